@@ -1,0 +1,197 @@
+//! Assembles cloths, their constraints and kinematic pins into a [`Solver`].
+
+use glam::Vec3;
+
+use crate::cloth::ClothMesh;
+use crate::constraints::{BlockBuilder, ConstraintSet, Dihedral, Distance, Tether};
+use crate::error::{BuildError, ParamError};
+use crate::forces::Forces;
+use crate::motion::{KinematicPin, Motion};
+use crate::params::{ClothParams, Family, FamilyParams};
+use crate::particles::Particles;
+use crate::settings::Settings;
+use crate::solver::{Cloth, Solver};
+use crate::topology::Topology;
+
+/// Collects cloths and pins, then colours the constraints and yields a [`Solver`].
+///
+/// A family disabled when its cloth is added gets no constraints; enabling it later needs a
+/// rebuild. A family disabled later is skipped at run time.
+#[derive(Debug)]
+pub struct SolverBuilder {
+    settings: Settings,
+    forces: Forces,
+    particles: Particles,
+    cloths: Vec<Cloth>,
+    params: Vec<FamilyParams>,
+    distance: BlockBuilder<2, Distance>,
+    dihedral: BlockBuilder<4, Dihedral>,
+    tethers: BlockBuilder<2, Tether>,
+    pins: Vec<KinematicPin>,
+}
+
+impl SolverBuilder {
+    /// Starts a solver with validated settings and forces.
+    pub fn new(settings: Settings, forces: Forces) -> Result<Self, ParamError> {
+        settings.validate()?;
+        forces.validate()?;
+        Ok(Self {
+            settings,
+            forces,
+            particles: Particles::default(),
+            cloths: Vec::new(),
+            params: Vec::new(),
+            distance: BlockBuilder::default(),
+            dihedral: BlockBuilder::default(),
+            tethers: BlockBuilder::default(),
+            pins: Vec::new(),
+        })
+    }
+
+    /// Adds a cloth with its family parameters and thickness (m); returns its index.
+    pub fn add_cloth(
+        &mut self,
+        name: impl Into<String>,
+        mesh: &ClothMesh,
+        params: ClothParams,
+        thickness: f32,
+    ) -> Result<usize, BuildError> {
+        let name = name.into();
+        params.validate()?;
+        if !(thickness.is_finite() && thickness >= 0.0) {
+            return Err(ParamError {
+                name: "thickness".into(),
+                value: thickness.into(),
+                expected: "finite and >= 0",
+            }
+            .into());
+        }
+        if mesh.masses.len() != mesh.positions.len() {
+            return Err(BuildError::MassCount {
+                name,
+                positions: mesh.positions.len(),
+                masses: mesh.masses.len(),
+            });
+        }
+        let cloth = self.cloths.len();
+        let offset = self.particles.len() as u32;
+        let start = self.particles.len();
+        let mut pinned = vec![false; mesh.len()];
+        for &p in &mesh.pinned {
+            pinned[p as usize] = true;
+        }
+        for (i, (&x, &m)) in mesh.positions.iter().zip(&mesh.masses).enumerate() {
+            let w = if pinned[i] || m <= 0.0 { 0.0 } else { 1.0 / m };
+            self.particles.push(x, w);
+        }
+        let group = |f: Family| (cloth * Family::COUNT + f.index()) as u32;
+        self.params.extend_from_slice(&params.families);
+        let g = |i: u32| i + offset;
+        let p = &mesh.positions;
+        let dist = |a: u32, b: u32| p[a as usize].distance(p[b as usize]);
+        for (family, pairs) in [
+            (Family::Stretch, &mesh.stretch),
+            (Family::Shear, &mesh.shear),
+        ] {
+            if params.get(family).enabled {
+                for &[a, b] in pairs {
+                    self.distance
+                        .push([g(a), g(b)], group(family), Distance { rest: dist(a, b) });
+                }
+            }
+        }
+        let topo = Topology::new(&mesh.triangles);
+        if params.get(Family::BendDistance).enabled {
+            for wing in &topo.wings {
+                let (a, b) = (wing.wing_a, wing.wing_b);
+                self.distance.push(
+                    [g(a), g(b)],
+                    group(Family::BendDistance),
+                    Distance { rest: dist(a, b) },
+                );
+            }
+        }
+        if params.get(Family::BendDihedral).enabled {
+            for wing in &topo.wings {
+                let idx = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
+                if let Some(rest) = Dihedral::angle(&idx.map(|i| p[i as usize])) {
+                    self.dihedral
+                        .push(idx.map(g), group(Family::BendDihedral), Dihedral { rest });
+                }
+            }
+        }
+        if params.get(Family::Tether).enabled && !mesh.pinned.is_empty() {
+            for i in (0..mesh.len() as u32).filter(|&i| !pinned[i as usize]) {
+                let nearest = mesh
+                    .pinned
+                    .iter()
+                    .copied()
+                    .min_by(|&a, &b| dist(i, a).total_cmp(&dist(i, b)));
+                if let Some(anchor) = nearest {
+                    self.tethers.push(
+                        [g(i), g(anchor)],
+                        group(Family::Tether),
+                        Tether {
+                            max_length: dist(i, anchor),
+                        },
+                    );
+                }
+            }
+        }
+        self.cloths.push(Cloth {
+            name,
+            particles: start..self.particles.len(),
+            triangles: mesh.triangles.iter().map(|t| t.map(g)).collect(),
+            edges: mesh.stretch.iter().map(|e| e.map(g)).collect(),
+            thickness,
+            grid: mesh.grid,
+        });
+        Ok(cloth)
+    }
+
+    /// Pins vertex `vertex` of cloth `cloth` (inverse mass 0) to follow `motion` from its rest position.
+    pub fn add_kinematic_pin(
+        &mut self,
+        cloth: usize,
+        vertex: u32,
+        motion: Motion,
+    ) -> Result<(), BuildError> {
+        let range = self
+            .cloths
+            .get(cloth)
+            .map(|c| c.particles.clone())
+            .ok_or(BuildError::NoSuchVertex { cloth, vertex })?;
+        let particle = range.start + vertex as usize;
+        if particle >= range.end {
+            return Err(BuildError::NoSuchVertex { cloth, vertex });
+        }
+        self.particles.inv_masses[particle] = 0.0;
+        self.pins.push(KinematicPin {
+            particle: particle as u32,
+            rest: self.particles.positions[particle],
+            motion,
+        });
+        Ok(())
+    }
+
+    /// Colours the constraints and returns the solver.
+    pub fn build(self) -> Solver {
+        let free: Vec<bool> = self.particles.inv_masses.iter().map(|&w| w > 0.0).collect();
+        let constraints = ConstraintSet {
+            distance: self.distance.finish(&free),
+            dihedral: self.dihedral.finish(&free),
+            tethers: self.tethers.finish(&free),
+        };
+        let n = self.particles.len();
+        Solver::assemble(
+            self.settings,
+            self.forces,
+            self.particles,
+            self.cloths,
+            self.params,
+            constraints,
+            self.pins,
+            vec![Vec3::ZERO; n],
+        )
+    }
+}

@@ -1,0 +1,265 @@
+//! A coloured block of constraints of one shape, stored struct-of-arrays and sorted by colour.
+
+use std::ops::Range;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::Shape;
+use crate::coloring::color;
+use crate::params::FamilyParams;
+
+/// How a position-based method turns C and ∇C into a multiplier step Δλ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Rule {
+    /// XPBD with substep `h`: Macklin et al. 2016, eq. (18) with the damping of eq. (26).
+    Xpbd {
+        /// Substep length (s).
+        h: f32,
+    },
+    /// PBD: Müller et al. 2007, eq. (10), scaled by the family's stiffness k.
+    Pbd,
+}
+
+/// Constraints of one shape, sorted by colour; arrays are indexed by constraint.
+#[derive(Clone, Debug)]
+pub(crate) struct Block<const N: usize, S> {
+    /// Global particle indices of each constraint.
+    pub particles: Vec<[u32; N]>,
+    /// Parameter group of each constraint: `cloth * Family::COUNT + family`.
+    pub group: Vec<u32>,
+    /// Rest data of each constraint.
+    pub shapes: Vec<S>,
+    /// XPBD Lagrange multipliers, reset each substep.
+    pub lambda: Vec<f32>,
+    /// Contiguous range of each colour.
+    pub colors: Vec<Range<usize>>,
+    /// Scratch corrections for the parallel path (one colour at a time).
+    deltas: Vec<[Vec3; N]>,
+}
+
+impl<const N: usize, S> Default for Block<N, S> {
+    fn default() -> Self {
+        Self {
+            particles: Vec::new(),
+            group: Vec::new(),
+            shapes: Vec::new(),
+            lambda: Vec::new(),
+            colors: Vec::new(),
+            deltas: Vec::new(),
+        }
+    }
+}
+
+/// Collects constraints of one shape before colouring.
+#[derive(Clone, Debug)]
+pub(crate) struct BlockBuilder<const N: usize, S> {
+    particles: Vec<[u32; N]>,
+    group: Vec<u32>,
+    shapes: Vec<S>,
+}
+
+impl<const N: usize, S> Default for BlockBuilder<N, S> {
+    fn default() -> Self {
+        Self {
+            particles: Vec::new(),
+            group: Vec::new(),
+            shapes: Vec::new(),
+        }
+    }
+}
+
+impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
+    /// Adds one constraint.
+    pub fn push(&mut self, particles: [u32; N], group: u32, shape: S) {
+        self.particles.push(particles);
+        self.group.push(group);
+        self.shapes.push(shape);
+    }
+
+    /// Colours the constraints (ignoring particles that are not `free`) and sorts them by colour.
+    pub fn finish(self, free: &[bool]) -> Block<N, S> {
+        let colours = color(&self.particles, free);
+        let mut order: Vec<usize> = (0..colours.len()).collect();
+        order.sort_by_key(|&i| colours[i]); // stable: keeps insertion order inside a colour
+        let mut ranges: Vec<Range<usize>> = Vec::new();
+        for (pos, &i) in order.iter().enumerate() {
+            match ranges.last_mut() {
+                Some(r) if colours[order[r.start]] == colours[i] => r.end = pos + 1,
+                _ => ranges.push(pos..pos + 1),
+            }
+        }
+        let largest = ranges.iter().map(|r| r.len()).max().unwrap_or(0);
+        Block {
+            particles: order.iter().map(|&i| self.particles[i]).collect(),
+            group: order.iter().map(|&i| self.group[i]).collect(),
+            shapes: order.iter().map(|&i| self.shapes[i]).collect(),
+            lambda: vec![0.0; order.len()],
+            colors: ranges,
+            deltas: vec![[Vec3::ZERO; N]; largest],
+        }
+    }
+}
+
+/// Position corrections Δxᵢ = wᵢ ∇Cᵢ Δλ of one constraint (zeros when it is inactive).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn correction<const N: usize, S: Shape<N>>(
+    shape: &S,
+    idx: &[u32; N],
+    group: u32,
+    lambda: &mut f32,
+    x: &[Vec3],
+    prev: &[Vec3],
+    w: &[f32],
+    params: &[FamilyParams],
+    rule: Rule,
+) -> [Vec3; N] {
+    let p = &params[group as usize];
+    let pos = idx.map(|i| x[i as usize]);
+    let wi = idx.map(|i| w[i as usize]);
+    if !p.enabled {
+        return [Vec3::ZERO; N];
+    }
+    let Some((c, grad)) = shape.evaluate(&pos) else {
+        return [Vec3::ZERO; N];
+    };
+    let w_grad2: f32 = (0..N).map(|k| wi[k] * grad[k].length_squared()).sum();
+    let dl = match rule {
+        Rule::Xpbd { h } => {
+            // α̃ = α/h², γ = α̃ β̃ / h with β̃ = h² β  (Macklin et al. 2016, eq. 26).
+            let alpha = p.compliance / (h * h);
+            let gamma = p.compliance * p.damping / h;
+            let grad_dx: f32 = if gamma > 0.0 {
+                (0..N)
+                    .map(|k| grad[k].dot(pos[k] - prev[idx[k] as usize]))
+                    .sum()
+            } else {
+                0.0
+            };
+            let denom = (1.0 + gamma) * w_grad2 + alpha;
+            if denom <= f32::MIN_POSITIVE {
+                return [Vec3::ZERO; N];
+            }
+            let dl = (-c - alpha * *lambda - gamma * grad_dx) / denom;
+            *lambda += dl;
+            dl
+        }
+        Rule::Pbd => {
+            if w_grad2 <= f32::MIN_POSITIVE {
+                return [Vec3::ZERO; N];
+            }
+            -p.pbd_stiffness * c / w_grad2
+        }
+    };
+    std::array::from_fn(|k| grad[k] * (wi[k] * dl))
+}
+
+impl<const N: usize, S: Shape<N>> Block<N, S> {
+    /// Number of constraints.
+    pub fn len(&self) -> usize {
+        self.particles.len()
+    }
+
+    /// Number of colours.
+    pub fn color_count(&self) -> usize {
+        self.colors.len()
+    }
+
+    /// Clears the XPBD multipliers.
+    pub fn reset_multipliers(&mut self) {
+        self.lambda.fill(0.0);
+    }
+
+    /// One Gauss–Seidel sweep, colour by colour.
+    ///
+    /// A colour with at least `par_min` constraints is computed in parallel into scratch and then
+    /// applied in order; a smaller one is computed and applied constraint by constraint. Inside a
+    /// colour no two constraints share a free particle, so both paths read the same inputs, do the
+    /// same arithmetic and give bit-identical results, whatever the thread count.
+    pub fn project(
+        &mut self,
+        x: &mut [Vec3],
+        prev: &[Vec3],
+        w: &[f32],
+        params: &[FamilyParams],
+        rule: Rule,
+        par_min: usize,
+    ) {
+        for c in 0..self.colors.len() {
+            let r = self.colors[c].clone();
+            let idx = &self.particles[r.clone()];
+            let shapes = &self.shapes[r.clone()];
+            let groups = &self.group[r.clone()];
+            let lambda = &mut self.lambda[r.clone()];
+            if r.len() >= par_min.max(1) {
+                let xr: &[Vec3] = x;
+                let deltas = &mut self.deltas[..r.len()];
+                deltas
+                    .par_iter_mut()
+                    .zip(lambda.par_iter_mut())
+                    .enumerate()
+                    .with_min_len(256)
+                    .for_each(|(k, (d, l))| {
+                        *d = correction(
+                            &shapes[k], &idx[k], groups[k], l, xr, prev, w, params, rule,
+                        );
+                    });
+                for (ids, d) in idx.iter().zip(deltas.iter()) {
+                    for k in 0..N {
+                        x[ids[k] as usize] += d[k];
+                    }
+                }
+            } else {
+                for k in 0..r.len() {
+                    let d = correction(
+                        &shapes[k],
+                        &idx[k],
+                        groups[k],
+                        &mut lambda[k],
+                        x,
+                        prev,
+                        w,
+                        params,
+                        rule,
+                    );
+                    for (j, dj) in d.iter().enumerate() {
+                        x[idx[k][j] as usize] += *dj;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds spring forces fᵢ = −(k C + c Ċ) ∇Cᵢ, with Ċ = Σ ∇Cⱼ·vⱼ, to `forces`.
+    pub fn spring_forces(
+        &self,
+        x: &[Vec3],
+        v: &[Vec3],
+        params: &[FamilyParams],
+        forces: &mut [Vec3],
+    ) {
+        for ((idx, shape), &g) in self.particles.iter().zip(&self.shapes).zip(&self.group) {
+            let p = &params[g as usize];
+            if !p.enabled {
+                continue;
+            }
+            let Some((c, grad)) = shape.evaluate(&idx.map(|i| x[i as usize])) else {
+                continue;
+            };
+            let c_dot: f32 = (0..N).map(|k| grad[k].dot(v[idx[k] as usize])).sum();
+            let f = -(p.spring_stiffness * c + p.spring_damping * c_dot);
+            for k in 0..N {
+                forces[idx[k] as usize] += grad[k] * f;
+            }
+        }
+    }
+
+    /// C of every active constraint at `x`.
+    pub fn residuals<'a>(&'a self, x: &'a [Vec3]) -> impl Iterator<Item = f32> + 'a {
+        self.particles
+            .iter()
+            .zip(&self.shapes)
+            .filter_map(|(idx, s)| s.evaluate(&idx.map(|i| x[i as usize])).map(|(c, _)| c))
+    }
+}

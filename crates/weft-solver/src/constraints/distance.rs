@@ -1,0 +1,25 @@
+//! Distance constraint C = |p₀ − p₁| − d (Müller et al. 2007, eq. 9; the poster's Δp formula).
+
+use glam::Vec3;
+
+use super::Shape;
+
+/// Keeps two particles at a rest distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Distance {
+    /// Rest length d (m).
+    pub rest: f32,
+}
+
+impl Shape<2> for Distance {
+    #[inline]
+    fn evaluate(&self, p: &[Vec3; 2]) -> Option<(f32, [Vec3; 2])> {
+        let d = p[0] - p[1];
+        let len = d.length();
+        if len < 1e-9 {
+            return None;
+        }
+        let n = d / len;
+        Some((len - self.rest, [n, -n]))
+    }
+}

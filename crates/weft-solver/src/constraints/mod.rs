@@ -1,0 +1,114 @@
+//! The constraint set: every cloth's constraints, coloured, in one block per shape.
+
+mod block;
+mod dihedral;
+mod distance;
+mod tether;
+
+pub(crate) use block::{Block, BlockBuilder, Rule};
+pub use dihedral::Dihedral;
+pub use distance::Distance;
+pub use tether::Tether;
+
+use glam::Vec3;
+
+use crate::params::FamilyParams;
+
+/// A constraint function C(p) over `N` particles with its gradient.
+pub trait Shape<const N: usize>: Copy + Send + Sync {
+    /// Returns C and ∇C at `p`, or `None` when the constraint is inactive or degenerate there.
+    fn evaluate(&self, p: &[Vec3; N]) -> Option<(f32, [Vec3; N])>;
+}
+
+/// Every constraint of a solver: distance-like pairs, dihedral quadruples and tethers.
+#[derive(Clone, Debug, Default)]
+pub struct ConstraintSet {
+    /// Stretch, shear and bend-distance constraints.
+    pub(crate) distance: Block<2, Distance>,
+    /// Dihedral bending constraints.
+    pub(crate) dihedral: Block<4, Dihedral>,
+    /// Long-range attachments.
+    pub(crate) tethers: Block<2, Tether>,
+}
+
+/// Max and root-mean-square of |C| over a set of constraints.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Residual {
+    /// Largest |C|.
+    pub max: f32,
+    /// Root mean square of C.
+    pub rms: f32,
+    /// Number of constraints measured.
+    pub count: usize,
+}
+
+impl ConstraintSet {
+    /// Number of constraints of every shape.
+    pub fn len(&self) -> usize {
+        self.distance.len() + self.dihedral.len() + self.tethers.len()
+    }
+
+    /// Whether there is no constraint.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Number of colours in each block (distance, dihedral, tether).
+    pub fn color_counts(&self) -> [usize; 3] {
+        [
+            self.distance.color_count(),
+            self.dihedral.color_count(),
+            self.tethers.color_count(),
+        ]
+    }
+
+    /// Clears the XPBD multipliers (at the start of each substep).
+    pub(crate) fn reset_multipliers(&mut self) {
+        self.distance.reset_multipliers();
+        self.dihedral.reset_multipliers();
+        self.tethers.reset_multipliers();
+    }
+
+    /// One Gauss–Seidel sweep over every constraint, colour by colour.
+    pub(crate) fn project(
+        &mut self,
+        x: &mut [Vec3],
+        prev: &[Vec3],
+        w: &[f32],
+        params: &[FamilyParams],
+        rule: Rule,
+        par_min: usize,
+    ) {
+        self.distance.project(x, prev, w, params, rule, par_min);
+        self.dihedral.project(x, prev, w, params, rule, par_min);
+        self.tethers.project(x, prev, w, params, rule, par_min);
+    }
+
+    /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N).
+    pub(crate) fn spring_forces(
+        &self,
+        x: &[Vec3],
+        v: &[Vec3],
+        params: &[FamilyParams],
+        forces: &mut [Vec3],
+    ) {
+        self.distance.spring_forces(x, v, params, forces);
+        self.dihedral.spring_forces(x, v, params, forces);
+        self.tethers.spring_forces(x, v, params, forces);
+    }
+
+    /// |C| over distance-like constraints (stretch, shear, bend-distance) and active tethers (m).
+    pub fn distance_residual(&self, x: &[Vec3]) -> Residual {
+        let mut r = Residual::default();
+        let mut sum = 0.0f64;
+        for c in self.distance.residuals(x).chain(self.tethers.residuals(x)) {
+            r.max = r.max.max(c.abs());
+            sum += f64::from(c) * f64::from(c);
+            r.count += 1;
+        }
+        if r.count > 0 {
+            r.rms = (sum / r.count as f64).sqrt() as f32;
+        }
+        r
+    }
+}

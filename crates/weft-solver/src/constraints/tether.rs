@@ -1,0 +1,25 @@
+//! Long-range attachment (Kim et al. 2012): C = |p − a| − L, active only when C > 0.
+
+use glam::Vec3;
+
+use super::Shape;
+
+/// Keeps a particle within a maximum distance of its pinned anchor (`[particle, anchor]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tether {
+    /// Maximum distance L (m).
+    pub max_length: f32,
+}
+
+impl Shape<2> for Tether {
+    #[inline]
+    fn evaluate(&self, p: &[Vec3; 2]) -> Option<(f32, [Vec3; 2])> {
+        let d = p[0] - p[1];
+        let len = d.length();
+        if len <= self.max_length || len < 1e-9 {
+            return None;
+        }
+        let n = d / len;
+        Some((len - self.max_length, [n, -n]))
+    }
+}

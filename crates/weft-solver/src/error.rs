@@ -1,0 +1,148 @@
+//! Error values of the solver crate.
+
+use glam::Vec3;
+use thiserror::Error;
+
+use crate::method::Method;
+
+/// A cloth mesh that cannot be simulated.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum MeshError {
+    /// The mesh has no triangle.
+    #[error("mesh has no triangles")]
+    Empty,
+    /// A triangle names a vertex that does not exist.
+    #[error("triangle {triangle} uses vertex {index}, but the mesh has only {vertices} vertices")]
+    IndexOutOfRange {
+        /// The triangle's index.
+        triangle: usize,
+        /// The bad vertex index.
+        index: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A triangle has zero area or repeats a vertex.
+    #[error("triangle {triangle} is degenerate (zero area or repeated vertex)")]
+    DegenerateTriangle {
+        /// The triangle's index.
+        triangle: usize,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex {
+        /// The vertex's index.
+        vertex: u32,
+    },
+    /// A vertex is used by no triangle.
+    #[error("vertex {vertex} belongs to no triangle")]
+    UnusedVertex {
+        /// The vertex's index.
+        vertex: u32,
+    },
+    /// More than two triangles share one edge.
+    #[error("edge {a}-{b} is shared by more than two triangles (non-manifold mesh)")]
+    NonManifoldEdge {
+        /// One end of the edge.
+        a: u32,
+        /// The other end.
+        b: u32,
+    },
+    /// A pinned index does not exist.
+    #[error("pinned particle {index} does not exist (the cloth has {vertices})")]
+    PinOutOfRange {
+        /// The bad index.
+        index: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// Mass or density not finite and positive.
+    #[error("mass must be finite and positive, got {value}")]
+    InvalidMass {
+        /// The value given.
+        value: f32,
+    },
+    /// A grid needs at least 2×2 particles.
+    #[error("a grid needs at least 2x2 particles, got {columns}x{rows}")]
+    GridTooSmall {
+        /// Columns given.
+        columns: usize,
+        /// Rows given.
+        rows: usize,
+    },
+    /// Grid size not finite and positive.
+    #[error("grid size must be finite and positive, got {width} x {height}")]
+    InvalidSize {
+        /// Width given.
+        width: f32,
+        /// Height given.
+        height: f32,
+    },
+}
+
+/// A parameter outside the range where it makes sense.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[error("parameter `{name}` = {value} is invalid: {expected}")]
+pub struct ParamError {
+    /// Dotted name of the parameter, e.g. `stretch.compliance`.
+    pub name: String,
+    /// The value given.
+    pub value: f64,
+    /// What was expected.
+    pub expected: &'static str,
+}
+
+/// A failure while stepping.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SolverError {
+    /// The simulation blew up: a position became non-finite or left the sane bound.
+    #[error(
+        "{method} simulation diverged at frame {frame}: particle {particle} reached {position} \
+         (bound {bound} m); lower the stiffness or the time step, or add substeps"
+    )]
+    Diverged {
+        /// The method that was running.
+        method: Method,
+        /// The frame being stepped (0-based).
+        frame: u64,
+        /// The first offending particle.
+        particle: usize,
+        /// Its position.
+        position: Vec3,
+        /// The bound that was crossed (m).
+        bound: f32,
+    },
+    /// A particle index that does not exist.
+    #[error("particle {index} does not exist (the solver has {count})")]
+    NoSuchParticle {
+        /// The index given.
+        index: usize,
+        /// Number of particles.
+        count: usize,
+    },
+}
+
+/// A cloth or pin that cannot be added to a solver.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum BuildError {
+    /// A parameter is out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// A pin names a vertex or cloth that does not exist.
+    #[error("cloth {cloth} has no vertex {vertex}")]
+    NoSuchVertex {
+        /// The cloth's index.
+        cloth: usize,
+        /// The vertex given.
+        vertex: u32,
+    },
+    /// The cloth's vertex count does not match its masses.
+    #[error("cloth `{name}` has {positions} positions but {masses} masses")]
+    MassCount {
+        /// The cloth's name.
+        name: String,
+        /// Number of positions.
+        positions: usize,
+        /// Number of masses.
+        masses: usize,
+    },
+}

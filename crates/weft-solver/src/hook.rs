@@ -1,0 +1,39 @@
+//! The seam through which collisions (or anything else) act inside each substep.
+
+use crate::method::Method;
+use crate::particles::Particles;
+
+/// Where in the step loop a hook is being called.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubstepContext {
+    /// The running method.
+    pub method: Method,
+    /// Simulated time at the end of this substep (s).
+    pub time: f64,
+    /// Substep length h (s).
+    pub h: f32,
+    /// Substep number inside the frame, from 0.
+    pub substep: u32,
+}
+
+/// Acts on the particles inside every substep; the collision crate implements it.
+///
+/// Order in one substep: integrate (predict) → [`SubstepHook::begin_substep`] → for each
+/// iteration: project constraints, then [`SubstepHook::project`] → velocities from positions →
+/// [`SubstepHook::end_substep`]. Mass-spring projects no constraints but still calls `project`
+/// once, so contacts are handled by projection for every method.
+pub trait SubstepHook {
+    /// After prediction: find contact candidates for this substep.
+    fn begin_substep(&mut self, _ctx: &SubstepContext, _particles: &Particles) {}
+
+    /// After each constraint sweep: move particles out of obstacles; returns the contact count.
+    fn project(&mut self, _ctx: &SubstepContext, _particles: &mut Particles) -> usize {
+        0
+    }
+
+    /// After velocities are derived from positions: velocity-level corrections.
+    fn end_substep(&mut self, _ctx: &SubstepContext, _particles: &mut Particles) {}
+}
+
+/// No hook: nothing but the cloth's own constraints.
+impl SubstepHook for () {}

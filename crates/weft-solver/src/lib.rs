@@ -1,0 +1,42 @@
+//! Weft's cloth solver.
+//!
+//! One particle store ([`Particles`], struct-of-arrays), one coloured constraint set and one
+//! substep loop ([`Solver::step_with`]) serve three methods ([`Method`]): XPBD, PBD and
+//! mass-spring. Cloths come from grid or triangle-mesh builders; collisions plug in through
+//! [`SubstepHook`]. The crate knows nothing of files, windows or rendering.
+#![warn(missing_docs)]
+
+mod builder;
+mod cloth;
+mod coloring;
+pub mod constraints;
+mod error;
+mod forces;
+mod grid;
+mod hook;
+mod method;
+mod methods;
+mod motion;
+mod params;
+mod particles;
+mod settings;
+mod solver;
+mod topology;
+
+pub use builder::SolverBuilder;
+pub use cloth::{ClothMesh, Mass};
+pub use constraints::Residual;
+pub use error::{BuildError, MeshError, ParamError, SolverError};
+pub use forces::{Aero, Forces, Wind};
+pub use grid::{Corner, Edge, GridDesc, Orientation, Pin};
+pub use hook::{SubstepContext, SubstepHook};
+pub use method::{Method, UnknownMethod};
+pub use motion::{KinematicPin, Motion, RigidTransform};
+pub use params::{ClothParams, Family, FamilyParams};
+pub use particles::Particles;
+pub use settings::Settings;
+pub use solver::{Cloth, Solver, StepStats};
+pub use topology::{EdgeWings, Topology};
+
+/// Re-export of the math library, so users share our `Vec3`.
+pub use glam;

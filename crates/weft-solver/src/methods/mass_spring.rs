@@ -1,0 +1,36 @@
+//! Mass-spring: constraint forces −(k C + c Ċ)∇C integrated with semi-implicit Euler.
+
+use glam::Vec3;
+
+use crate::constraints::{ConstraintSet, Rule};
+use crate::method::Strategy;
+use crate::params::FamilyParams;
+use crate::particles::Particles;
+
+/// Springs with stiffness in N/m, integrated explicitly: conditionally stable.
+pub(crate) struct MassSpring;
+
+impl Strategy for MassSpring {
+    fn add_internal_forces(
+        &self,
+        constraints: &ConstraintSet,
+        particles: &Particles,
+        params: &[FamilyParams],
+        force: &mut [Vec3],
+        accel: &mut [Vec3],
+    ) {
+        force.fill(Vec3::ZERO);
+        constraints.spring_forces(&particles.positions, &particles.velocities, params, force);
+        for ((a, f), w) in accel
+            .iter_mut()
+            .zip(force.iter())
+            .zip(&particles.inv_masses)
+        {
+            *a += *f * *w;
+        }
+    }
+
+    fn rule(&self, _h: f32) -> Option<Rule> {
+        None
+    }
+}

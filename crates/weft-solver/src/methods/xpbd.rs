@@ -1,0 +1,17 @@
+//! XPBD: multipliers reset every substep, projection with compliance α̃ = α/h².
+
+use crate::constraints::{ConstraintSet, Rule};
+use crate::method::Strategy;
+
+/// Extended Position Based Dynamics (Macklin, Müller, Chentanez 2016).
+pub(crate) struct Xpbd;
+
+impl Strategy for Xpbd {
+    fn begin_substep(&self, constraints: &mut ConstraintSet) {
+        constraints.reset_multipliers();
+    }
+
+    fn rule(&self, h: f32) -> Option<Rule> {
+        Some(Rule::Xpbd { h })
+    }
+}

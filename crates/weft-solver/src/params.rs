@@ -1,0 +1,180 @@
+//! Constraint families and their per-method parameters.
+
+use crate::error::ParamError;
+
+/// A family of constraints; each cloth sets each family's parameters on its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Family {
+    /// Mesh edges (grid lines on grids).
+    Stretch,
+    /// Quad diagonals on grids.
+    Shear,
+    /// Distance between the two wing vertices across each interior edge.
+    BendDistance,
+    /// Dihedral angle across each interior edge.
+    BendDihedral,
+    /// Long-range attachments to pinned particles (unilateral: only resists stretching).
+    Tether,
+}
+
+impl Family {
+    /// Every family, in a fixed order.
+    pub const ALL: [Family; 5] = [
+        Family::Stretch,
+        Family::Shear,
+        Family::BendDistance,
+        Family::BendDihedral,
+        Family::Tether,
+    ];
+
+    /// Number of families.
+    pub const COUNT: usize = Self::ALL.len();
+
+    /// Position of the family in [`Family::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Lower-case name as used in scene files (`stretch`, `shear`, `bend_distance`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::Stretch => "stretch",
+            Family::Shear => "shear",
+            Family::BendDistance => "bend_distance",
+            Family::BendDihedral => "bend_dihedral",
+            Family::Tether => "tether",
+        }
+    }
+}
+
+/// The parameters of one constraint family, for each method.
+///
+/// Units: distance families (stretch, shear, bend-distance, tether) use m/N for compliance and
+/// N/m for spring stiffness; the dihedral family uses rad/(N·m) and N·m/rad.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FamilyParams {
+    /// Whether the family's constraints are created at all.
+    pub enabled: bool,
+    /// XPBD compliance α (inverse stiffness); 0 is infinitely stiff.
+    pub compliance: f32,
+    /// XPBD constraint damping β (s), the damping term of Macklin et al. 2016, eq. (26).
+    pub damping: f32,
+    /// PBD stiffness k in [0, 1], applied to each projection (Müller et al. 2007, §3.3).
+    pub pbd_stiffness: f32,
+    /// Mass-spring stiffness.
+    pub spring_stiffness: f32,
+    /// Mass-spring damping along the spring (N·s/m).
+    pub spring_damping: f32,
+}
+
+impl FamilyParams {
+    /// Defaults for a family: stiff in-plane, soft bending, tethers off.
+    pub fn default_for(family: Family) -> Self {
+        let (enabled, compliance, pbd_stiffness, spring_stiffness) = match family {
+            Family::Stretch => (true, 0.0, 1.0, 5.0e3),
+            Family::Shear => (true, 1e-6, 1.0, 2.0e3),
+            Family::BendDistance => (false, 1e-3, 0.1, 50.0),
+            Family::BendDihedral => (true, 1.0, 0.05, 0.05),
+            Family::Tether => (false, 0.0, 1.0, 5.0e3),
+        };
+        Self {
+            enabled,
+            compliance,
+            damping: 0.0,
+            pbd_stiffness,
+            spring_stiffness,
+            spring_damping: 0.0,
+        }
+    }
+
+    /// Checks every value is finite and in range; `family` names the parameter in the error.
+    pub fn validate(&self, family: Family) -> Result<(), ParamError> {
+        let check = |field: &str, value: f32, ok: bool, expected: &'static str| {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(ParamError {
+                    name: format!("{}.{field}", family.name()),
+                    value: f64::from(value),
+                    expected,
+                })
+            }
+        };
+        check(
+            "compliance",
+            self.compliance,
+            self.compliance >= 0.0,
+            "finite and >= 0",
+        )?;
+        check(
+            "damping",
+            self.damping,
+            self.damping >= 0.0,
+            "finite and >= 0",
+        )?;
+        check(
+            "pbd_stiffness",
+            self.pbd_stiffness,
+            (0.0..=1.0).contains(&self.pbd_stiffness),
+            "in [0, 1]",
+        )?;
+        check(
+            "spring_stiffness",
+            self.spring_stiffness,
+            self.spring_stiffness >= 0.0,
+            "finite and >= 0",
+        )?;
+        check(
+            "spring_damping",
+            self.spring_damping,
+            self.spring_damping >= 0.0,
+            "finite and >= 0",
+        )
+    }
+}
+
+/// Parameters of every family of one cloth, indexed by [`Family::index`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClothParams {
+    /// One entry per family.
+    pub families: [FamilyParams; Family::COUNT],
+}
+
+impl Default for ClothParams {
+    fn default() -> Self {
+        Self {
+            families: Family::ALL.map(FamilyParams::default_for),
+        }
+    }
+}
+
+impl ClothParams {
+    /// The parameters of `family`.
+    pub fn get(&self, family: Family) -> &FamilyParams {
+        &self.families[family.index()]
+    }
+
+    /// Mutable parameters of `family`.
+    pub fn get_mut(&mut self, family: Family) -> &mut FamilyParams {
+        &mut self.families[family.index()]
+    }
+
+    /// Builder-style: sets `family`'s parameters.
+    pub fn with(mut self, family: Family, params: FamilyParams) -> Self {
+        self.families[family.index()] = params;
+        self
+    }
+
+    /// Builder-style: edits `family`'s parameters in place.
+    pub fn edit(mut self, family: Family, f: impl FnOnce(&mut FamilyParams)) -> Self {
+        f(self.get_mut(family));
+        self
+    }
+
+    /// Validates every family.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        Family::ALL
+            .iter()
+            .try_for_each(|&f| self.get(f).validate(f))
+    }
+}

@@ -1,0 +1,69 @@
+//! Time stepping settings.
+
+use crate::error::ParamError;
+use crate::method::Method;
+
+/// How the solver steps: method, frame time step, substeps and iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The method.
+    pub method: Method,
+    /// Frame time step Δt (s); each frame is split into `substeps` substeps of h = Δt / substeps.
+    pub dt: f32,
+    /// Substeps per frame (≥ 1).
+    pub substeps: u32,
+    /// Constraint sweeps per substep (≥ 1; ignored by mass-spring).
+    pub iterations: u32,
+    /// A particle farther than this from the origin (m) means the simulation diverged.
+    pub divergence_bound: f32,
+    /// Colours with at least this many constraints are solved in parallel.
+    pub parallel_min_batch: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            method: Method::Xpbd,
+            dt: 1.0 / 60.0,
+            substeps: 10,
+            iterations: 1,
+            divergence_bound: 1.0e4,
+            parallel_min_batch: 4096,
+        }
+    }
+}
+
+impl Settings {
+    /// Substep length h = Δt / substeps (s).
+    pub fn h(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+
+    /// Checks the values make sense.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let bad = |name: &str, value: f64, expected| {
+            Err(ParamError {
+                name: name.to_owned(),
+                value,
+                expected,
+            })
+        };
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return bad("dt", self.dt.into(), "finite and > 0");
+        }
+        if self.substeps == 0 {
+            return bad("substeps", 0.0, ">= 1");
+        }
+        if self.iterations == 0 {
+            return bad("iterations", 0.0, ">= 1");
+        }
+        if !(self.divergence_bound.is_finite() && self.divergence_bound > 0.0) {
+            return bad(
+                "divergence_bound",
+                self.divergence_bound.into(),
+                "finite and > 0",
+            );
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,360 @@
+//! The solver: one step loop shared by every method.
+
+use std::ops::Range;
+
+use glam::Vec3;
+
+use crate::constraints::{ConstraintSet, Residual};
+use crate::error::{ParamError, SolverError};
+use crate::forces::Forces;
+use crate::hook::{SubstepContext, SubstepHook};
+use crate::motion::KinematicPin;
+use crate::params::{ClothParams, Family, FamilyParams};
+use crate::particles::Particles;
+use crate::settings::Settings;
+
+/// A cloth inside a solver: its particle range and its mesh in global particle indices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cloth {
+    /// Name (unique names are the caller's business).
+    pub name: String,
+    /// Its particles in the solver's store.
+    pub particles: Range<usize>,
+    /// Triangles, in global particle indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Mesh edges (grid lines for grids), in global particle indices.
+    pub edges: Vec<[u32; 2]>,
+    /// Thickness (m): contacts keep particles this far from surfaces.
+    pub thickness: f32,
+    /// Grid resolution `(columns, rows)` when the cloth is a grid.
+    pub grid: Option<(usize, usize)>,
+}
+
+/// What one frame did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepStats {
+    /// Contacts reported by the hook in the last substep.
+    pub contacts: usize,
+}
+
+/// A particle held by the user, dragged toward a target.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Grab {
+    particle: usize,
+    inv_mass: f32,
+    from: Vec3,
+    target: Vec3,
+}
+
+/// The cloth solver: particles, constraints, forces and the shared step loop.
+#[derive(Clone, Debug)]
+pub struct Solver {
+    settings: Settings,
+    forces: Forces,
+    particles: Particles,
+    initial: Particles,
+    cloths: Vec<Cloth>,
+    all_triangles: Vec<[u32; 3]>,
+    params: Vec<FamilyParams>,
+    constraints: ConstraintSet,
+    pins: Vec<KinematicPin>,
+    grab: Option<Grab>,
+    accel: Vec<Vec3>,
+    force: Vec<Vec3>,
+    time: f64,
+    frame: u64,
+}
+
+impl Solver {
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn assemble(
+        settings: Settings,
+        forces: Forces,
+        particles: Particles,
+        cloths: Vec<Cloth>,
+        params: Vec<FamilyParams>,
+        constraints: ConstraintSet,
+        pins: Vec<KinematicPin>,
+        scratch: Vec<Vec3>,
+    ) -> Self {
+        let all_triangles = cloths
+            .iter()
+            .flat_map(|c| c.triangles.iter().copied())
+            .collect();
+        Self {
+            settings,
+            forces,
+            initial: particles.clone(),
+            particles,
+            cloths,
+            all_triangles,
+            params,
+            constraints,
+            pins,
+            grab: None,
+            force: scratch.clone(),
+            accel: scratch,
+            time: 0.0,
+            frame: 0,
+        }
+    }
+
+    /// The particle store (read-only: only the step loop and its hook move particles).
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+
+    /// Mutable particle store, for tools that set up states (e.g. initial velocities).
+    pub fn particles_mut(&mut self) -> &mut Particles {
+        &mut self.particles
+    }
+
+    /// The cloths.
+    pub fn cloths(&self) -> &[Cloth] {
+        &self.cloths
+    }
+
+    /// The index of the cloth called `name`.
+    pub fn cloth_index(&self, name: &str) -> Option<usize> {
+        self.cloths.iter().position(|c| c.name == name)
+    }
+
+    /// The constraint set.
+    pub fn constraints(&self) -> &ConstraintSet {
+        &self.constraints
+    }
+
+    /// The kinematic pins.
+    pub fn kinematic_pins(&self) -> &[KinematicPin] {
+        &self.pins
+    }
+
+    /// Current settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Changes settings (method, time step, substeps, iterations) from the next frame on.
+    pub fn set_settings(&mut self, settings: Settings) -> Result<(), ParamError> {
+        settings.validate()?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Current forces.
+    pub fn forces(&self) -> &Forces {
+        &self.forces
+    }
+
+    /// Changes forces from the next frame on.
+    pub fn set_forces(&mut self, forces: Forces) -> Result<(), ParamError> {
+        forces.validate()?;
+        self.forces = forces;
+        Ok(())
+    }
+
+    /// The family parameters of cloth `cloth`.
+    pub fn cloth_params(&self, cloth: usize) -> ClothParams {
+        let base = cloth * Family::COUNT;
+        ClothParams {
+            families: std::array::from_fn(|f| self.params[base + f]),
+        }
+    }
+
+    /// Changes the family parameters of cloth `cloth` from the next frame on.
+    pub fn set_cloth_params(
+        &mut self,
+        cloth: usize,
+        params: ClothParams,
+    ) -> Result<(), ParamError> {
+        params.validate()?;
+        let base = cloth * Family::COUNT;
+        self.params[base..base + Family::COUNT].copy_from_slice(&params.families);
+        Ok(())
+    }
+
+    /// Changes the thickness of cloth `cloth`.
+    pub fn set_thickness(&mut self, cloth: usize, thickness: f32) -> Result<(), ParamError> {
+        if !(thickness.is_finite() && thickness >= 0.0) {
+            return Err(ParamError {
+                name: "thickness".into(),
+                value: thickness.into(),
+                expected: "finite and >= 0",
+            });
+        }
+        self.cloths[cloth].thickness = thickness;
+        Ok(())
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Frames stepped so far.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Puts every particle back where it started and the clock at 0.
+    pub fn reset(&mut self) {
+        self.particles = self.initial.clone();
+        self.grab = None;
+        self.time = 0.0;
+        self.frame = 0;
+    }
+
+    /// |C| over the distance-like constraints at the current positions (m).
+    pub fn residual(&self) -> Residual {
+        self.constraints
+            .distance_residual(&self.particles.positions)
+    }
+
+    /// Holds particle `i` (inverse mass 0) where it is, until [`Solver::release`].
+    pub fn grab(&mut self, i: usize) -> Result<(), SolverError> {
+        if i >= self.particles.len() {
+            return Err(SolverError::NoSuchParticle {
+                index: i,
+                count: self.particles.len(),
+            });
+        }
+        self.release();
+        let x = self.particles.positions[i];
+        self.grab = Some(Grab {
+            particle: i,
+            inv_mass: self.particles.inv_masses[i],
+            from: x,
+            target: x,
+        });
+        self.particles.inv_masses[i] = 0.0;
+        Ok(())
+    }
+
+    /// Moves the held particle toward `target` over the next frame's substeps.
+    pub fn drag_to(&mut self, target: Vec3) {
+        if let Some(g) = &mut self.grab
+            && target.is_finite()
+        {
+            g.target = target;
+        }
+    }
+
+    /// The held particle and its target, if any.
+    pub fn grabbed(&self) -> Option<(usize, Vec3)> {
+        self.grab.map(|g| (g.particle, g.target))
+    }
+
+    /// Lets the held particle go: its mass comes back and it keeps its drag velocity.
+    pub fn release(&mut self) {
+        if let Some(g) = self.grab.take() {
+            self.particles.inv_masses[g.particle] = g.inv_mass;
+        }
+    }
+
+    /// Advances one frame of Δt with no hook.
+    pub fn step(&mut self) -> Result<StepStats, SolverError> {
+        self.step_with(&mut ())
+    }
+
+    /// Advances one frame of Δt: `substeps` substeps of the shared loop, calling `hook` inside.
+    pub fn step_with(&mut self, hook: &mut dyn SubstepHook) -> Result<StepStats, SolverError> {
+        let s = self.settings;
+        let h = s.h();
+        let strategy = s.method.strategy();
+        let mut stats = StepStats::default();
+        for k in 0..s.substeps {
+            let ctx = SubstepContext {
+                method: s.method,
+                time: self.time + f64::from(s.dt) * f64::from(k + 1) / f64::from(s.substeps),
+                h,
+                substep: k,
+            };
+            // External and (mass-spring) internal accelerations at the start of the substep.
+            self.forces
+                .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
+            strategy.add_internal_forces(
+                &self.constraints,
+                &self.particles,
+                &self.params,
+                &mut self.force,
+                &mut self.accel,
+            );
+            // Semi-implicit Euler: v ← v + h a, x ← x + h v (for PBD/XPBD, the prediction).
+            let p = &mut self.particles;
+            for i in 0..p.len() {
+                p.prev_positions[i] = p.positions[i];
+                if p.inv_masses[i] > 0.0 {
+                    p.velocities[i] += self.accel[i] * h;
+                    p.positions[i] += p.velocities[i] * h;
+                }
+            }
+            for pin in &self.pins {
+                p.positions[pin.particle as usize] = pin.motion.position(pin.rest, ctx.time);
+            }
+            if let Some(g) = &self.grab {
+                let f = (k + 1) as f32 / s.substeps as f32;
+                p.positions[g.particle] = g.from.lerp(g.target, f);
+            }
+            hook.begin_substep(&ctx, p);
+            strategy.begin_substep(&mut self.constraints);
+            match strategy.rule(h) {
+                Some(rule) => {
+                    for _ in 0..s.iterations {
+                        self.constraints.project(
+                            &mut p.positions,
+                            &p.prev_positions,
+                            &p.inv_masses,
+                            &self.params,
+                            rule,
+                            s.parallel_min_batch,
+                        );
+                        stats.contacts = hook.project(&ctx, p);
+                    }
+                }
+                None => stats.contacts = hook.project(&ctx, p),
+            }
+            // Velocities from positions (the PBD update; for mass-spring it equals v unless
+            // a contact moved the particle).
+            let inv_h = 1.0 / h;
+            for i in 0..p.len() {
+                p.velocities[i] = (p.positions[i] - p.prev_positions[i]) * inv_h;
+            }
+            hook.end_substep(&ctx, p);
+            if self.forces.damping > 0.0 {
+                let keep = (-self.forces.damping * h).exp();
+                for (v, w) in p.velocities.iter_mut().zip(&p.inv_masses) {
+                    if *w > 0.0 {
+                        *v *= keep;
+                    }
+                }
+            }
+        }
+        if let Some(g) = &mut self.grab {
+            g.from = g.target;
+        }
+        self.time += f64::from(s.dt);
+        let frame = self.frame;
+        self.frame += 1;
+        self.check_divergence(frame)?;
+        Ok(stats)
+    }
+
+    fn check_divergence(&self, frame: u64) -> Result<(), SolverError> {
+        let bound = self.settings.divergence_bound;
+        match self
+            .particles
+            .positions
+            .iter()
+            .position(|x| !x.is_finite() || x.abs().max_element() > bound)
+        {
+            Some(particle) => Err(SolverError::Diverged {
+                method: self.settings.method,
+                frame,
+                particle,
+                position: self.particles.positions[particle],
+                bound,
+            }),
+            None => Ok(()),
+        }
+    }
+}

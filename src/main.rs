@@ -1,0 +1,4 @@
+//! The `weft` binary.
+fn main() -> anyhow::Result<()> {
+    Ok(())
+}
