@@ -1,6 +1,6 @@
 //! Assembles cloths, their constraints and kinematic pins into a [`Solver`].
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::cloth::ClothMesh;
 use crate::constraints::{BlockBuilder, ConstraintSet, Dihedral, Distance, Tether};
@@ -54,14 +54,14 @@ impl SolverBuilder {
         name: impl Into<String>,
         mesh: &ClothMesh,
         params: ClothParams,
-        thickness: f32,
+        thickness: f64,
     ) -> Result<usize, BuildError> {
         let name = name.into();
         params.validate()?;
         if !(thickness.is_finite() && thickness >= 0.0) {
             return Err(ParamError {
                 name: "thickness".into(),
-                value: thickness.into(),
+                value: thickness,
                 expected: "finite and >= 0",
             }
             .into());
@@ -191,7 +191,7 @@ impl SolverBuilder {
             self.params,
             constraints,
             self.pins,
-            vec![Vec3::ZERO; n],
+            vec![DVec3::ZERO; n],
         )
     }
 }

@@ -1,6 +1,6 @@
 //! Cloth geometry before it enters a solver: a triangle mesh with masses and pins.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::error::MeshError;
 use crate::topology::Topology;
@@ -9,9 +9,9 @@ use crate::topology::Topology;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Mass {
     /// Total mass of the cloth (kg), spread by lumped triangle area.
-    Total(f32),
+    Total(f64),
     /// Areal density (kg/m²), lumped per vertex as a third of each adjacent triangle's area.
-    Density(f32),
+    Density(f64),
 }
 
 /// A cloth as geometry: rest positions, triangles, per-vertex masses, pins and constraint pairs.
@@ -21,11 +21,11 @@ pub enum Mass {
 #[derive(Clone, Debug)]
 pub struct ClothMesh {
     /// Rest (and initial) positions (m).
-    pub positions: Vec<Vec3>,
+    pub positions: Vec<DVec3>,
     /// Triangles, counter-clockwise seen from the front face.
     pub triangles: Vec<[u32; 3]>,
     /// Per-vertex masses (kg).
-    pub masses: Vec<f32>,
+    pub masses: Vec<f64>,
     /// Pinned vertices (given inverse mass 0).
     pub pinned: Vec<u32>,
     /// Stretch pairs: mesh edges (grid lines for grids).
@@ -42,7 +42,7 @@ impl ClothMesh {
     /// Rejects empty meshes, out-of-range indices, non-finite vertices, degenerate
     /// (zero-area or repeated-index) triangles and non-manifold edges.
     pub fn from_triangles(
-        positions: Vec<Vec3>,
+        positions: Vec<DVec3>,
         triangles: Vec<[u32; 3]>,
         mass: Mass,
         pinned: Vec<u32>,
@@ -75,12 +75,12 @@ impl ClothMesh {
     }
 
     /// Total mass (kg).
-    pub fn total_mass(&self) -> f32 {
+    pub fn total_mass(&self) -> f64 {
         self.masses.iter().sum()
     }
 
     /// Total area of the triangles (m²).
-    pub fn area(&self) -> f32 {
+    pub fn area(&self) -> f64 {
         self.triangles
             .iter()
             .map(|t| triangle_area(&self.positions, t))
@@ -89,14 +89,14 @@ impl ClothMesh {
 }
 
 /// Area of triangle `t` (m²).
-pub(crate) fn triangle_area(p: &[Vec3], t: &[u32; 3]) -> f32 {
+pub(crate) fn triangle_area(p: &[DVec3], t: &[u32; 3]) -> f64 {
     let [a, b, c] = t.map(|i| p[i as usize]);
     0.5 * (b - a).cross(c - a).length()
 }
 
 /// Lumped vertex masses: each triangle gives a third of its mass to each corner.
-pub(crate) fn lumped_masses(p: &[Vec3], triangles: &[[u32; 3]], mass: Mass) -> Vec<f32> {
-    let area: f32 = triangles.iter().map(|t| triangle_area(p, t)).sum();
+pub(crate) fn lumped_masses(p: &[DVec3], triangles: &[[u32; 3]], mass: Mass) -> Vec<f64> {
+    let area: f64 = triangles.iter().map(|t| triangle_area(p, t)).sum();
     let density = match mass {
         Mass::Total(m) => m / area,
         Mass::Density(d) => d,
@@ -112,7 +112,7 @@ pub(crate) fn lumped_masses(p: &[Vec3], triangles: &[[u32; 3]], mass: Mass) -> V
 }
 
 fn validate(
-    positions: &[Vec3],
+    positions: &[DVec3],
     triangles: &[[u32; 3]],
     mass: Mass,
     pinned: &[u32],
@@ -163,9 +163,9 @@ fn validate(
 mod tests {
     use super::*;
 
-    fn quad() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    fn quad() -> (Vec<DVec3>, Vec<[u32; 3]>) {
         (
-            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)],
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
             vec![[0, 1, 2], [2, 1, 3]],
         )
     }
@@ -182,8 +182,8 @@ mod tests {
     #[test]
     fn bad_meshes_are_rejected_with_the_reason() {
         let (mut p, t) = quad();
-        let err = |p: Vec<Vec3>, t: Vec<[u32; 3]>, m| {
-            ClothMesh::from_triangles(p, t, m, vec![]).unwrap_err()
+        let err = |p: Vec<DVec3>, t: Vec<[u32; 3]>, m| {
+            ClothMesh::from_triangles(p, t, m, vec![]).expect_err("must be rejected")
         };
         assert_eq!(err(p.clone(), vec![], Mass::Total(1.0)), MeshError::Empty);
         assert!(matches!(
@@ -195,10 +195,10 @@ mod tests {
             MeshError::DegenerateTriangle { triangle: 0 }
         ));
         assert!(matches!(
-            err(p.clone(), t.clone(), Mass::Total(f32::NAN)),
+            err(p.clone(), t.clone(), Mass::Total(f64::NAN)),
             MeshError::InvalidMass { .. }
         ));
-        p[3].x = f32::NAN;
+        p[3].x = f64::NAN;
         assert!(matches!(
             err(p, t, Mass::Total(1.0)),
             MeshError::NonFiniteVertex { vertex: 3 }

@@ -1,6 +1,6 @@
 //! Error values of the solver crate.
 
-use glam::Vec3;
+use glam::DVec3;
 use thiserror::Error;
 
 use crate::method::Method;
@@ -59,7 +59,7 @@ pub enum MeshError {
     #[error("mass must be finite and positive, got {value}")]
     InvalidMass {
         /// The value given.
-        value: f32,
+        value: f64,
     },
     /// A grid needs at least 2×2 particles.
     #[error("a grid needs at least 2x2 particles, got {columns}x{rows}")]
@@ -73,9 +73,9 @@ pub enum MeshError {
     #[error("grid size must be finite and positive, got {width} x {height}")]
     InvalidSize {
         /// Width given.
-        width: f32,
+        width: f64,
         /// Height given.
-        height: f32,
+        height: f64,
     },
 }
 
@@ -107,9 +107,9 @@ pub enum SolverError {
         /// The first offending particle.
         particle: usize,
         /// Its position.
-        position: Vec3,
+        position: DVec3,
         /// The bound that was crossed (m).
-        bound: f32,
+        bound: f64,
     },
     /// A particle index that does not exist.
     #[error("particle {index} does not exist (the solver has {count})")]

@@ -1,6 +1,6 @@
 //! External forces: gravity, wind (uniform drag and per-triangle aerodynamics), global damping.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::error::ParamError;
 use crate::particles::Particles;
@@ -9,11 +9,11 @@ use crate::particles::Particles;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aero {
     /// Air density ρ (kg/m³).
-    pub air_density: f32,
+    pub air_density: f64,
     /// Drag coefficient C_d.
-    pub drag_coefficient: f32,
+    pub drag_coefficient: f64,
     /// Lift coefficient C_l.
-    pub lift_coefficient: f32,
+    pub lift_coefficient: f64,
 }
 
 impl Default for Aero {
@@ -30,9 +30,9 @@ impl Default for Aero {
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Wind {
     /// Wind velocity (m/s).
-    pub velocity: Vec3,
+    pub velocity: DVec3,
     /// Uniform drag rate (1/s): each particle accelerates by `drag · (wind − v)`.
-    pub drag: f32,
+    pub drag: f64,
     /// Per-triangle aerodynamics, if any.
     pub aero: Option<Aero>,
 }
@@ -41,17 +41,17 @@ pub struct Wind {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Forces {
     /// Gravitational acceleration (m/s²).
-    pub gravity: Vec3,
+    pub gravity: DVec3,
     /// Wind.
     pub wind: Wind,
     /// Global velocity damping rate c (1/s): v ← v·e^(−c h) every substep.
-    pub damping: f32,
+    pub damping: f64,
 }
 
 impl Default for Forces {
     fn default() -> Self {
         Self {
-            gravity: Vec3::new(0.0, -9.81, 0.0),
+            gravity: DVec3::new(0.0, -9.81, 0.0),
             wind: Wind::default(),
             damping: 0.0,
         }
@@ -61,9 +61,9 @@ impl Default for Forces {
 impl Forces {
     /// Checks every value is finite and non-negative where it must be.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let bad = |name: &str, value: f32, expected| ParamError {
+        let bad = |name: &str, value: f64, expected| ParamError {
             name: name.to_owned(),
-            value: f64::from(value),
+            value,
             expected,
         };
         for (name, v) in [
@@ -92,7 +92,7 @@ impl Forces {
     }
 
     /// Writes every particle's external acceleration (m/s²) into `accel`.
-    pub(crate) fn accelerations(&self, p: &Particles, triangles: &[[u32; 3]], accel: &mut [Vec3]) {
+    pub(crate) fn accelerations(&self, p: &Particles, triangles: &[[u32; 3]], accel: &mut [DVec3]) {
         let wind = self.wind;
         for (a, v) in accel.iter_mut().zip(&p.velocities) {
             *a = self.gravity + wind.drag * (wind.velocity - *v);
@@ -114,15 +114,15 @@ impl Forces {
 /// drag D = −½ ρ C_d A |u|² cos θ û, lift L = ½ ρ C_l A |u|² cos θ sin θ l̂ with
 /// l̂ = (n × û) × û normalised (Keckeisen et al. 2004, "Interactive cloth simulation in
 /// virtual environments", §3.2).
-fn aero_force(aero: Aero, wind: Vec3, p: &Particles, t: &[u32; 3]) -> Vec3 {
+fn aero_force(aero: Aero, wind: DVec3, p: &Particles, t: &[u32; 3]) -> DVec3 {
     let [a, b, c] = t.map(|i| p.positions[i as usize]);
-    let v_mean = t.iter().map(|&i| p.velocities[i as usize]).sum::<Vec3>() / 3.0;
+    let v_mean = t.iter().map(|&i| p.velocities[i as usize]).sum::<DVec3>() / 3.0;
     let u = v_mean - wind;
     let speed = u.length();
     let cross = (b - a).cross(c - a);
     let twice_area = cross.length();
     if speed < 1e-6 || twice_area < 1e-12 {
-        return Vec3::ZERO;
+        return DVec3::ZERO;
     }
     let u_hat = u / speed;
     let mut n = cross / twice_area;
@@ -137,7 +137,7 @@ fn aero_force(aero: Aero, wind: Vec3, p: &Particles, t: &[u32; 3]) -> Vec3 {
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         q * aero.lift_coefficient * cos * sin * lift_dir.normalize()
     } else {
-        Vec3::ZERO
+        DVec3::ZERO
     };
     drag + lift
 }
@@ -146,9 +146,9 @@ fn aero_force(aero: Aero, wind: Vec3, p: &Particles, t: &[u32; 3]) -> Vec3 {
 mod tests {
     use super::*;
 
-    fn one_triangle(v: Vec3) -> Particles {
+    fn one_triangle(v: DVec3) -> Particles {
         let mut p = Particles::default();
-        for x in [Vec3::ZERO, Vec3::X, Vec3::Z] {
+        for x in [DVec3::ZERO, DVec3::X, DVec3::Z] {
             p.push(x, 1.0);
         }
         p.velocities.fill(v);
@@ -161,26 +161,31 @@ mod tests {
             lift_coefficient: 0.0,
             ..Aero::default()
         };
-        let f1 = aero_force(aero, Vec3::ZERO, &one_triangle(-Vec3::Y), &[0, 1, 2]);
-        let f2 = aero_force(aero, Vec3::ZERO, &one_triangle(-2.0 * Vec3::Y), &[0, 1, 2]);
+        let f1 = aero_force(aero, DVec3::ZERO, &one_triangle(-DVec3::Y), &[0, 1, 2]);
+        let f2 = aero_force(
+            aero,
+            DVec3::ZERO,
+            &one_triangle(-2.0 * DVec3::Y),
+            &[0, 1, 2],
+        );
         // Face-on: |F| = ½ ρ C_d A |u|² with A = ½ m².
-        assert!((f1 - Vec3::Y * 0.5 * 1.2 * 0.5).length() < 1e-5, "{f1}");
+        assert!((f1 - DVec3::Y * 0.5 * 1.2 * 0.5).length() < 1e-5, "{f1}");
         assert!((f2.y / f1.y - 4.0).abs() < 1e-4);
         // Edge-on motion feels nothing.
-        let f = aero_force(aero, Vec3::ZERO, &one_triangle(Vec3::X), &[0, 1, 2]);
+        let f = aero_force(aero, DVec3::ZERO, &one_triangle(DVec3::X), &[0, 1, 2]);
         assert!(f.length() < 1e-6);
     }
 
     #[test]
     fn lift_is_perpendicular_to_the_relative_wind() {
         let aero = Aero::default();
-        let u = Vec3::new(1.0, -1.0, 0.0);
+        let u = DVec3::new(1.0, -1.0, 0.0);
         let f = aero_force(
             Aero {
                 drag_coefficient: 0.0,
                 ..aero
             },
-            Vec3::ZERO,
+            DVec3::ZERO,
             &one_triangle(u),
             &[0, 1, 2],
         );
@@ -192,12 +197,15 @@ mod tests {
     #[test]
     fn nan_wind_is_rejected() {
         let mut f = Forces::default();
-        f.wind.velocity.x = f32::NAN;
-        assert_eq!(f.validate().unwrap_err().name, "wind.velocity");
+        f.wind.velocity.x = f64::NAN;
+        assert_eq!(
+            f.validate().expect_err("must be rejected").name,
+            "wind.velocity"
+        );
         f = Forces {
             damping: -1.0,
             ..Forces::default()
         };
-        assert_eq!(f.validate().unwrap_err().name, "damping");
+        assert_eq!(f.validate().expect_err("must be rejected").name, "damping");
     }
 }

@@ -1,6 +1,6 @@
 //! Rectangular grid cloths: resolution, size, placement, mass and pins.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::cloth::{ClothMesh, Mass, lumped_masses};
 use crate::error::MeshError;
@@ -58,9 +58,9 @@ pub struct GridDesc {
     /// Particles along x (columns) and along the other axis (rows); each at least 2.
     pub resolution: (usize, usize),
     /// Width (along x) and height (along the other axis) in metres.
-    pub size: (f32, f32),
+    pub size: (f64, f64),
     /// Centre of the cloth (m).
-    pub center: Vec3,
+    pub center: DVec3,
     /// Plane of the cloth.
     pub orientation: Orientation,
     /// Total mass or areal density.
@@ -74,7 +74,7 @@ impl Default for GridDesc {
         Self {
             resolution: (20, 20),
             size: (1.0, 1.0),
-            center: Vec3::ZERO,
+            center: DVec3::ZERO,
             orientation: Orientation::Vertical,
             mass: Mass::Total(1.0),
             pins: vec![Pin::Corner(Corner::TopLeft), Pin::Corner(Corner::TopRight)],
@@ -107,17 +107,17 @@ impl GridDesc {
         if !self.center.is_finite() {
             return Err(MeshError::NonFiniteVertex { vertex: 0 });
         }
-        let (dx, dy) = (w / (nx - 1) as f32, h / (ny - 1) as f32);
+        let (dx, dy) = (w / (nx - 1) as f64, h / (ny - 1) as f64);
         let mut positions = Vec::with_capacity(nx * ny);
         for j in 0..ny {
             for i in 0..nx {
-                let u = -0.5 * w + i as f32 * dx;
-                let v = 0.5 * h - j as f32 * dy;
+                let u = -0.5 * w + i as f64 * dx;
+                let v = 0.5 * h - j as f64 * dy;
                 positions.push(
                     self.center
                         + match self.orientation {
-                            Orientation::Vertical => Vec3::new(u, v, 0.0),
-                            Orientation::Horizontal => Vec3::new(u, 0.0, -v),
+                            Orientation::Vertical => DVec3::new(u, v, 0.0),
+                            Orientation::Horizontal => DVec3::new(u, 0.0, -v),
                         },
                 );
             }
@@ -217,8 +217,8 @@ mod tests {
     #[test]
     fn triangles_face_the_stated_normal() {
         for (o, normal) in [
-            (Orientation::Vertical, Vec3::Z),
-            (Orientation::Horizontal, Vec3::Y),
+            (Orientation::Vertical, DVec3::Z),
+            (Orientation::Horizontal, DVec3::Y),
         ] {
             let g = GridDesc {
                 resolution: (4, 3),
@@ -256,7 +256,7 @@ mod tests {
 
     #[test]
     fn bad_grids_are_rejected() {
-        let bad = |d: GridDesc| d.build().unwrap_err();
+        let bad = |d: GridDesc| d.build().expect_err("must be rejected");
         assert!(matches!(
             bad(GridDesc {
                 resolution: (1, 5),
@@ -266,7 +266,7 @@ mod tests {
         ));
         assert!(matches!(
             bad(GridDesc {
-                size: (f32::NAN, 1.0),
+                size: (f64::NAN, 1.0),
                 ..GridDesc::default()
             }),
             MeshError::InvalidSize { .. }

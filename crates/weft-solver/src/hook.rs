@@ -11,7 +11,7 @@ pub struct SubstepContext {
     /// Simulated time at the end of this substep (s).
     pub time: f64,
     /// Substep length h (s).
-    pub h: f32,
+    pub h: f64,
     /// Substep number inside the frame, from 0.
     pub substep: u32,
 }

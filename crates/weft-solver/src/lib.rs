@@ -38,5 +38,5 @@ pub use settings::Settings;
 pub use solver::{Cloth, Solver, StepStats};
 pub use topology::{EdgeWings, Topology};
 
-/// Re-export of the math library, so users share our `Vec3`.
+/// Re-export of the math library, so users share our `DVec3`.
 pub use glam;

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, Rule};
 use crate::methods::{MassSpring, Pbd, Xpbd};
@@ -79,8 +79,8 @@ pub(crate) trait Strategy: Sync {
         _constraints: &ConstraintSet,
         _particles: &Particles,
         _params: &[FamilyParams],
-        _force: &mut [Vec3],
-        _accel: &mut [Vec3],
+        _force: &mut [DVec3],
+        _accel: &mut [DVec3],
     ) {
     }
 
@@ -88,5 +88,5 @@ pub(crate) trait Strategy: Sync {
     fn begin_substep(&self, _constraints: &mut ConstraintSet) {}
 
     /// How constraints are projected with substep `h`, or `None` when they are not projected.
-    fn rule(&self, h: f32) -> Option<Rule>;
+    fn rule(&self, h: f64) -> Option<Rule>;
 }

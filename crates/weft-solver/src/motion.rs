@@ -2,7 +2,7 @@
 
 use std::f64::consts::TAU;
 
-use glam::{Quat, Vec3};
+use glam::{DQuat, DVec3};
 
 /// A rigid motion prescribed as a function of time.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -13,23 +13,23 @@ pub enum Motion {
     /// Constant velocity: x(t) = x₀ + v t.
     Linear {
         /// Velocity (m/s).
-        velocity: Vec3,
+        velocity: DVec3,
     },
     /// Harmonic oscillation: x(t) = x₀ + A sin(2π f t).
     Oscillate {
         /// Amplitude A (m).
-        amplitude: Vec3,
+        amplitude: DVec3,
         /// Frequency f (Hz).
-        frequency: f32,
+        frequency: f64,
     },
     /// Rotation about an axis through a pivot at a constant angular velocity.
     Rotate {
         /// A point on the axis (m).
-        pivot: Vec3,
+        pivot: DVec3,
         /// Axis direction (normalised on use).
-        axis: Vec3,
+        axis: DVec3,
         /// Angular velocity (rad/s).
-        angular_velocity: f32,
+        angular_velocity: f64,
     },
 }
 
@@ -37,20 +37,20 @@ pub enum Motion {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidTransform {
     /// Rotation R.
-    pub rotation: Quat,
+    pub rotation: DQuat,
     /// Translation t (m).
-    pub translation: Vec3,
+    pub translation: DVec3,
 }
 
 impl RigidTransform {
     /// The identity.
     pub const IDENTITY: Self = Self {
-        rotation: Quat::IDENTITY,
-        translation: Vec3::ZERO,
+        rotation: DQuat::IDENTITY,
+        translation: DVec3::ZERO,
     };
 
     /// Applies the transform to a point.
-    pub fn apply(&self, p: Vec3) -> Vec3 {
+    pub fn apply(&self, p: DVec3) -> DVec3 {
         self.rotation * p + self.translation
     }
 }
@@ -61,25 +61,23 @@ impl Motion {
         match *self {
             Motion::Static => RigidTransform::IDENTITY,
             Motion::Linear { velocity } => RigidTransform {
-                rotation: Quat::IDENTITY,
-                translation: velocity * t as f32,
+                rotation: DQuat::IDENTITY,
+                translation: velocity * t,
             },
             Motion::Oscillate {
                 amplitude,
                 frequency,
             } => RigidTransform {
-                rotation: Quat::IDENTITY,
-                translation: amplitude * (TAU * f64::from(frequency) * t).sin() as f32,
+                rotation: DQuat::IDENTITY,
+                translation: amplitude * (TAU * frequency * t).sin(),
             },
             Motion::Rotate {
                 pivot,
                 axis,
                 angular_velocity,
             } => {
-                let rotation = Quat::from_axis_angle(
-                    axis.normalize_or(Vec3::Y),
-                    (f64::from(angular_velocity) * t) as f32,
-                );
+                let rotation =
+                    DQuat::from_axis_angle(axis.normalize_or(DVec3::Y), angular_velocity * t);
                 RigidTransform {
                     rotation,
                     translation: pivot - rotation * pivot,
@@ -89,7 +87,7 @@ impl Motion {
     }
 
     /// Position at time `t` of a point whose rest position is `rest`.
-    pub fn position(&self, rest: Vec3, t: f64) -> Vec3 {
+    pub fn position(&self, rest: DVec3, t: f64) -> DVec3 {
         self.transform(t).apply(rest)
     }
 }
@@ -100,7 +98,7 @@ pub struct KinematicPin {
     /// Global particle index.
     pub particle: u32,
     /// Its rest position (m).
-    pub rest: Vec3,
+    pub rest: DVec3,
     /// The motion it follows.
     pub motion: Motion,
 }
@@ -112,17 +110,17 @@ mod tests {
     #[test]
     fn rotation_keeps_distance_to_pivot_and_oscillation_returns() {
         let m = Motion::Rotate {
-            pivot: Vec3::new(1.0, 0.0, 0.0),
-            axis: Vec3::Y,
-            angular_velocity: std::f32::consts::FRAC_PI_2,
+            pivot: DVec3::new(1.0, 0.0, 0.0),
+            axis: DVec3::Y,
+            angular_velocity: std::f64::consts::FRAC_PI_2,
         };
-        let p = m.position(Vec3::new(2.0, 0.0, 0.0), 1.0);
-        assert!((p - Vec3::new(1.0, 0.0, -1.0)).length() < 1e-5, "{p}");
+        let p = m.position(DVec3::new(2.0, 0.0, 0.0), 1.0);
+        assert!((p - DVec3::new(1.0, 0.0, -1.0)).length() < 1e-5, "{p}");
         let o = Motion::Oscillate {
-            amplitude: Vec3::X,
+            amplitude: DVec3::X,
             frequency: 2.0,
         };
-        assert!((o.position(Vec3::ZERO, 0.125) - Vec3::X).length() < 1e-6);
-        assert!(o.position(Vec3::ZERO, 0.5).length() < 1e-5);
+        assert!((o.position(DVec3::ZERO, 0.125) - DVec3::X).length() < 1e-6);
+        assert!(o.position(DVec3::ZERO, 0.5).length() < 1e-5);
     }
 }

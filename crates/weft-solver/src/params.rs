@@ -9,7 +9,8 @@ pub enum Family {
     Stretch,
     /// Quad diagonals on grids.
     Shear,
-    /// Distance between the two wing vertices across each interior edge.
+    /// Distance between the two wing vertices across each interior edge (cheap, but weak near
+    /// flat: the distance changes as cos(θ/2), so its gradient vanishes at θ = 0).
     BendDistance,
     /// Dihedral angle across each interior edge.
     BendDihedral,
@@ -56,15 +57,15 @@ pub struct FamilyParams {
     /// Whether the family's constraints are created at all.
     pub enabled: bool,
     /// XPBD compliance α (inverse stiffness); 0 is infinitely stiff.
-    pub compliance: f32,
+    pub compliance: f64,
     /// XPBD constraint damping β (s), the damping term of Macklin et al. 2016, eq. (26).
-    pub damping: f32,
+    pub damping: f64,
     /// PBD stiffness k in [0, 1], applied to each projection (Müller et al. 2007, §3.3).
-    pub pbd_stiffness: f32,
+    pub pbd_stiffness: f64,
     /// Mass-spring stiffness.
-    pub spring_stiffness: f32,
+    pub spring_stiffness: f64,
     /// Mass-spring damping along the spring (N·s/m).
-    pub spring_damping: f32,
+    pub spring_damping: f64,
 }
 
 impl FamilyParams {
@@ -89,13 +90,13 @@ impl FamilyParams {
 
     /// Checks every value is finite and in range; `family` names the parameter in the error.
     pub fn validate(&self, family: Family) -> Result<(), ParamError> {
-        let check = |field: &str, value: f32, ok: bool, expected: &'static str| {
+        let check = |field: &str, value: f64, ok: bool, expected: &'static str| {
             if value.is_finite() && ok {
                 Ok(())
             } else {
                 Err(ParamError {
                     name: format!("{}.{field}", family.name()),
-                    value: f64::from(value),
+                    value,
                     expected,
                 })
             }

@@ -1,6 +1,6 @@
 //! The particle store: struct-of-arrays state shared by every method.
 
-use glam::Vec3;
+use glam::DVec3;
 
 /// Particle state as struct-of-arrays; index `i` is the same particle in every array.
 ///
@@ -8,13 +8,13 @@ use glam::Vec3;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Particles {
     /// Current positions (m).
-    pub positions: Vec<Vec3>,
+    pub positions: Vec<DVec3>,
     /// Positions at the start of the current substep (m).
-    pub prev_positions: Vec<Vec3>,
+    pub prev_positions: Vec<DVec3>,
     /// Velocities (m/s).
-    pub velocities: Vec<Vec3>,
+    pub velocities: Vec<DVec3>,
     /// Inverse masses (1/kg); 0 pins the particle.
-    pub inv_masses: Vec<f32>,
+    pub inv_masses: Vec<f64>,
 }
 
 impl Particles {
@@ -28,11 +28,11 @@ impl Particles {
         self.positions.is_empty()
     }
 
-    /// Appends a particle at rest with the given mass (`f32::INFINITY` or 0 inverse mass pins it).
-    pub fn push(&mut self, position: Vec3, inv_mass: f32) {
+    /// Appends a particle at rest with the given mass (`f64::INFINITY` or 0 inverse mass pins it).
+    pub fn push(&mut self, position: DVec3, inv_mass: f64) {
         self.positions.push(position);
         self.prev_positions.push(position);
-        self.velocities.push(Vec3::ZERO);
+        self.velocities.push(DVec3::ZERO);
         self.inv_masses.push(inv_mass);
     }
 
@@ -47,12 +47,12 @@ impl Particles {
             .iter()
             .zip(&self.inv_masses)
             .filter(|(_, w)| **w > 0.0)
-            .map(|(v, w)| 0.5 * f64::from(v.length_squared()) / f64::from(*w))
+            .map(|(v, w)| 0.5 * v.length_squared() / (*w))
             .sum()
     }
 
     /// Total momentum Σ m v of the free particles (kg·m/s).
-    pub fn momentum(&self) -> Vec3 {
+    pub fn momentum(&self) -> DVec3 {
         self.velocities
             .iter()
             .zip(&self.inv_masses)

@@ -9,13 +9,13 @@ pub struct Settings {
     /// The method.
     pub method: Method,
     /// Frame time step Δt (s); each frame is split into `substeps` substeps of h = Δt / substeps.
-    pub dt: f32,
+    pub dt: f64,
     /// Substeps per frame (≥ 1).
     pub substeps: u32,
     /// Constraint sweeps per substep (≥ 1; ignored by mass-spring).
     pub iterations: u32,
     /// A particle farther than this from the origin (m) means the simulation diverged.
-    pub divergence_bound: f32,
+    pub divergence_bound: f64,
     /// Colours with at least this many constraints are solved in parallel.
     pub parallel_min_batch: usize,
 }
@@ -35,8 +35,8 @@ impl Default for Settings {
 
 impl Settings {
     /// Substep length h = Δt / substeps (s).
-    pub fn h(&self) -> f32 {
-        self.dt / self.substeps as f32
+    pub fn h(&self) -> f64 {
+        self.dt / self.substeps as f64
     }
 
     /// Checks the values make sense.
@@ -49,7 +49,7 @@ impl Settings {
             })
         };
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return bad("dt", self.dt.into(), "finite and > 0");
+            return bad("dt", self.dt, "finite and > 0");
         }
         if self.substeps == 0 {
             return bad("substeps", 0.0, ">= 1");
@@ -58,11 +58,7 @@ impl Settings {
             return bad("iterations", 0.0, ">= 1");
         }
         if !(self.divergence_bound.is_finite() && self.divergence_bound > 0.0) {
-            return bad(
-                "divergence_bound",
-                self.divergence_bound.into(),
-                "finite and > 0",
-            );
+            return bad("divergence_bound", self.divergence_bound, "finite and > 0");
         }
         Ok(())
     }

@@ -2,7 +2,7 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, Residual};
 use crate::error::{ParamError, SolverError};
@@ -25,7 +25,7 @@ pub struct Cloth {
     /// Mesh edges (grid lines for grids), in global particle indices.
     pub edges: Vec<[u32; 2]>,
     /// Thickness (m): contacts keep particles this far from surfaces.
-    pub thickness: f32,
+    pub thickness: f64,
     /// Grid resolution `(columns, rows)` when the cloth is a grid.
     pub grid: Option<(usize, usize)>,
 }
@@ -41,9 +41,9 @@ pub struct StepStats {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Grab {
     particle: usize,
-    inv_mass: f32,
-    from: Vec3,
-    target: Vec3,
+    inv_mass: f64,
+    from: DVec3,
+    target: DVec3,
 }
 
 /// The cloth solver: particles, constraints, forces and the shared step loop.
@@ -59,8 +59,8 @@ pub struct Solver {
     constraints: ConstraintSet,
     pins: Vec<KinematicPin>,
     grab: Option<Grab>,
-    accel: Vec<Vec3>,
-    force: Vec<Vec3>,
+    accel: Vec<DVec3>,
+    force: Vec<DVec3>,
     time: f64,
     frame: u64,
 }
@@ -75,7 +75,7 @@ impl Solver {
         params: Vec<FamilyParams>,
         constraints: ConstraintSet,
         pins: Vec<KinematicPin>,
-        scratch: Vec<Vec3>,
+        scratch: Vec<DVec3>,
     ) -> Self {
         let all_triangles = cloths
             .iter()
@@ -174,11 +174,11 @@ impl Solver {
     }
 
     /// Changes the thickness of cloth `cloth`.
-    pub fn set_thickness(&mut self, cloth: usize, thickness: f32) -> Result<(), ParamError> {
+    pub fn set_thickness(&mut self, cloth: usize, thickness: f64) -> Result<(), ParamError> {
         if !(thickness.is_finite() && thickness >= 0.0) {
             return Err(ParamError {
                 name: "thickness".into(),
-                value: thickness.into(),
+                value: thickness,
                 expected: "finite and >= 0",
             });
         }
@@ -231,7 +231,7 @@ impl Solver {
     }
 
     /// Moves the held particle toward `target` over the next frame's substeps.
-    pub fn drag_to(&mut self, target: Vec3) {
+    pub fn drag_to(&mut self, target: DVec3) {
         if let Some(g) = &mut self.grab
             && target.is_finite()
         {
@@ -240,7 +240,7 @@ impl Solver {
     }
 
     /// The held particle and its target, if any.
-    pub fn grabbed(&self) -> Option<(usize, Vec3)> {
+    pub fn grabbed(&self) -> Option<(usize, DVec3)> {
         self.grab.map(|g| (g.particle, g.target))
     }
 
@@ -265,7 +265,7 @@ impl Solver {
         for k in 0..s.substeps {
             let ctx = SubstepContext {
                 method: s.method,
-                time: self.time + f64::from(s.dt) * f64::from(k + 1) / f64::from(s.substeps),
+                time: self.time + s.dt * f64::from(k + 1) / f64::from(s.substeps),
                 h,
                 substep: k,
             };
@@ -292,7 +292,7 @@ impl Solver {
                 p.positions[pin.particle as usize] = pin.motion.position(pin.rest, ctx.time);
             }
             if let Some(g) = &self.grab {
-                let f = (k + 1) as f32 / s.substeps as f32;
+                let f = (k + 1) as f64 / s.substeps as f64;
                 p.positions[g.particle] = g.from.lerp(g.target, f);
             }
             hook.begin_substep(&ctx, p);
@@ -332,7 +332,7 @@ impl Solver {
         if let Some(g) = &mut self.grab {
             g.from = g.target;
         }
-        self.time += f64::from(s.dt);
+        self.time += s.dt;
         let frame = self.frame;
         self.frame += 1;
         self.check_divergence(frame)?;

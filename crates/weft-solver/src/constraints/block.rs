@@ -2,7 +2,7 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Shape;
@@ -15,7 +15,7 @@ pub(crate) enum Rule {
     /// XPBD with substep `h`: Macklin et al. 2016, eq. (18) with the damping of eq. (26).
     Xpbd {
         /// Substep length (s).
-        h: f32,
+        h: f64,
     },
     /// PBD: Müller et al. 2007, eq. (10), scaled by the family's stiffness k.
     Pbd,
@@ -31,11 +31,11 @@ pub(crate) struct Block<const N: usize, S> {
     /// Rest data of each constraint.
     pub shapes: Vec<S>,
     /// XPBD Lagrange multipliers, reset each substep.
-    pub lambda: Vec<f32>,
+    pub lambda: Vec<f64>,
     /// Contiguous range of each colour.
     pub colors: Vec<Range<usize>>,
     /// Scratch corrections for the parallel path (one colour at a time).
-    deltas: Vec<[Vec3; N]>,
+    deltas: Vec<[DVec3; N]>,
 }
 
 impl<const N: usize, S> Default for Block<N, S> {
@@ -96,7 +96,7 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
             shapes: order.iter().map(|&i| self.shapes[i]).collect(),
             lambda: vec![0.0; order.len()],
             colors: ranges,
-            deltas: vec![[Vec3::ZERO; N]; largest],
+            deltas: vec![[DVec3::ZERO; N]; largest],
         }
     }
 }
@@ -108,29 +108,29 @@ fn correction<const N: usize, S: Shape<N>>(
     shape: &S,
     idx: &[u32; N],
     group: u32,
-    lambda: &mut f32,
-    x: &[Vec3],
-    prev: &[Vec3],
-    w: &[f32],
+    lambda: &mut f64,
+    x: &[DVec3],
+    prev: &[DVec3],
+    w: &[f64],
     params: &[FamilyParams],
     rule: Rule,
-) -> [Vec3; N] {
+) -> [DVec3; N] {
     let p = &params[group as usize];
     let pos = idx.map(|i| x[i as usize]);
     let wi = idx.map(|i| w[i as usize]);
     if !p.enabled {
-        return [Vec3::ZERO; N];
+        return [DVec3::ZERO; N];
     }
     let Some((c, grad)) = shape.evaluate(&pos) else {
-        return [Vec3::ZERO; N];
+        return [DVec3::ZERO; N];
     };
-    let w_grad2: f32 = (0..N).map(|k| wi[k] * grad[k].length_squared()).sum();
+    let w_grad2: f64 = (0..N).map(|k| wi[k] * grad[k].length_squared()).sum();
     let dl = match rule {
         Rule::Xpbd { h } => {
             // α̃ = α/h², γ = α̃ β̃ / h with β̃ = h² β  (Macklin et al. 2016, eq. 26).
             let alpha = p.compliance / (h * h);
             let gamma = p.compliance * p.damping / h;
-            let grad_dx: f32 = if gamma > 0.0 {
+            let grad_dx: f64 = if gamma > 0.0 {
                 (0..N)
                     .map(|k| grad[k].dot(pos[k] - prev[idx[k] as usize]))
                     .sum()
@@ -138,16 +138,16 @@ fn correction<const N: usize, S: Shape<N>>(
                 0.0
             };
             let denom = (1.0 + gamma) * w_grad2 + alpha;
-            if denom <= f32::MIN_POSITIVE {
-                return [Vec3::ZERO; N];
+            if denom <= f64::MIN_POSITIVE {
+                return [DVec3::ZERO; N];
             }
             let dl = (-c - alpha * *lambda - gamma * grad_dx) / denom;
             *lambda += dl;
             dl
         }
         Rule::Pbd => {
-            if w_grad2 <= f32::MIN_POSITIVE {
-                return [Vec3::ZERO; N];
+            if w_grad2 <= f64::MIN_POSITIVE {
+                return [DVec3::ZERO; N];
             }
             -p.pbd_stiffness * c / w_grad2
         }
@@ -179,9 +179,9 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
     /// same arithmetic and give bit-identical results, whatever the thread count.
     pub fn project(
         &mut self,
-        x: &mut [Vec3],
-        prev: &[Vec3],
-        w: &[f32],
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        w: &[f64],
         params: &[FamilyParams],
         rule: Rule,
         par_min: usize,
@@ -193,7 +193,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
             let groups = &self.group[r.clone()];
             let lambda = &mut self.lambda[r.clone()];
             if r.len() >= par_min.max(1) {
-                let xr: &[Vec3] = x;
+                let xr: &[DVec3] = x;
                 let deltas = &mut self.deltas[..r.len()];
                 deltas
                     .par_iter_mut()
@@ -234,10 +234,10 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
     /// Adds spring forces fᵢ = −(k C + c Ċ) ∇Cᵢ, with Ċ = Σ ∇Cⱼ·vⱼ, to `forces`.
     pub fn spring_forces(
         &self,
-        x: &[Vec3],
-        v: &[Vec3],
+        x: &[DVec3],
+        v: &[DVec3],
         params: &[FamilyParams],
-        forces: &mut [Vec3],
+        forces: &mut [DVec3],
     ) {
         for ((idx, shape), &g) in self.particles.iter().zip(&self.shapes).zip(&self.group) {
             let p = &params[g as usize];
@@ -247,7 +247,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
             let Some((c, grad)) = shape.evaluate(&idx.map(|i| x[i as usize])) else {
                 continue;
             };
-            let c_dot: f32 = (0..N).map(|k| grad[k].dot(v[idx[k] as usize])).sum();
+            let c_dot: f64 = (0..N).map(|k| grad[k].dot(v[idx[k] as usize])).sum();
             let f = -(p.spring_stiffness * c + p.spring_damping * c_dot);
             for k in 0..N {
                 forces[idx[k] as usize] += grad[k] * f;
@@ -256,7 +256,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
     }
 
     /// C of every active constraint at `x`.
-    pub fn residuals<'a>(&'a self, x: &'a [Vec3]) -> impl Iterator<Item = f32> + 'a {
+    pub fn residuals<'a>(&'a self, x: &'a [DVec3]) -> impl Iterator<Item = f64> + 'a {
         self.particles
             .iter()
             .zip(&self.shapes)

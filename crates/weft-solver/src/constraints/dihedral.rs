@@ -1,9 +1,9 @@
 //! Dihedral bending: C = θ − θ₀ across an interior edge, with the gradients of
 //! Bridson et al. 2003 ("Simulation of clothing with folds and wrinkles", §4).
 
-use std::f32::consts::PI;
+use std::f64::consts::PI;
 
-use glam::Vec3;
+use glam::DVec3;
 
 use super::Shape;
 
@@ -13,12 +13,12 @@ use super::Shape;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dihedral {
     /// Rest dihedral angle θ₀ (rad).
-    pub rest: f32,
+    pub rest: f64,
 }
 
 impl Dihedral {
     /// Signed dihedral angle θ at `p`, in (−π, π]; 0 when both triangles are coplanar.
-    pub fn angle(p: &[Vec3; 4]) -> Option<f32> {
+    pub fn angle(p: &[DVec3; 4]) -> Option<f64> {
         let [x1, x2, x3, x4] = *p;
         let n1 = (x1 - x3).cross(x1 - x4);
         let n2 = (x2 - x4).cross(x2 - x3);
@@ -34,7 +34,7 @@ impl Dihedral {
 
 impl Shape<4> for Dihedral {
     #[inline]
-    fn evaluate(&self, p: &[Vec3; 4]) -> Option<(f32, [Vec3; 4])> {
+    fn evaluate(&self, p: &[DVec3; 4]) -> Option<(f64, [DVec3; 4])> {
         let [x1, x2, x3, x4] = *p;
         let n1 = (x1 - x3).cross(x1 - x4);
         let n2 = (x2 - x4).cross(x2 - x3);
@@ -65,19 +65,19 @@ impl Shape<4> for Dihedral {
 mod tests {
     use super::*;
 
-    fn sample() -> [Vec3; 4] {
+    fn sample() -> [DVec3; 4] {
         [
-            Vec3::new(0.3, 1.0, 0.2),
-            Vec3::new(-0.1, -0.9, 0.4),
-            Vec3::new(-0.5, 0.05, 0.0),
-            Vec3::new(0.6, -0.1, 0.1),
+            DVec3::new(0.3, 1.0, 0.2),
+            DVec3::new(-0.1, -0.9, 0.4),
+            DVec3::new(-0.5, 0.05, 0.0),
+            DVec3::new(0.6, -0.1, 0.1),
         ]
     }
 
     #[test]
     fn gradient_matches_finite_differences() {
         let shape = Dihedral { rest: 0.1 };
-        for p in [sample(), sample().map(|v| v * 2.0 + Vec3::X)] {
+        for p in [sample(), sample().map(|v| v * 2.0 + DVec3::X)] {
             let (_, grad) = shape.evaluate(&p).expect("not degenerate");
             for k in 0..4 {
                 for axis in 0..3 {
@@ -94,7 +94,7 @@ mod tests {
                     );
                 }
             }
-            let sum: Vec3 = grad.iter().sum();
+            let sum: DVec3 = grad.iter().sum();
             assert!(
                 sum.length() < 1e-4,
                 "gradients must sum to zero (translation invariance)"
@@ -105,10 +105,10 @@ mod tests {
     #[test]
     fn flat_pair_has_zero_angle_and_folding_changes_sign() {
         let flat = [
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(0.0, -1.0, 0.0),
-            Vec3::new(-1.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, -1.0, 0.0),
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
         ];
         assert!(Dihedral::angle(&flat).expect("ok").abs() < 1e-6);
         let mut up = flat;

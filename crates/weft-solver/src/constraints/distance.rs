@@ -1,6 +1,6 @@
 //! Distance constraint C = |p₀ − p₁| − d (Müller et al. 2007, eq. 9; the poster's Δp formula).
 
-use glam::Vec3;
+use glam::DVec3;
 
 use super::Shape;
 
@@ -8,12 +8,12 @@ use super::Shape;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Distance {
     /// Rest length d (m).
-    pub rest: f32,
+    pub rest: f64,
 }
 
 impl Shape<2> for Distance {
     #[inline]
-    fn evaluate(&self, p: &[Vec3; 2]) -> Option<(f32, [Vec3; 2])> {
+    fn evaluate(&self, p: &[DVec3; 2]) -> Option<(f64, [DVec3; 2])> {
         let d = p[0] - p[1];
         let len = d.length();
         if len < 1e-9 {

@@ -10,14 +10,14 @@ pub use dihedral::Dihedral;
 pub use distance::Distance;
 pub use tether::Tether;
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::params::FamilyParams;
 
 /// A constraint function C(p) over `N` particles with its gradient.
 pub trait Shape<const N: usize>: Copy + Send + Sync {
     /// Returns C and ∇C at `p`, or `None` when the constraint is inactive or degenerate there.
-    fn evaluate(&self, p: &[Vec3; N]) -> Option<(f32, [Vec3; N])>;
+    fn evaluate(&self, p: &[DVec3; N]) -> Option<(f64, [DVec3; N])>;
 }
 
 /// Every constraint of a solver: distance-like pairs, dihedral quadruples and tethers.
@@ -35,9 +35,9 @@ pub struct ConstraintSet {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Residual {
     /// Largest |C|.
-    pub max: f32,
+    pub max: f64,
     /// Root mean square of C.
-    pub rms: f32,
+    pub rms: f64,
     /// Number of constraints measured.
     pub count: usize,
 }
@@ -72,9 +72,9 @@ impl ConstraintSet {
     /// One Gauss–Seidel sweep over every constraint, colour by colour.
     pub(crate) fn project(
         &mut self,
-        x: &mut [Vec3],
-        prev: &[Vec3],
-        w: &[f32],
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        w: &[f64],
         params: &[FamilyParams],
         rule: Rule,
         par_min: usize,
@@ -87,10 +87,10 @@ impl ConstraintSet {
     /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N).
     pub(crate) fn spring_forces(
         &self,
-        x: &[Vec3],
-        v: &[Vec3],
+        x: &[DVec3],
+        v: &[DVec3],
         params: &[FamilyParams],
-        forces: &mut [Vec3],
+        forces: &mut [DVec3],
     ) {
         self.distance.spring_forces(x, v, params, forces);
         self.dihedral.spring_forces(x, v, params, forces);
@@ -98,16 +98,16 @@ impl ConstraintSet {
     }
 
     /// |C| over distance-like constraints (stretch, shear, bend-distance) and active tethers (m).
-    pub fn distance_residual(&self, x: &[Vec3]) -> Residual {
+    pub fn distance_residual(&self, x: &[DVec3]) -> Residual {
         let mut r = Residual::default();
         let mut sum = 0.0f64;
         for c in self.distance.residuals(x).chain(self.tethers.residuals(x)) {
             r.max = r.max.max(c.abs());
-            sum += f64::from(c) * f64::from(c);
+            sum += c * c;
             r.count += 1;
         }
         if r.count > 0 {
-            r.rms = (sum / r.count as f64).sqrt() as f32;
+            r.rms = (sum / r.count as f64).sqrt();
         }
         r
     }

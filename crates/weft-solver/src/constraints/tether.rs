@@ -1,6 +1,6 @@
 //! Long-range attachment (Kim et al. 2012): C = |p − a| − L, active only when C > 0.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use super::Shape;
 
@@ -8,12 +8,12 @@ use super::Shape;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tether {
     /// Maximum distance L (m).
-    pub max_length: f32,
+    pub max_length: f64,
 }
 
 impl Shape<2> for Tether {
     #[inline]
-    fn evaluate(&self, p: &[Vec3; 2]) -> Option<(f32, [Vec3; 2])> {
+    fn evaluate(&self, p: &[DVec3; 2]) -> Option<(f64, [DVec3; 2])> {
         let d = p[0] - p[1];
         let len = d.length();
         if len <= self.max_length || len < 1e-9 {

@@ -1,6 +1,6 @@
 //! Mass-spring: constraint forces −(k C + c Ċ)∇C integrated with semi-implicit Euler.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, Rule};
 use crate::method::Strategy;
@@ -16,10 +16,10 @@ impl Strategy for MassSpring {
         constraints: &ConstraintSet,
         particles: &Particles,
         params: &[FamilyParams],
-        force: &mut [Vec3],
-        accel: &mut [Vec3],
+        force: &mut [DVec3],
+        accel: &mut [DVec3],
     ) {
-        force.fill(Vec3::ZERO);
+        force.fill(DVec3::ZERO);
         constraints.spring_forces(&particles.positions, &particles.velocities, params, force);
         for ((a, f), w) in accel
             .iter_mut()
@@ -30,7 +30,7 @@ impl Strategy for MassSpring {
         }
     }
 
-    fn rule(&self, _h: f32) -> Option<Rule> {
+    fn rule(&self, _h: f64) -> Option<Rule> {
         None
     }
 }

@@ -7,7 +7,7 @@ use crate::method::Strategy;
 pub(crate) struct Pbd;
 
 impl Strategy for Pbd {
-    fn rule(&self, _h: f32) -> Option<Rule> {
+    fn rule(&self, _h: f64) -> Option<Rule> {
         Some(Rule::Pbd)
     }
 }

@@ -11,7 +11,7 @@ impl Strategy for Xpbd {
         constraints.reset_multipliers();
     }
 
-    fn rule(&self, h: f32) -> Option<Rule> {
+    fn rule(&self, h: f64) -> Option<Rule> {
         Some(Rule::Xpbd { h })
     }
 }

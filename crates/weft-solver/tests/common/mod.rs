@@ -1,0 +1,92 @@
+//! Fixtures shared by the physics tests.
+#![allow(dead_code)]
+
+use weft_solver::glam::DVec3;
+use weft_solver::{
+    ClothMesh, ClothParams, Corner, Family, Forces, GridDesc, Mass, Method, Orientation, Pin,
+    Settings, Solver, SolverBuilder,
+};
+
+/// Cloth parameters with every family switched off.
+pub fn no_families() -> ClothParams {
+    let mut p = ClothParams::default();
+    for f in Family::ALL {
+        p.get_mut(f).enabled = false;
+    }
+    p
+}
+
+/// Stretch (and shear, on grids) only, with the given XPBD compliance, PBD stiffness and spring stiffness.
+pub fn in_plane(compliance: f64, pbd_stiffness: f64, spring_stiffness: f64) -> ClothParams {
+    let mut p = no_families();
+    for f in [Family::Stretch, Family::Shear] {
+        let fp = p.get_mut(f);
+        fp.enabled = true;
+        fp.compliance = compliance;
+        fp.pbd_stiffness = pbd_stiffness;
+        fp.spring_stiffness = spring_stiffness;
+    }
+    p
+}
+
+/// A polyline of particles joined by stretch constraints; `pinned` get inverse mass 0.
+pub fn chain(points: &[DVec3], masses: &[f64], pinned: &[u32]) -> ClothMesh {
+    ClothMesh {
+        positions: points.to_vec(),
+        triangles: vec![],
+        masses: masses.to_vec(),
+        pinned: pinned.to_vec(),
+        stretch: (0..points.len() as u32 - 1).map(|i| [i, i + 1]).collect(),
+        shear: vec![],
+        grid: None,
+    }
+}
+
+/// Settings for `method` with frame step `dt`, `substeps` and `iterations`.
+pub fn settings(method: Method, dt: f64, substeps: u32, iterations: u32) -> Settings {
+    Settings {
+        method,
+        dt,
+        substeps,
+        iterations,
+        ..Settings::default()
+    }
+}
+
+/// A solver holding one cloth.
+pub fn solver(settings: Settings, forces: Forces, mesh: &ClothMesh, params: ClothParams) -> Solver {
+    let mut b = SolverBuilder::new(settings, forces).expect("valid settings");
+    b.add_cloth("cloth", mesh, params, 0.0)
+        .expect("valid cloth");
+    b.build()
+}
+
+/// A vertical `n`×`n` 1 m cloth of 1 kg pinned at its two top corners.
+pub fn hanging_grid(n: usize) -> ClothMesh {
+    GridDesc {
+        resolution: (n, n),
+        size: (1.0, 1.0),
+        center: DVec3::ZERO,
+        orientation: Orientation::Vertical,
+        mass: Mass::Total(1.0),
+        pins: vec![Pin::Corner(Corner::TopLeft), Pin::Corner(Corner::TopRight)],
+    }
+    .build()
+    .expect("valid grid")
+}
+
+/// Steps `frames` frames, panicking with the solver's error if it diverges.
+pub fn run(s: &mut Solver, frames: usize) {
+    for _ in 0..frames {
+        s.step().expect("simulation stays finite");
+    }
+}
+
+/// Lowest y of any particle.
+pub fn lowest_y(s: &Solver) -> f64 {
+    s.particles()
+        .positions
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::INFINITY, f64::min)
+}
