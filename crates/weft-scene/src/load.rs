@@ -1,0 +1,128 @@
+//! Loading: file → TOML document → `--set` overrides → serde → validation.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use toml_edit::DocumentMut;
+
+use crate::error::{Origin, SceneError, SceneErrors};
+use crate::overrides::{self, Override};
+use crate::resolve::{Checker, resolve};
+use crate::scene::{DirFiles, Files, Scene};
+use crate::schema::SceneFile;
+use crate::source::{Source, key_at, line_at};
+
+/// Loads and validates the scene file at `path` with `overrides` applied; mesh files are
+/// read relative to the scene's directory.
+pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneErrors> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        origin: Origin::File {
+            path: name.clone(),
+            line: None,
+        },
+        key: String::new(),
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    from_text(&name, &text, overrides, &DirFiles(Scene::dir_of(path)))
+}
+
+/// Validates scene `text` (called `name` in messages) with `overrides`, reading meshes from `files`.
+pub fn from_text(
+    name: &str,
+    text: &str,
+    overrides: &[Override],
+    files: &dyn Files,
+) -> Result<Scene, SceneErrors> {
+    let file_error = |line: Option<usize>, message: String| SceneError {
+        origin: Origin::File {
+            path: name.to_owned(),
+            line,
+        },
+        key: String::new(),
+        message,
+    };
+    let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
+        let line = e.span().map(|s| line_at(text, s.start));
+        file_error(line, format!("not valid TOML: {}", first_line(e.message())))
+    })?;
+    for ov in overrides {
+        overrides::apply(&mut doc, ov)?;
+    }
+    let effective = doc.to_string();
+    let overridden: BTreeSet<String> = overrides.iter().map(|o| o.key.clone()).collect();
+    let src = Source::new(name, text, overridden);
+    let file: SceneFile = toml_edit::de::from_str(&effective).map_err(|e| {
+        let message = tidy(e.message());
+        match e.span().and_then(|s| key_at(&effective, s.start)) {
+            Some(key) => src.error(&key, message),
+            None => file_error(e.span().map(|s| line_at(&effective, s.start)), message),
+        }
+    })?;
+    let mut checker = Checker::new(&src, files);
+    let parts = resolve(&file, &mut checker);
+    let Some(parts) = parts else {
+        return Err(SceneErrors(checker.errors));
+    };
+    Ok(Scene {
+        name: name.to_owned(),
+        source: text.to_owned(),
+        effective,
+        overrides: overrides.to_vec(),
+        file,
+        settings: parts.settings,
+        forces: parts.forces,
+        cloths: parts.cloths,
+        colliders: parts.colliders,
+        self_collision: parts.self_collision,
+        files: checker.read,
+    })
+}
+
+fn first_line(s: &str) -> &str {
+    s.lines().next().unwrap_or(s).trim()
+}
+
+/// Shortens serde's messages: long lists of expected keys become a "did you mean".
+fn tidy(message: &str) -> String {
+    let message = first_line(message)
+        .replace("expected i64", "expected an integer")
+        .replace("expected f64", "expected a number");
+    let message = message.as_str();
+    let Some(rest) = message.strip_prefix("unknown field `") else {
+        return message.to_owned();
+    };
+    let Some((field, tail)) = rest.split_once('`') else {
+        return message.to_owned();
+    };
+    let expected: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
+    let best = expected
+        .iter()
+        .min_by_key(|c| edit_distance(field, c))
+        .filter(|c| edit_distance(field, c) <= 3.max(field.len() / 3));
+    match best {
+        Some(b) => format!("unknown key `{field}` (did you mean `{b}`?)"),
+        None if expected.len() <= 8 && !expected.is_empty() => {
+            format!(
+                "unknown key `{field}`, expected one of: {}",
+                expected.join(", ")
+            )
+        }
+        None => format!("unknown key `{field}` (see the scene key reference in README.md)"),
+    }
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}

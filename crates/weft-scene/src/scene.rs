@@ -1,0 +1,183 @@
+//! A validated scene: solver settings, forces, cloths, colliders and the texts it came from.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use weft_solver::glam::{DQuat, DVec3};
+use weft_solver::{ClothMesh, ClothParams, Forces, Method, Motion, Settings};
+
+use crate::overrides::Override;
+use crate::schema::SceneFile;
+
+/// Reads the files a scene names (OBJ meshes), by the path written in the scene.
+pub trait Files {
+    /// The bytes of `path`, or why they cannot be read.
+    fn read(&self, path: &str) -> Result<Vec<u8>, String>;
+}
+
+/// Files relative to a directory (the scene file's own).
+#[derive(Clone, Debug)]
+pub struct DirFiles(pub PathBuf);
+
+impl Files for DirFiles {
+    fn read(&self, path: &str) -> Result<Vec<u8>, String> {
+        std::fs::read(self.0.join(path)).map_err(|e| e.to_string())
+    }
+}
+
+/// Files held in memory (e.g. the attachments of an MCAP log).
+#[derive(Clone, Debug, Default)]
+pub struct MapFiles(pub BTreeMap<String, Vec<u8>>);
+
+impl Files for MapFiles {
+    fn read(&self, path: &str) -> Result<Vec<u8>, String> {
+        self.0
+            .get(path)
+            .cloned()
+            .ok_or_else(|| "not in the log's attachments".to_owned())
+    }
+}
+
+/// A cloth ready for a solver.
+#[derive(Clone, Debug)]
+pub struct ClothSpec {
+    /// Unique name (topic `/cloth/<name>/…`).
+    pub name: String,
+    /// The method (and so the solver) that simulates it.
+    pub method: Method,
+    /// Geometry, masses and pins.
+    pub mesh: ClothMesh,
+    /// Per-family parameters.
+    pub params: ClothParams,
+    /// Collision thickness (m).
+    pub thickness: f64,
+    /// Motion of its pins.
+    pub motion: Motion,
+}
+
+/// A collider's geometry in its own frame (f64; converted by the collision crate).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeSpec {
+    /// Ball.
+    Sphere {
+        /// Radius (m).
+        radius: f64,
+    },
+    /// Box.
+    Cuboid {
+        /// Half extents (m).
+        half_extents: DVec3,
+    },
+    /// Capsule along local y.
+    Capsule {
+        /// Half height of the core segment (m).
+        half_height: f64,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// Half-space below the plane through the collider's position.
+    Plane {
+        /// Outward normal.
+        normal: DVec3,
+    },
+    /// Convex hull.
+    ConvexHull {
+        /// Points (m).
+        points: Vec<DVec3>,
+    },
+    /// Triangle mesh.
+    Mesh {
+        /// Vertices (m, scaled).
+        positions: Vec<DVec3>,
+        /// Triangles.
+        triangles: Vec<[u32; 3]>,
+    },
+    /// Convex parts, each placed in the compound's frame.
+    Compound(Vec<(DVec3, DQuat, ShapeSpec)>),
+}
+
+/// A collider ready for the collision world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColliderSpec {
+    /// Name.
+    pub name: String,
+    /// Geometry.
+    pub shape: ShapeSpec,
+    /// Position (m).
+    pub position: DVec3,
+    /// Orientation.
+    pub rotation: DQuat,
+    /// Kinematic motion.
+    pub motion: Motion,
+    /// Static friction coefficient.
+    pub static_friction: f64,
+    /// Dynamic friction coefficient.
+    pub dynamic_friction: f64,
+}
+
+/// Self-collision settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SelfCollisionSpec {
+    /// Cloths taking part.
+    pub cloths: Vec<String>,
+    /// Static friction between particles.
+    pub static_friction: f64,
+    /// Dynamic friction between particles.
+    pub dynamic_friction: f64,
+    /// Largest per-substep displacement as a fraction of thickness.
+    pub max_displacement: f64,
+    /// Extra search radius as a fraction of thickness.
+    pub search_margin: f64,
+}
+
+/// A validated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The scene file's path as given (for messages and logs).
+    pub name: String,
+    /// The file's text, verbatim.
+    pub source: String,
+    /// The text after `--set` overrides (what was simulated).
+    pub effective: String,
+    /// The overrides applied.
+    pub overrides: Vec<Override>,
+    /// The file as deserialised, defaults filled in.
+    pub file: SceneFile,
+    /// Settings shared by every solver (each solver sets its own method).
+    pub settings: Settings,
+    /// Forces shared by every solver.
+    pub forces: Forces,
+    /// Cloths, sorted by name.
+    pub cloths: Vec<ClothSpec>,
+    /// Colliders in file order.
+    pub colliders: Vec<ColliderSpec>,
+    /// Self-collision, when on.
+    pub self_collision: Option<SelfCollisionSpec>,
+    /// Files the scene read (OBJ meshes), by the path written in the scene.
+    pub files: BTreeMap<String, Vec<u8>>,
+}
+
+impl Scene {
+    /// The methods used, in cloth order, each once: a scene yields one solver per method.
+    pub fn methods(&self) -> Vec<Method> {
+        let mut out = Vec::new();
+        for c in &self.cloths {
+            if !out.contains(&c.method) {
+                out.push(c.method);
+            }
+        }
+        out
+    }
+
+    /// The resolved scene (every default filled in) as TOML.
+    pub fn resolved_toml(&self) -> String {
+        toml_edit::ser::to_string_pretty(&self.file).unwrap_or_else(|e| format!("# {e}\n"))
+    }
+
+    /// Directory a scene at `path` resolves its files against.
+    pub fn dir_of(path: &Path) -> PathBuf {
+        path.parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."))
+    }
+}

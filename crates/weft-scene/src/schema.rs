@@ -1,0 +1,691 @@
+//! The scene file as written: serde structures mirroring the TOML, before validation.
+//!
+//! Every table denies unknown keys, so a typo is an error rather than a silently ignored value.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use serde::de::{self, Visitor};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use weft_solver::Family;
+
+use crate::family::Field;
+
+/// A whole scene file.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// `[sim]`: method, time step, substeps, iterations, gravity, damping.
+    #[serde(default)]
+    pub sim: SimSection,
+    /// `[wind]`: uniform wind and optional aerodynamics.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind: Option<WindSection>,
+    /// `[cloth.<name>]`: one or more named cloths (sorted by name).
+    #[serde(default)]
+    pub cloth: BTreeMap<String, ClothSection>,
+    /// `[[collider]]`: obstacles.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub collider: Vec<ColliderSection>,
+    /// `[self_collision]`: particle–particle collision among cloths.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub self_collision: Option<SelfCollisionSection>,
+}
+
+/// A method name: `xpbd`, `pbd` or `mass-spring`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodName {
+    /// XPBD.
+    #[default]
+    Xpbd,
+    /// PBD.
+    Pbd,
+    /// Mass-spring.
+    MassSpring,
+}
+
+impl From<MethodName> for weft_solver::Method {
+    fn from(m: MethodName) -> Self {
+        match m {
+            MethodName::Xpbd => weft_solver::Method::Xpbd,
+            MethodName::Pbd => weft_solver::Method::Pbd,
+            MethodName::MassSpring => weft_solver::Method::MassSpring,
+        }
+    }
+}
+
+/// A time in seconds, written as a number (`0.0166`) or a fraction (`"1/60"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Seconds(pub f64);
+
+impl Serialize for Seconds {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_f64(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for Seconds {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Seconds;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number of seconds or a fraction such as \"1/60\"")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Seconds, E> {
+                Ok(Seconds(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Seconds, E> {
+                Ok(Seconds(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Seconds, E> {
+                Ok(Seconds(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Seconds, E> {
+                let parse = |s: &str| s.trim().parse::<f64>().ok();
+                let value = match v.split_once('/') {
+                    Some((a, b)) => parse(a).zip(parse(b)).map(|(a, b)| a / b),
+                    None => parse(v),
+                };
+                value.map(Seconds).ok_or_else(|| {
+                    E::custom(format!(
+                        "expected a number of seconds or a fraction such as \"1/60\", got \"{v}\""
+                    ))
+                })
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// `[sim]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimSection {
+    /// Default method of every cloth: `xpbd`, `pbd` or `mass-spring`.
+    #[serde(default)]
+    pub method: MethodName,
+    /// Frame time step (s); a number or `"1/60"`.
+    #[serde(default = "default_dt")]
+    pub dt: Seconds,
+    /// Substeps per frame.
+    #[serde(default = "default_substeps")]
+    pub substeps: i64,
+    /// Constraint sweeps per substep.
+    #[serde(default = "default_iterations")]
+    pub iterations: i64,
+    /// Gravitational acceleration (m/s²).
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    /// Global velocity damping rate (1/s).
+    #[serde(default)]
+    pub damping: f64,
+    /// A particle farther than this from the origin (m) means divergence.
+    #[serde(default = "default_bound")]
+    pub divergence_bound: f64,
+}
+
+fn default_dt() -> Seconds {
+    Seconds(weft_solver::Settings::default().dt)
+}
+fn default_substeps() -> i64 {
+    weft_solver::Settings::default().substeps.into()
+}
+fn default_iterations() -> i64 {
+    weft_solver::Settings::default().iterations.into()
+}
+fn default_gravity() -> [f64; 3] {
+    weft_solver::Forces::default().gravity.to_array()
+}
+fn default_bound() -> f64 {
+    weft_solver::Settings::default().divergence_bound
+}
+
+impl Default for SimSection {
+    fn default() -> Self {
+        Self {
+            method: MethodName::Xpbd,
+            dt: default_dt(),
+            substeps: default_substeps(),
+            iterations: default_iterations(),
+            gravity: default_gravity(),
+            damping: 0.0,
+            divergence_bound: default_bound(),
+        }
+    }
+}
+
+/// `[wind]`.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindSection {
+    /// Wind velocity (m/s).
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Uniform drag rate (1/s).
+    #[serde(default)]
+    pub drag: f64,
+    /// `[wind.aero]`: per-triangle drag and lift; present means on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aero: Option<AeroSection>,
+}
+
+/// `[wind.aero]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AeroSection {
+    /// Air density (kg/m³).
+    #[serde(default = "default_air_density")]
+    pub air_density: f64,
+    /// Drag coefficient.
+    #[serde(default = "default_drag_coefficient")]
+    pub drag_coefficient: f64,
+    /// Lift coefficient.
+    #[serde(default = "default_lift_coefficient")]
+    pub lift_coefficient: f64,
+}
+
+fn default_air_density() -> f64 {
+    weft_solver::Aero::default().air_density
+}
+fn default_drag_coefficient() -> f64 {
+    weft_solver::Aero::default().drag_coefficient
+}
+fn default_lift_coefficient() -> f64 {
+    weft_solver::Aero::default().lift_coefficient
+}
+
+/// The plane of a grid cloth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OrientationName {
+    /// x–y plane, hanging.
+    #[default]
+    Vertical,
+    /// x–z plane, lying.
+    Horizontal,
+}
+
+/// A pin: a corner or edge name (`top-left`, `top`, …) or a vertex index.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PinSpec {
+    /// A corner or edge of a grid.
+    Named(String),
+    /// A vertex index.
+    Index(i64),
+}
+
+impl Serialize for PinSpec {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            PinSpec::Named(n) => s.serialize_str(n),
+            PinSpec::Index(i) => s.serialize_i64(*i),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PinSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = PinSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a corner or edge name (\"top-left\", \"top\", …) or a vertex index")
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<PinSpec, E> {
+                Ok(PinSpec::Index(v))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<PinSpec, E> {
+                i64::try_from(v)
+                    .map(PinSpec::Index)
+                    .map_err(|_| E::custom("vertex index too large"))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<PinSpec, E> {
+                Ok(PinSpec::Named(v.to_owned()))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// A prescribed motion (for a cloth's pins or a collider).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum MotionSpec {
+    /// Does not move.
+    Static,
+    /// Constant velocity (m/s).
+    Linear {
+        /// Velocity (m/s).
+        velocity: [f64; 3],
+    },
+    /// x₀ + A sin(2π f t).
+    Oscillate {
+        /// Amplitude (m).
+        amplitude: [f64; 3],
+        /// Frequency (Hz).
+        frequency: f64,
+    },
+    /// Rotation about an axis through a pivot.
+    Rotate {
+        /// A point on the axis (m).
+        pivot: [f64; 3],
+        /// Axis direction.
+        axis: [f64; 3],
+        /// Angular velocity (rad/s).
+        angular_velocity: f64,
+    },
+}
+
+/// `[cloth.<name>]`.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClothSection {
+    /// Method of this cloth, overriding `sim.method` (a scene yields one solver per method).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<MethodName>,
+    /// Grid particles `[columns, rows]` (grid cloths).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<[i64; 2]>,
+    /// Grid size `[width, height]` (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<[f64; 2]>,
+    /// Grid plane: `vertical` or `horizontal`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientationName>,
+    /// OBJ mesh file, relative to the scene file (instead of a grid).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// Scale applied to the OBJ mesh's vertices.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
+    /// Centre of a grid, or translation of a mesh (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center: Option<[f64; 3]>,
+    /// Total mass (kg); give this or `density`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<f64>,
+    /// Areal density (kg/m²); give this or `mass`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    /// Pinned particles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pins: Option<Vec<PinSpec>>,
+    /// Motion the pins follow (default: static).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionSpec>,
+    /// Collision thickness (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    // Per-family parameters, `<family>_<field>` (generated list).
+    /// `stretch`: whether the family's constraints are created.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_enabled: Option<bool>,
+    /// `stretch`: XPBD compliance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_compliance: Option<f64>,
+    /// `stretch`: XPBD constraint damping (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_damping: Option<f64>,
+    /// `stretch`: PBD stiffness in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_pbd_stiffness: Option<f64>,
+    /// `stretch`: mass-spring stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_spring_stiffness: Option<f64>,
+    /// `stretch`: mass-spring damping (N·s/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_spring_damping: Option<f64>,
+    /// `shear`: whether the family's constraints are created.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_enabled: Option<bool>,
+    /// `shear`: XPBD compliance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_compliance: Option<f64>,
+    /// `shear`: XPBD constraint damping (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_damping: Option<f64>,
+    /// `shear`: PBD stiffness in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_pbd_stiffness: Option<f64>,
+    /// `shear`: mass-spring stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_spring_stiffness: Option<f64>,
+    /// `shear`: mass-spring damping (N·s/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_spring_damping: Option<f64>,
+    /// `bend_distance`: whether the family's constraints are created.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_distance_enabled: Option<bool>,
+    /// `bend_distance`: XPBD compliance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_distance_compliance: Option<f64>,
+    /// `bend_distance`: XPBD constraint damping (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_distance_damping: Option<f64>,
+    /// `bend_distance`: PBD stiffness in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_distance_pbd_stiffness: Option<f64>,
+    /// `bend_distance`: mass-spring stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_distance_spring_stiffness: Option<f64>,
+    /// `bend_distance`: mass-spring damping (N·s/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_distance_spring_damping: Option<f64>,
+    /// `bend_dihedral`: whether the family's constraints are created.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_dihedral_enabled: Option<bool>,
+    /// `bend_dihedral`: XPBD compliance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_dihedral_compliance: Option<f64>,
+    /// `bend_dihedral`: XPBD constraint damping (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_dihedral_damping: Option<f64>,
+    /// `bend_dihedral`: PBD stiffness in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_dihedral_pbd_stiffness: Option<f64>,
+    /// `bend_dihedral`: mass-spring stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_dihedral_spring_stiffness: Option<f64>,
+    /// `bend_dihedral`: mass-spring damping (N·s/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bend_dihedral_spring_damping: Option<f64>,
+    /// `tether`: whether the family's constraints are created.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether_enabled: Option<bool>,
+    /// `tether`: XPBD compliance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether_compliance: Option<f64>,
+    /// `tether`: XPBD constraint damping (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether_damping: Option<f64>,
+    /// `tether`: PBD stiffness in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether_pbd_stiffness: Option<f64>,
+    /// `tether`: mass-spring stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether_spring_stiffness: Option<f64>,
+    /// `tether`: mass-spring damping (N·s/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether_spring_damping: Option<f64>,
+}
+
+impl ClothSection {
+    /// The keys as `(family, field, value)` triples, numbers as f64 and booleans as 0/1.
+    pub fn family_entries(&self) -> Vec<(Family, Field, Option<f64>)> {
+        vec![
+            (
+                Family::Stretch,
+                Field::Enabled,
+                self.stretch_enabled.map(|b| if b { 1.0 } else { 0.0 }),
+            ),
+            (Family::Stretch, Field::Compliance, self.stretch_compliance),
+            (Family::Stretch, Field::Damping, self.stretch_damping),
+            (
+                Family::Stretch,
+                Field::PbdStiffness,
+                self.stretch_pbd_stiffness,
+            ),
+            (
+                Family::Stretch,
+                Field::SpringStiffness,
+                self.stretch_spring_stiffness,
+            ),
+            (
+                Family::Stretch,
+                Field::SpringDamping,
+                self.stretch_spring_damping,
+            ),
+            (
+                Family::Shear,
+                Field::Enabled,
+                self.shear_enabled.map(|b| if b { 1.0 } else { 0.0 }),
+            ),
+            (Family::Shear, Field::Compliance, self.shear_compliance),
+            (Family::Shear, Field::Damping, self.shear_damping),
+            (Family::Shear, Field::PbdStiffness, self.shear_pbd_stiffness),
+            (
+                Family::Shear,
+                Field::SpringStiffness,
+                self.shear_spring_stiffness,
+            ),
+            (
+                Family::Shear,
+                Field::SpringDamping,
+                self.shear_spring_damping,
+            ),
+            (
+                Family::BendDistance,
+                Field::Enabled,
+                self.bend_distance_enabled
+                    .map(|b| if b { 1.0 } else { 0.0 }),
+            ),
+            (
+                Family::BendDistance,
+                Field::Compliance,
+                self.bend_distance_compliance,
+            ),
+            (
+                Family::BendDistance,
+                Field::Damping,
+                self.bend_distance_damping,
+            ),
+            (
+                Family::BendDistance,
+                Field::PbdStiffness,
+                self.bend_distance_pbd_stiffness,
+            ),
+            (
+                Family::BendDistance,
+                Field::SpringStiffness,
+                self.bend_distance_spring_stiffness,
+            ),
+            (
+                Family::BendDistance,
+                Field::SpringDamping,
+                self.bend_distance_spring_damping,
+            ),
+            (
+                Family::BendDihedral,
+                Field::Enabled,
+                self.bend_dihedral_enabled
+                    .map(|b| if b { 1.0 } else { 0.0 }),
+            ),
+            (
+                Family::BendDihedral,
+                Field::Compliance,
+                self.bend_dihedral_compliance,
+            ),
+            (
+                Family::BendDihedral,
+                Field::Damping,
+                self.bend_dihedral_damping,
+            ),
+            (
+                Family::BendDihedral,
+                Field::PbdStiffness,
+                self.bend_dihedral_pbd_stiffness,
+            ),
+            (
+                Family::BendDihedral,
+                Field::SpringStiffness,
+                self.bend_dihedral_spring_stiffness,
+            ),
+            (
+                Family::BendDihedral,
+                Field::SpringDamping,
+                self.bend_dihedral_spring_damping,
+            ),
+            (
+                Family::Tether,
+                Field::Enabled,
+                self.tether_enabled.map(|b| if b { 1.0 } else { 0.0 }),
+            ),
+            (Family::Tether, Field::Compliance, self.tether_compliance),
+            (Family::Tether, Field::Damping, self.tether_damping),
+            (
+                Family::Tether,
+                Field::PbdStiffness,
+                self.tether_pbd_stiffness,
+            ),
+            (
+                Family::Tether,
+                Field::SpringStiffness,
+                self.tether_spring_stiffness,
+            ),
+            (
+                Family::Tether,
+                Field::SpringDamping,
+                self.tether_spring_damping,
+            ),
+        ]
+    }
+}
+
+/// A collider's shape kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShapeKind {
+    /// `radius`.
+    Sphere,
+    /// `half_extents`.
+    Cuboid,
+    /// `half_height` (along local y) and `radius`.
+    Capsule,
+    /// A half-space below the plane through `position` with outward `normal`.
+    Plane,
+    /// The convex hull of `points`.
+    ConvexHull,
+    /// An OBJ triangle mesh (`mesh`, `scale`).
+    Mesh,
+    /// Several convex `parts`.
+    Compound,
+}
+
+/// The geometry keys shared by a collider and a compound part.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartSection {
+    /// The shape kind.
+    pub shape: ShapeKind,
+    /// Sphere and capsule radius (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Cuboid half extents (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_extents: Option<[f64; 3]>,
+    /// Capsule half height of the core segment (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_height: Option<f64>,
+    /// Plane outward normal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// Convex hull points (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 3]>>,
+    /// Position in the parent frame (m).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Rotation as XYZ Euler angles in degrees.
+    #[serde(default)]
+    pub rotation_deg: [f64; 3],
+}
+
+/// `[[collider]]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColliderSection {
+    /// Name (for logs); defaults to `collider<i>`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The shape kind.
+    pub shape: ShapeKind,
+    /// Sphere and capsule radius (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Cuboid half extents (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_extents: Option<[f64; 3]>,
+    /// Capsule half height of the core segment (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_height: Option<f64>,
+    /// Plane outward normal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// Convex hull points (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 3]>>,
+    /// OBJ file for `mesh`, relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// Scale of the OBJ mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
+    /// Parts of a compound.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parts: Option<Vec<PartSection>>,
+    /// Position (m).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Rotation as XYZ Euler angles in degrees.
+    #[serde(default)]
+    pub rotation_deg: [f64; 3],
+    /// Coulomb static friction coefficient.
+    #[serde(default = "default_static_friction")]
+    pub static_friction: f64,
+    /// Coulomb dynamic friction coefficient (≤ static).
+    #[serde(default = "default_dynamic_friction")]
+    pub dynamic_friction: f64,
+    /// Kinematic motion (default static).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionSpec>,
+}
+
+fn default_static_friction() -> f64 {
+    0.5
+}
+fn default_dynamic_friction() -> f64 {
+    0.4
+}
+
+/// `[self_collision]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SelfCollisionSection {
+    /// On or off.
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// Cloths that collide with themselves and each other (default: all).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cloths: Option<Vec<String>>,
+    /// Static friction between particles.
+    #[serde(default = "default_self_static")]
+    pub static_friction: f64,
+    /// Dynamic friction between particles.
+    #[serde(default = "default_self_dynamic")]
+    pub dynamic_friction: f64,
+    /// Largest per-substep displacement as a fraction of thickness.
+    #[serde(default = "default_max_displacement")]
+    pub max_displacement: f64,
+    /// Extra candidate search radius as a fraction of thickness.
+    #[serde(default = "default_search_margin")]
+    pub search_margin: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+fn default_self_static() -> f64 {
+    0.3
+}
+fn default_self_dynamic() -> f64 {
+    0.2
+}
+fn default_max_displacement() -> f64 {
+    0.45
+}
+fn default_search_margin() -> f64 {
+    0.5
+}
