@@ -1,60 +1,99 @@
-//! The `weft` binary: runs the built-in default scene and reports what the cloth does.
+//! The `weft` binary: runs scenes headless, logs them to MCAP, checks scene files, replays
+//! logs and runs experiment queues.
 
+mod cli;
 mod default_scene;
+mod experiments;
+mod record;
+mod replay;
+mod run;
+mod sim;
 
-use std::time::Instant;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::Context;
 use clap::Parser;
-use weft_solver::Method;
+use weft_scene::{Scene, SceneErrors};
 
-/// Real-time cloth simulation with XPBD, PBD and mass-spring.
-#[derive(Debug, Parser)]
-#[command(version, about)]
-struct Cli {
-    /// Method: xpbd, pbd or mass-spring.
-    #[arg(long, default_value = "xpbd")]
-    method: Method,
-    /// Frames to simulate (at the scene's time step, 1/60 s by default).
-    #[arg(long, default_value_t = 300)]
-    frames: u64,
-}
+use cli::{Cli, Command, RunArgs};
+use record::RecordOptions;
+use run::RunPlan;
 
-fn main() -> anyhow::Result<()> {
+fn main() -> ExitCode {
     let cli = Cli::parse();
-    let mut solver = default_scene::hanging(cli.method).context("building the default scene")?;
-    let n = solver.particles().len();
-    println!(
-        "weft: default scene (hanging cloth, {n} particles, {} constraints), {}, {} substeps",
-        solver.constraints().len(),
-        cli.method,
-        solver.settings().substeps
-    );
-    let start = Instant::now();
-    for frame in 1..=cli.frames {
-        solver.step().context("stepping the default scene")?;
-        if frame % 60 == 0 || frame == cli.frames {
-            let lowest = solver
-                .particles()
-                .positions
-                .iter()
-                .map(|p| p.y)
-                .fold(f64::INFINITY, f64::min);
-            println!(
-                "t = {:5.2} s  lowest point y = {lowest:+.4} m  stretch error rms = {:.2e} m  kinetic energy = {:.3e} J",
-                solver.time(),
-                solver.residual().rms,
-                solver.particles().kinetic_energy()
-            );
+    // SIGINT and SIGTERM only raise a flag: runs check it every frame and close their logs.
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst)) {
+        eprintln!("weft: warning: cannot catch SIGINT/SIGTERM: {e}");
+    }
+    let result = match cli.command {
+        None => run_command(&cli.run, &stop),
+        Some(Command::Run(args)) => run_command(&args, &stop),
+        Some(Command::Check(args)) => check(&args),
+        Some(Command::Replay(args)) => replay::replay(&args, &stop),
+        Some(Command::Experiments(args)) => experiments::run(&args, &stop),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("weft: error: {e:#}");
+            ExitCode::FAILURE
         }
     }
-    let wall = start.elapsed().as_secs_f64();
-    println!(
-        "{} frames, {:.2} s simulated, {:.3} s wall, {:.3} ms/frame",
-        cli.frames,
-        solver.time(),
-        wall,
-        1e3 * wall / cli.frames as f64
-    );
-    Ok(())
+}
+
+/// Loads the scene a run names (or the default one), printing every error.
+fn load_scene(
+    path: Option<&std::path::Path>,
+    overrides: &[weft_scene::Override],
+) -> Result<Scene, SceneErrors> {
+    match path {
+        Some(p) => weft_scene::load(p, overrides),
+        None => default_scene::load(overrides),
+    }
+}
+
+fn report(errors: &SceneErrors) -> ExitCode {
+    for e in &errors.0 {
+        eprintln!("error: {e}");
+    }
+    ExitCode::FAILURE
+}
+
+fn run_command(args: &RunArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
+    let scene = match load_scene(args.scene.as_deref(), &args.overrides()) {
+        Ok(s) => s,
+        Err(e) => return Ok(report(&e)),
+    };
+    let plan = RunPlan {
+        frames: args.frames,
+        out: args.out.as_deref(),
+        dump_final: args.dump_final.as_deref(),
+        record: RecordOptions {
+            mesh_every: args.mesh_every,
+            timing: args.timing,
+        },
+        progress: !args.quiet,
+    };
+    run::run(scene, &plan, stop)
+}
+
+fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
+    match weft_scene::load(&args.scene, &args.set) {
+        Ok(scene) => {
+            scene.build()?;
+            let methods: Vec<&str> = scene.methods().iter().map(|m| m.name()).collect();
+            println!(
+                "{}: ok ({} cloth(s), {} collider(s), methods: {})",
+                scene.name,
+                scene.cloths.len(),
+                scene.colliders.len(),
+                methods.join(", ")
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(e) => Ok(report(&e)),
+    }
 }

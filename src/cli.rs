@@ -1,0 +1,123 @@
+//! The command line.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+use weft_scene::Override;
+use weft_solver::Method;
+
+/// Real-time cloth simulation with XPBD, PBD and mass-spring.
+///
+/// With no command, runs the built-in default scene (assets/scenes/hanging.toml) headless.
+#[derive(Debug, Parser)]
+#[command(version, about, args_conflicts_with_subcommands = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Options for the default run.
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run a scene headless, optionally logging every frame to MCAP.
+    Run(RunArgs),
+    /// Validate a scene file (and overrides) without running it.
+    Check(CheckArgs),
+    /// Re-run a logged run from its MCAP alone (scene, overrides and meshes are in the log).
+    Replay(ReplayArgs),
+    /// Run an experiments file: a queue of runs, a summary table and plots.
+    Experiments(ExperimentArgs),
+}
+
+/// `weft run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scene file (default: the built-in hanging cloth).
+    pub scene: Option<PathBuf>,
+    /// Frames to simulate.
+    #[arg(long, default_value_t = 300)]
+    pub frames: u64,
+    /// MCAP file to write.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Override a scene key: `--set sim.substeps=20` (repeatable; values are TOML, else strings).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<Override>,
+    /// Shorthand for `--set sim.method=…` (xpbd, pbd or mass-spring).
+    #[arg(long)]
+    pub method: Option<Method>,
+    /// Write every cloth's final positions (as float32) to this JSON file.
+    #[arg(long, value_name = "FILE.json")]
+    pub dump_final: Option<PathBuf>,
+    /// Log the cloth surface every N frames (0: never).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub mesh_every: u64,
+    /// Add wall-clock step time to /stats (the file is then no longer reproducible byte for byte).
+    #[arg(long)]
+    pub timing: bool,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+impl RunArgs {
+    /// The overrides, `--method` first.
+    pub fn overrides(&self) -> Vec<Override> {
+        let mut v: Vec<Override> = self
+            .method
+            .map(|m| Override {
+                key: "sim.method".into(),
+                value: format!("\"{}\"", m.name()),
+            })
+            .into_iter()
+            .collect();
+        v.extend(self.set.iter().cloned());
+        v
+    }
+}
+
+/// `weft check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Scene file.
+    pub scene: PathBuf,
+    /// Overrides to validate with the file.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<Override>,
+}
+
+/// `weft replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// A log written by `weft run --out`.
+    pub log: PathBuf,
+    /// Where to write the re-run (default: `<log>.replay.mcap`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// `weft experiments`.
+#[derive(Debug, Args)]
+pub struct ExperimentArgs {
+    /// Experiments file.
+    pub file: PathBuf,
+    /// Output directory (default: `experiments-out/<file stem>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Run only every N-th run starting at K (`K/N`, K in 0..N), for batch schedulers.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Parallel runs (default: the number of cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Skip writing one MCAP per run.
+    #[arg(long)]
+    pub no_mcap: bool,
+}

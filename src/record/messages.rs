@@ -1,0 +1,223 @@
+//! Foxglove well-known messages for cloth particles, cloth surfaces and colliders.
+
+use foxglove::bytes::Bytes;
+use foxglove::messages::packed_element_field::NumericType;
+use foxglove::messages::{
+    Color, CubePrimitive, CylinderPrimitive, PackedElementField, Point3, PointCloud, Pose,
+    Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, TriangleListPrimitive,
+    Vector3,
+};
+use weft_scene::{ColliderSpec, ShapeSpec};
+use weft_solver::glam::{DQuat, DVec3};
+
+/// The frame every message is expressed in.
+pub const FRAME_ID: &str = "world";
+
+/// Simulated time in nanoseconds (the MCAP log time).
+pub fn nanos(time: f64) -> u64 {
+    (time * 1e9).round().max(0.0) as u64
+}
+
+/// Simulated time as a Foxglove timestamp.
+pub fn timestamp(time: f64) -> Timestamp {
+    let ns = nanos(time);
+    Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
+}
+
+fn vec3(v: DVec3) -> Vector3 {
+    Vector3 {
+        x: v.x,
+        y: v.y,
+        z: v.z,
+    }
+}
+
+fn pose(position: DVec3, rotation: DQuat) -> Pose {
+    Pose {
+        position: Some(vec3(position)),
+        orientation: Some(Quaternion {
+            x: rotation.x,
+            y: rotation.y,
+            z: rotation.z,
+            w: rotation.w,
+        }),
+    }
+}
+
+/// Every particle's position as float32 x, y, z in particle order.
+pub fn point_cloud(time: f64, positions: &[DVec3]) -> PointCloud {
+    let mut data = Vec::with_capacity(12 * positions.len());
+    for p in positions {
+        for c in [p.x, p.y, p.z] {
+            data.extend_from_slice(&(c as f32).to_le_bytes());
+        }
+    }
+    let field = |name: &str, offset| PackedElementField {
+        name: name.into(),
+        offset,
+        r#type: NumericType::Float32 as i32,
+    };
+    PointCloud {
+        timestamp: Some(timestamp(time)),
+        frame_id: FRAME_ID.into(),
+        pose: Some(pose(DVec3::ZERO, DQuat::IDENTITY)),
+        point_stride: 12,
+        fields: vec![field("x", 0), field("y", 4), field("z", 8)],
+        data: Bytes::from(data),
+    }
+}
+
+/// The cloth surface as an indexed triangle list.
+pub fn cloth_mesh(
+    time: f64,
+    name: &str,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    color: Color,
+) -> SceneUpdate {
+    let tri = TriangleListPrimitive {
+        pose: Some(pose(DVec3::ZERO, DQuat::IDENTITY)),
+        points: positions
+            .iter()
+            .map(|p| Point3 {
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            })
+            .collect(),
+        color: Some(color),
+        colors: vec![],
+        indices: triangles.iter().flatten().copied().collect(),
+    };
+    SceneUpdate {
+        deletions: vec![],
+        entities: vec![SceneEntity {
+            timestamp: Some(timestamp(time)),
+            frame_id: FRAME_ID.into(),
+            id: format!("cloth/{name}"),
+            triangles: vec![tri],
+            ..SceneEntity::default()
+        }],
+    }
+}
+
+/// A colour per method, so side-by-side cloths are told apart.
+pub fn method_color(method: weft_solver::Method) -> Color {
+    let (r, g, b) = match method {
+        weft_solver::Method::Xpbd => (0.25, 0.55, 0.95),
+        weft_solver::Method::Pbd => (0.95, 0.55, 0.2),
+        weft_solver::Method::MassSpring => (0.4, 0.8, 0.35),
+    };
+    Color { r, g, b, a: 1.0 }
+}
+
+const GREY: Color = Color {
+    r: 0.6,
+    g: 0.6,
+    b: 0.62,
+    a: 0.8,
+};
+
+fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: DQuat) {
+    let p = pose(position, rotation);
+    let color = Some(GREY);
+    match shape {
+        ShapeSpec::Sphere { radius } => e.spheres.push(SpherePrimitive {
+            pose: Some(p),
+            size: Some(vec3(DVec3::splat(2.0 * radius))),
+            color,
+        }),
+        ShapeSpec::Cuboid { half_extents } => e.cubes.push(CubePrimitive {
+            pose: Some(p),
+            size: Some(vec3(2.0 * *half_extents)),
+            color,
+        }),
+        ShapeSpec::Capsule {
+            half_height,
+            radius,
+        } => {
+            // Foxglove cylinders run along z; capsules along local y.
+            let to_y = rotation * DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
+            e.cylinders.push(CylinderPrimitive {
+                pose: Some(pose(position, to_y)),
+                size: Some(vec3(DVec3::new(2.0 * radius, 2.0 * radius, 2.0 * half_height))),
+                bottom_scale: 1.0,
+                top_scale: 1.0,
+                color,
+            });
+            for s in [-1.0, 1.0] {
+                let c = position + rotation * DVec3::new(0.0, s * half_height, 0.0);
+                add_shape(e, &ShapeSpec::Sphere { radius: *radius }, c, rotation);
+            }
+        }
+        ShapeSpec::Plane { normal } => {
+            let n = normal.normalize_or(DVec3::Y);
+            let r = rotation * DQuat::from_rotation_arc(DVec3::Y, n);
+            let centre = position - r * DVec3::new(0.0, 0.0005, 0.0);
+            e.cubes.push(CubePrimitive {
+                pose: Some(pose(centre, r)),
+                size: Some(vec3(DVec3::new(10.0, 0.001, 10.0))),
+                color,
+            });
+        }
+        ShapeSpec::ConvexHull { points } => {
+            // Drawn as the points' bounding box.
+            let lo = points.iter().copied().fold(DVec3::INFINITY, DVec3::min);
+            let hi = points.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
+            e.cubes.push(CubePrimitive {
+                pose: Some(pose(position + rotation * (0.5 * (lo + hi)), rotation)),
+                size: Some(vec3(hi - lo)),
+                color,
+            });
+        }
+        ShapeSpec::Mesh {
+            positions,
+            triangles,
+        } => e.triangles.push(TriangleListPrimitive {
+            pose: Some(p),
+            points: positions
+                .iter()
+                .map(|v| Point3 {
+                    x: v.x,
+                    y: v.y,
+                    z: v.z,
+                })
+                .collect(),
+            color,
+            colors: vec![],
+            indices: triangles.iter().flatten().copied().collect(),
+        }),
+        ShapeSpec::Compound(parts) => {
+            for (pp, pr, s) in parts {
+                add_shape(e, s, position + rotation * *pp, rotation * *pr);
+            }
+        }
+    }
+}
+
+/// Every collider at time `time`, moved by its motion.
+pub fn colliders(time: f64, colliders: &[ColliderSpec]) -> SceneUpdate {
+    let entities = colliders
+        .iter()
+        .map(|c| {
+            let t = c.motion.transform(time);
+            let mut e = SceneEntity {
+                timestamp: Some(timestamp(time)),
+                frame_id: FRAME_ID.into(),
+                id: format!("collider/{}", c.name),
+                ..SceneEntity::default()
+            };
+            add_shape(
+                &mut e,
+                &c.shape,
+                t.apply(c.position),
+                t.rotation * c.rotation,
+            );
+            e
+        })
+        .collect();
+    SceneUpdate {
+        deletions: vec![],
+        entities,
+    }
+}
