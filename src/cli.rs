@@ -120,4 +120,8 @@ pub struct ExperimentArgs {
     /// Skip writing one MCAP per run.
     #[arg(long)]
     pub no_mcap: bool,
+    /// Only rebuild the summary and plots from the results already in the output directory
+    /// (e.g. after every shard of a batch job has finished).
+    #[arg(long)]
+    pub report_only: bool,
 }

@@ -109,7 +109,11 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Resul
     println!(
         "{frames} frames, {:.3} s simulated, {wall:.3} s wall, {:.3} ms/frame; lowest point y = {lowest:+.4} m, stretch error max {:.2e} m, kinetic energy {:.3e} J",
         sim.time(),
-        if frames > 0 { 1e3 * wall / frames as f64 } else { 0.0 },
+        if frames > 0 {
+            1e3 * wall / frames as f64
+        } else {
+            0.0
+        },
         last.residual_max,
         last.kinetic_energy,
     );

@@ -140,7 +140,11 @@ fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: 
             let to_y = rotation * DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
             e.cylinders.push(CylinderPrimitive {
                 pose: Some(pose(position, to_y)),
-                size: Some(vec3(DVec3::new(2.0 * radius, 2.0 * radius, 2.0 * half_height))),
+                size: Some(vec3(DVec3::new(
+                    2.0 * radius,
+                    2.0 * radius,
+                    2.0 * half_height,
+                ))),
                 bottom_scale: 1.0,
                 top_scale: 1.0,
                 color,

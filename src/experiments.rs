@@ -1,1 +1,0 @@
-pub fn run(_a: &crate::cli::ExperimentArgs, _s: &std::sync::atomic::AtomicBool) -> anyhow::Result<std::process::ExitCode> { todo!() }

@@ -1,0 +1,128 @@
+//! Metrics of one run, measured while it steps.
+
+use serde::{Deserialize, Serialize};
+
+use crate::sim::{FrameStats, Simulation};
+
+/// A quantity reported per run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// Drop of the lowest particle from its rest height at the end (m).
+    Sag,
+    /// Largest |C| over all frames (m).
+    StretchErrorMax,
+    /// Largest per-frame RMS |C| over all frames (m).
+    StretchErrorRms,
+    /// Largest |C| at the last frame (m).
+    FinalStretchError,
+    /// Kinetic energy at the last frame (J).
+    KineticEnergy,
+    /// Wall-clock milliseconds per frame (not deterministic).
+    MsPerFrame,
+    /// Constraint sweeps per frame: substeps × iterations.
+    Cost,
+    /// Frames simulated.
+    Frames,
+}
+
+impl Metric {
+    /// Name as written in files and table headers.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Sag => "sag",
+            Metric::StretchErrorMax => "stretch_error_max",
+            Metric::StretchErrorRms => "stretch_error_rms",
+            Metric::FinalStretchError => "final_stretch_error",
+            Metric::KineticEnergy => "kinetic_energy",
+            Metric::MsPerFrame => "ms_per_frame",
+            Metric::Cost => "cost",
+            Metric::Frames => "frames",
+        }
+    }
+
+    /// Unit for axis labels.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Metric::Sag | Metric::StretchErrorMax | Metric::StretchErrorRms => "m",
+            Metric::FinalStretchError => "m",
+            Metric::KineticEnergy => "J",
+            Metric::MsPerFrame => "ms",
+            Metric::Cost => "sweeps/frame",
+            Metric::Frames => "frames",
+        }
+    }
+
+    /// Every metric.
+    pub const ALL: [Metric; 8] = [
+        Metric::Sag,
+        Metric::StretchErrorMax,
+        Metric::StretchErrorRms,
+        Metric::FinalStretchError,
+        Metric::KineticEnergy,
+        Metric::MsPerFrame,
+        Metric::Cost,
+        Metric::Frames,
+    ];
+
+    /// The metric called `name`.
+    pub fn from_name(name: &str) -> Option<Metric> {
+        Metric::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
+/// Accumulates a run's metrics frame by frame.
+#[derive(Clone, Debug, Default)]
+pub struct Meter {
+    rest_lowest: f64,
+    worst_max: f64,
+    worst_rms: f64,
+    last: FrameStats,
+    wall_ms: f64,
+}
+
+fn lowest(sim: &Simulation) -> f64 {
+    (0..sim.scene.cloths.len())
+        .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y))
+        .fold(f64::INFINITY, f64::min)
+}
+
+impl Meter {
+    /// Starts at the initial state.
+    pub fn new(sim: &Simulation) -> Self {
+        Self {
+            rest_lowest: lowest(sim),
+            ..Self::default()
+        }
+    }
+
+    /// Records one stepped frame.
+    pub fn frame(&mut self, stats: &FrameStats) {
+        self.worst_max = self.worst_max.max(stats.residual_max);
+        self.worst_rms = self.worst_rms.max(stats.residual_rms);
+        self.wall_ms += stats.step_ms;
+        self.last = *stats;
+    }
+
+    /// Every metric of the run so far.
+    pub fn values(&self, sim: &Simulation) -> Vec<(Metric, f64)> {
+        let s = sim.scene.settings;
+        let frames = self.last.frame;
+        Metric::ALL
+            .into_iter()
+            .map(|m| {
+                let v = match m {
+                    Metric::Sag => self.rest_lowest - lowest(sim),
+                    Metric::StretchErrorMax => self.worst_max,
+                    Metric::StretchErrorRms => self.worst_rms,
+                    Metric::FinalStretchError => self.last.residual_max,
+                    Metric::KineticEnergy => self.last.kinetic_energy,
+                    Metric::MsPerFrame => self.wall_ms / frames.max(1) as f64,
+                    Metric::Cost => f64::from(s.substeps * s.iterations),
+                    Metric::Frames => frames as f64,
+                };
+                (m, v)
+            })
+            .collect()
+    }
+}

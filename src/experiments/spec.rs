@@ -1,0 +1,238 @@
+//! The experiments file: a base scene, series of runs (a sweep is the cartesian product of
+//! its `vary` lists), metrics and plots; expanded into a numbered queue of runs.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use serde::Deserialize;
+use serde_json::Value;
+use weft_scene::Override;
+
+use crate::experiments::metrics::Metric;
+
+/// An experiments file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Spec {
+    /// Title of the report.
+    #[serde(default)]
+    pub title: String,
+    /// Base scene, relative to the experiments file.
+    pub scene: String,
+    /// Simulated seconds per run (frames = round(duration / dt)); or give `frames`.
+    #[serde(default)]
+    pub duration: Option<f64>,
+    /// Frames per run.
+    #[serde(default)]
+    pub frames: Option<u64>,
+    /// Overrides applied to every run.
+    #[serde(default)]
+    pub set: BTreeMap<String, Value>,
+    /// Metrics in the summary table.
+    pub metrics: Vec<Metric>,
+    /// The series of runs.
+    pub series: Vec<Series>,
+    /// Plots.
+    #[serde(default)]
+    pub plot: Vec<PlotSpec>,
+}
+
+/// A series: fixed overrides plus a sweep.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Series {
+    /// Legend name.
+    pub name: String,
+    /// Overrides of this series.
+    #[serde(default)]
+    pub set: BTreeMap<String, Value>,
+    /// Keys to sweep and their values; every combination is one run.
+    #[serde(default)]
+    pub vary: BTreeMap<String, Vec<Value>>,
+}
+
+/// A plot of a metric against a swept key or another metric.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlotSpec {
+    /// Output file name (PNG), in the output directory.
+    pub file: String,
+    /// A swept key (e.g. `sim.dt`) or a metric name (e.g. `cost`).
+    pub x: String,
+    /// A metric.
+    pub y: Metric,
+    /// Title.
+    #[serde(default)]
+    pub title: String,
+    /// Axis labels (default: the names).
+    #[serde(default)]
+    pub x_label: Option<String>,
+    /// Axis labels (default: the names).
+    #[serde(default)]
+    pub y_label: Option<String>,
+    /// Logarithmic x axis.
+    #[serde(default)]
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    #[serde(default)]
+    pub log_y: bool,
+    /// Legend corner: `upper-left`, `upper-right` (default), `lower-left`, `lower-right`.
+    #[serde(default)]
+    pub legend: Option<String>,
+}
+
+/// One run of the queue.
+#[derive(Clone, Debug)]
+pub struct PlannedRun {
+    /// Position in the whole queue (stable across shards).
+    pub index: usize,
+    /// Its series' name.
+    pub series: String,
+    /// `key=value` of the swept keys.
+    pub label: String,
+    /// Every override, common ones first.
+    pub overrides: Vec<Override>,
+    /// Swept keys and their numeric values (fractions such as "1/60" evaluated).
+    pub x: BTreeMap<String, f64>,
+}
+
+/// A JSON value written as TOML text for an override.
+pub fn toml_text(v: &Value) -> String {
+    match v {
+        Value::String(s) => Value::String(s.clone()).to_string(),
+        Value::Array(a) => format!(
+            "[{}]",
+            a.iter().map(toml_text).collect::<Vec<_>>().join(", ")
+        ),
+        Value::Object(o) => format!(
+            "{{ {} }}",
+            o.iter()
+                .map(|(k, v)| format!("{k} = {}", toml_text(v)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        other => other.to_string(),
+    }
+}
+
+/// A number, or a fraction string such as "1/60".
+pub fn numeric(v: &Value) -> Option<f64> {
+    match v {
+        Value::Number(n) => n.as_f64(),
+        Value::String(s) => match s.split_once('/') {
+            Some((a, b)) => Some(a.trim().parse::<f64>().ok()? / b.trim().parse::<f64>().ok()?),
+            None => s.trim().parse().ok(),
+        },
+        Value::Bool(b) => Some(f64::from(u8::from(*b))),
+        _ => None,
+    }
+}
+
+fn plain(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+impl Spec {
+    /// Reads an experiments file.
+    pub fn load(path: &Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let spec: Spec = toml_edit::de::from_str(&text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            anyhow::anyhow!(
+                "{}:{}: {}",
+                path.display(),
+                line.map(|l| l.to_string()).unwrap_or_default(),
+                e.message().trim()
+            )
+        })?;
+        if spec.series.is_empty() {
+            bail!("{}: no [[series]]", path.display());
+        }
+        if spec.duration.is_some() == spec.frames.is_some() {
+            bail!(
+                "{}: give exactly one of `duration` and `frames`",
+                path.display()
+            );
+        }
+        if let Some(d) = spec.duration
+            && !(d.is_finite() && d > 0.0)
+        {
+            bail!(
+                "{}: duration must be finite and > 0, got {d}",
+                path.display()
+            );
+        }
+        Ok(spec)
+    }
+
+    /// The base scene's path.
+    pub fn scene_path(&self, experiments_file: &Path) -> PathBuf {
+        weft_scene::Scene::dir_of(experiments_file).join(&self.scene)
+    }
+
+    /// Every run, in queue order.
+    pub fn expand(&self) -> anyhow::Result<Vec<PlannedRun>> {
+        let ov = |k: &str, v: &Value| -> anyhow::Result<Override> {
+            Ok(format!("{k}={}", toml_text(v)).parse::<Override>()?)
+        };
+        let mut runs = Vec::new();
+        for s in &self.series {
+            let mut combos: Vec<Vec<(&String, &Value)>> = vec![vec![]];
+            for (k, values) in &s.vary {
+                if values.is_empty() {
+                    bail!("series `{}`: vary.{k} is empty", s.name);
+                }
+                combos = combos
+                    .into_iter()
+                    .flat_map(|c| {
+                        values.iter().map(move |v| {
+                            let mut c = c.clone();
+                            c.push((k, v));
+                            c
+                        })
+                    })
+                    .collect();
+            }
+            for combo in combos {
+                let mut overrides = Vec::new();
+                for (k, v) in self.set.iter().chain(&s.set) {
+                    overrides.push(ov(k, v)?);
+                }
+                let mut x = BTreeMap::new();
+                let mut label = Vec::new();
+                for (k, v) in combo {
+                    overrides.push(ov(k, v)?);
+                    if let Some(n) = numeric(v) {
+                        x.insert(k.clone(), n);
+                    }
+                    label.push(format!("{k}={}", plain(v)));
+                }
+                runs.push(PlannedRun {
+                    index: runs.len(),
+                    series: s.name.clone(),
+                    label: label.join(" "),
+                    overrides,
+                    x,
+                });
+            }
+        }
+        Ok(runs)
+    }
+}
+
+/// Parses `K/N` (K in 0..N).
+pub fn parse_shard(s: &str) -> anyhow::Result<(usize, usize)> {
+    let (k, n) = s.split_once('/').context("--shard takes K/N, e.g. 0/4")?;
+    let (k, n): (usize, usize) = (k.trim().parse()?, n.trim().parse()?);
+    if n == 0 || k >= n {
+        bail!("--shard {s}: need N >= 1 and K in 0..N");
+    }
+    Ok((k, n))
+}
