@@ -58,7 +58,8 @@ pub struct FamilyParams {
     pub enabled: bool,
     /// XPBD compliance α (inverse stiffness); 0 is infinitely stiff.
     pub compliance: f64,
-    /// XPBD constraint damping β (s), the damping term of Macklin et al. 2016, eq. (26).
+    /// XPBD constraint damping β: the Rayleigh damping coefficient of Macklin et al. 2016,
+    /// eq. (26), a force −β Ċ ∇C (N·s/m for distance families, N·m·s/rad for the dihedral).
     pub damping: f64,
     /// PBD stiffness k in [0, 1], applied to each projection (Müller et al. 2007, §3.3).
     pub pbd_stiffness: f64,
