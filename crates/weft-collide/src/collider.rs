@@ -183,10 +183,14 @@ impl Collider {
 
     /// How far the material point of the collider now at `point` moved during this substep.
     pub fn displacement_at(&self, point: Vec3) -> Vec3 {
-        point
-            - self
-                .prev_pose
-                .transform_point(self.pose.inverse_transform_point(point))
+        if self.pose == self.prev_pose {
+            // Exactly zero: a round trip through the inverse pose would leave a rounding error
+            // that is the same every substep, which friction would read as a slowly moving
+            // surface and follow.
+            return Vec3::ZERO;
+        }
+        let local = self.pose.inverse_transform_point(point);
+        self.pose.transform_point(local) - self.prev_pose.transform_point(local)
     }
 
     /// First hit of the segment `from → to` with the surface: `(fraction, normal facing from)`.
