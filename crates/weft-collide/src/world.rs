@@ -222,11 +222,14 @@ impl SubstepHook for CollisionWorld {
         if std::mem::take(&mut self.fresh) {
             self.prepare(particles);
         }
-        let collider_contacts = self.resolve_colliders(particles);
+        // Particle pairs first, colliders last: a stack of layers pressed together must not
+        // end the substep pushed into the ground, while a slight overlap between layers is
+        // harmless and corrected next time.
         let (self_contacts, self_depth) = self
             .self_collision
             .as_ref()
             .map_or((0, 0.0), |sc| sc.solve(particles));
+        let collider_contacts = self.resolve_colliders(particles);
         self.stats.collider_contacts = collider_contacts;
         self.stats.self_contacts = self_contacts;
         self.stats.max_self_depth = self.stats.max_self_depth.max(self_depth);
