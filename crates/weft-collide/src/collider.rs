@@ -240,8 +240,14 @@ fn local_closest(shape: &dyn Shape, p: Vec3, max_dist: f32) -> Option<(Vec3, Vec
     // solid = false: a point inside is projected onto the boundary (with is_inside set),
     // rather than onto itself.
     let proj = shape.project_local_point(p, false);
-    let fallback = (p - shape.compute_local_aabb().center()).normalize_or(Vec3::Y);
-    let hit = signed(p, &proj, fallback);
+    let delta = p - proj.point;
+    let hit = if delta.length_squared() > 1e-18 {
+        signed(p, &proj, Vec3::Y)
+    } else {
+        // Exactly on the surface: push away from the shape's middle.
+        let fallback = (p - shape.compute_local_aabb().center()).normalize_or(Vec3::Y);
+        signed(p, &proj, fallback)
+    };
     (hit.2 <= max_dist).then_some(hit)
 }
 

@@ -63,8 +63,8 @@ impl SpatialHash {
         }
     }
 
-    /// Appends to `out` every item whose cell overlaps the cube of half-size `radius` around
-    /// `p` (a superset of the items within `radius`; sorted and without repeats).
+    /// Writes to `out` every item whose cell overlaps the cube of half-size `radius` around
+    /// `p` (a superset of the items within `radius`), each once, in a fixed order.
     pub fn query(&self, p: Vec3, radius: f32, out: &mut Vec<u32>) {
         out.clear();
         if self.cell_entries.is_empty() {
@@ -72,18 +72,32 @@ impl SpatialHash {
         }
         let lo = self.cell(p - Vec3::splat(radius));
         let hi = self.cell(p + Vec3::splat(radius));
+        // Two cells in range may hash to one bucket: visit each bucket once.
+        let mut seen = [usize::MAX; 64];
+        let mut count = 0;
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
                     let b = self.bucket([x, y, z]);
+                    if seen[..count.min(64)].contains(&b) {
+                        continue;
+                    }
+                    if count < 64 {
+                        seen[count] = b;
+                    } else {
+                        // A huge radius against the spacing: fall back to sorting below.
+                        count = usize::MAX;
+                    }
+                    count = count.saturating_add(1);
                     let (s, e) = (self.cell_start[b], self.cell_start[b + 1]);
                     out.extend_from_slice(&self.cell_entries[s as usize..e as usize]);
                 }
             }
         }
-        // Two cells may share a bucket: sort and dedup so each item is reported once.
-        out.sort_unstable();
-        out.dedup();
+        if count == usize::MAX {
+            out.sort_unstable();
+            out.dedup();
+        }
     }
 }
 
@@ -105,9 +119,13 @@ mod tests {
         let mut out = Vec::new();
         for (i, p) in positions.iter().enumerate() {
             hash.query(*p, 0.05, &mut out);
+            let mut sorted = out.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            assert_eq!(sorted.len(), out.len(), "repeats for {i}");
             for (j, q) in positions.iter().enumerate() {
                 if p.distance(*q) <= 0.05 {
-                    assert!(out.binary_search(&(j as u32)).is_ok(), "{i} misses {j}");
+                    assert!(sorted.binary_search(&(j as u32)).is_ok(), "{i} misses {j}");
                 }
             }
         }
