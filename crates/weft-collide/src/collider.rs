@@ -265,3 +265,98 @@ fn signed(p: Vec3, proj: &PointProjection, fallback: Vec3) -> (Vec3, Vec3, f32) 
         (proj.point, delta / len, len)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriangleMesh;
+    use crate::shape::CompoundPart;
+
+    fn at(shape: ShapeDesc, position: Vec3) -> Collider {
+        Collider::new(&ColliderDesc::new(shape).at(position)).expect("valid collider")
+    }
+
+    /// Signed distance and normal of a point outside and a point inside, per shape.
+    #[test]
+    fn signed_distance_and_normal_for_every_shape() {
+        let cube_points: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+            .map(|v| v * 2.0 - Vec3::ONE)
+            .collect();
+        // The same cube as a closed triangle mesh (vertex i has coordinates from its bits).
+        let cube = TriangleMesh::new(
+            cube_points.clone(),
+            vec![
+                [0, 4, 6],
+                [0, 6, 2],
+                [1, 3, 7],
+                [1, 7, 5],
+                [0, 1, 5],
+                [0, 5, 4],
+                [2, 6, 7],
+                [2, 7, 3],
+                [0, 2, 3],
+                [0, 3, 1],
+                [4, 5, 7],
+                [4, 7, 6],
+            ],
+        )
+        .expect("cube mesh");
+        let up = Vec3::Y * 10.0;
+        let shapes = [
+            ShapeDesc::Sphere { radius: 1.0 },
+            ShapeDesc::Cuboid {
+                half_extents: Vec3::ONE,
+            },
+            ShapeDesc::Capsule {
+                half_height: 0.5,
+                radius: 0.5,
+            },
+            ShapeDesc::HalfSpace { normal: Vec3::Y },
+            ShapeDesc::ConvexHull {
+                points: cube_points,
+            },
+            ShapeDesc::Compound(vec![
+                CompoundPart::at(Vec3::new(0.0, 0.5, 0.0), ShapeDesc::Sphere { radius: 0.5 }),
+                CompoundPart::at(
+                    Vec3::new(0.0, -2.0, 0.0),
+                    ShapeDesc::Cuboid {
+                        half_extents: Vec3::splat(0.5),
+                    },
+                ),
+            ]),
+            ShapeDesc::TriMesh(cube),
+        ];
+        for shape in shapes {
+            let kind = shape.kind();
+            // The half-space's surface passes through its origin: lift it to match the others.
+            let lift = if kind == "half-space" {
+                Vec3::Y
+            } else {
+                Vec3::ZERO
+            };
+            let c = at(shape, up + lift);
+            // Top surface of every shape is at y = 1 (local) → 11 (world).
+            let above = c
+                .closest(up + Vec3::new(0.0, 1.3, 0.0), 1.0)
+                .unwrap_or_else(|| panic!("{kind}: nothing near"));
+            assert!((above.distance - 0.3).abs() < 1e-4, "{kind}: {above:?}");
+            assert!(
+                (above.normal - Vec3::Y).length() < 1e-4,
+                "{kind}: {above:?}"
+            );
+            let inside = c
+                .closest(up + Vec3::new(0.0, 0.9, 0.0), 1.0)
+                .expect("inside");
+            assert!((inside.distance + 0.1).abs() < 1e-4, "{kind}: {inside:?}");
+            assert!(
+                (inside.normal - Vec3::Y).length() < 1e-4,
+                "{kind}: {inside:?}"
+            );
+            assert!(
+                (inside.point - (up + Vec3::Y)).length() < 1e-4,
+                "{kind}: {inside:?}"
+            );
+        }
+    }
+}
