@@ -28,7 +28,7 @@ impl Particles {
         self.positions.is_empty()
     }
 
-    /// Appends a particle at rest with the given mass (`f64::INFINITY` or 0 inverse mass pins it).
+    /// Appends a particle at rest with the given inverse mass (0 pins it).
     pub fn push(&mut self, position: DVec3, inv_mass: f64) {
         self.positions.push(position);
         self.prev_positions.push(position);

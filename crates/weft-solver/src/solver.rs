@@ -153,11 +153,24 @@ impl Solver {
         Ok(())
     }
 
-    /// The family parameters of cloth `cloth`.
-    pub fn cloth_params(&self, cloth: usize) -> ClothParams {
+    /// The family parameters of cloth `cloth`, if it exists.
+    pub fn cloth_params(&self, cloth: usize) -> Option<ClothParams> {
         let base = cloth * Family::COUNT;
-        ClothParams {
-            families: std::array::from_fn(|f| self.params[base + f]),
+        let p = self.params.get(base..base + Family::COUNT)?;
+        Some(ClothParams {
+            families: std::array::from_fn(|f| p[f]),
+        })
+    }
+
+    fn check_cloth(&self, cloth: usize) -> Result<(), ParamError> {
+        if cloth < self.cloths.len() {
+            Ok(())
+        } else {
+            Err(ParamError {
+                name: "cloth".into(),
+                value: cloth as f64,
+                expected: "an existing cloth index",
+            })
         }
     }
 
@@ -167,6 +180,7 @@ impl Solver {
         cloth: usize,
         params: ClothParams,
     ) -> Result<(), ParamError> {
+        self.check_cloth(cloth)?;
         params.validate()?;
         let base = cloth * Family::COUNT;
         self.params[base..base + Family::COUNT].copy_from_slice(&params.families);
@@ -175,6 +189,7 @@ impl Solver {
 
     /// Changes the thickness of cloth `cloth`.
     pub fn set_thickness(&mut self, cloth: usize, thickness: f64) -> Result<(), ParamError> {
+        self.check_cloth(cloth)?;
         if !(thickness.is_finite() && thickness >= 0.0) {
             return Err(ParamError {
                 name: "thickness".into(),

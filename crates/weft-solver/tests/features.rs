@@ -273,6 +273,13 @@ fn invalid_parameters_are_rejected_with_their_name() {
         .expect_err("negative dt");
     assert_eq!(e.name, "dt");
     assert!(s.set_thickness(0, f64::INFINITY).is_err());
+    assert_eq!(
+        s.set_thickness(7, 0.01).expect_err("no cloth 7").name,
+        "cloth"
+    );
+    assert!(s.set_cloth_params(1, ClothParams::default()).is_err());
+    assert!(s.cloth_params(1).is_none());
+    assert_eq!(s.cloth_params(0), Some(ClothParams::default()));
     let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("valid");
     assert!(
         b.add_cloth("x", &hanging_grid(4), ClothParams::default(), -0.1)

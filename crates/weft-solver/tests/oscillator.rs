@@ -13,30 +13,33 @@ const ALPHA: f64 = 1e-3;
 
 /// Period (s) from the first upward zero crossings of the extension, sampled every substep.
 fn period(method: Method, h: f64, iterations: u32, pbd_stiffness: f64) -> f64 {
+    trace(method, h, iterations, pbd_stiffness, 0.0).0
+}
+
+/// (period, amplitude of the extension after 1 s) with XPBD constraint damping β.
+fn trace(method: Method, h: f64, iterations: u32, pbd_stiffness: f64, beta: f64) -> (f64, f64) {
     // Rest length 1 (taken from the built positions), then released from 1.5.
     let mesh = chain(&[DVec3::ZERO, DVec3::X], &[1.0, 1.0], &[0]);
     let forces = Forces {
         gravity: DVec3::ZERO,
         ..Forces::default()
     };
-    let mut s = solver(
-        settings(method, h, 1, iterations),
-        forces,
-        &mesh,
-        in_plane(ALPHA, pbd_stiffness, 0.0),
-    );
+    let params = in_plane(ALPHA, pbd_stiffness, 0.0)
+        .edit(weft_solver::Family::Stretch, |p| p.damping = beta);
+    let mut s = solver(settings(method, h, 1, iterations), forces, &mesh, params);
     s.particles_mut().positions[1] = DVec3::new(1.5, 0.0, 0.0);
     let mut crossings = Vec::new();
     let mut last = 0.5f64;
-    for k in 1..=(4.0 / h) as usize {
+    let mut late_amplitude = 0.0f64;
+    for k in 1..=(1.2 / h) as usize {
         s.step().expect("bounded");
         let e = s.particles().positions[1].length() - 1.0;
-        if last < 0.0 && e >= 0.0 {
+        if last < 0.0 && e >= 0.0 && crossings.len() < 3 {
             let frac = last / (last - e);
             crossings.push((k as f64 - 1.0 + frac) * h);
         }
-        if crossings.len() == 3 {
-            break;
+        if k as f64 * h > 1.0 {
+            late_amplitude = late_amplitude.max(e.abs());
         }
         last = e;
     }
@@ -44,7 +47,8 @@ fn period(method: Method, h: f64, iterations: u32, pbd_stiffness: f64) -> f64 {
         crossings.len() >= 2,
         "{method} h={h}: no oscillation seen ({crossings:?})"
     );
-    (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64
+    let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    (period, late_amplitude)
 }
 
 #[test]
@@ -105,4 +109,22 @@ fn pbd_period_depends_on_step_and_iterations() {
     for pair in periods.chunks(3) {
         assert!(pair[0] > pair[1] && pair[1] > pair[2], "{pair:?}");
     }
+}
+
+#[test]
+fn xpbd_constraint_damping_damps_without_changing_the_period_much() {
+    let h = 1.0 / 960.0;
+    let omega = 1.0 / ALPHA.sqrt();
+    let (t0, a0) = trace(Method::Xpbd, h, 1, 1.0, 0.0);
+    // β = 2 N·s/m on m = 1 kg: damping ratio ζ = β / (2 m ω) ≈ 0.032, decay rate ζω = 1 /s.
+    let (t1, a1) = trace(Method::Xpbd, h, 1, 1.0, 2.0);
+    // Undamped, implicit Euler still loses (1 + (hω)²)^(−1/2) of the amplitude per step.
+    let predicted = 0.5 * (1.0 + (h * omega).powi(2)).powf(-0.5 / h);
+    println!(
+        "XPBD h=1/960: undamped period {t0:.5} s, amplitude after 1 s {a0:.4} m (implicit Euler predicts {predicted:.4}); β = 2 N·s/m: {t1:.5} s, {a1:.4} m (ratio {:.3}, e^-1 = 0.368)",
+        a1 / a0
+    );
+    assert!((a0 / predicted - 1.0).abs() < 0.05, "{a0} vs {predicted}");
+    assert!((a1 / a0 - (-1.0f64).exp()).abs() < 0.06, "{a1} vs {a0}");
+    assert!((t1 / t0 - 1.0).abs() < 0.01, "period {t1} vs {t0}");
 }

@@ -78,3 +78,27 @@ fn soft_mass_spring_at_small_steps_is_stable_and_sags() {
     let low = lowest_y(&s);
     assert!(low < -0.5 && low > -1.5, "lowest point {low}");
 }
+
+#[test]
+fn a_nan_is_reported_with_its_particle_not_propagated() {
+    let mut s = solver(
+        settings(Method::Xpbd, DT, 4, 1),
+        Forces::default(),
+        &hanging_grid(8),
+        in_plane(0.0, 1.0, 0.0),
+    );
+    run(&mut s, 5);
+    s.particles_mut().velocities[37].y = f64::NAN;
+    match s.step() {
+        Err(SolverError::Diverged {
+            method: Method::Xpbd,
+            frame: 5,
+            particle,
+            ..
+        }) => {
+            // The NaN reaches 37's constraint neighbours within the frame; the first is reported.
+            assert!(particle <= 37, "particle {particle}");
+        }
+        other => panic!("expected divergence at frame 5, got {other:?}"),
+    }
+}

@@ -127,7 +127,7 @@ fn correction<const N: usize, S: Shape<N>>(
     let w_grad2: f64 = (0..N).map(|k| wi[k] * grad[k].length_squared()).sum();
     let dl = match rule {
         Rule::Xpbd { h } => {
-            // α̃ = α/h², γ = α̃ β̃ / h with β̃ = h² β  (Macklin et al. 2016, eq. 26).
+            // α̃ = α/h², γ = α̃ β̃ / h = α β / h with β̃ = h² β  (Macklin et al. 2016, eq. 26).
             let alpha = p.compliance / (h * h);
             let gamma = p.compliance * p.damping / h;
             let grad_dx: f64 = if gamma > 0.0 {

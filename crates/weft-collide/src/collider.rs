@@ -1,0 +1,368 @@
+//! Colliders: a parry shape with a pose that follows a prescribed motion, and friction.
+
+use glam::{DVec3, Quat, Vec3};
+use parry3d::bounding_volume::Aabb;
+use parry3d::math::Pose;
+use parry3d::query::{PointProjection, PointQuery, PointQueryWithLocation, Ray};
+use parry3d::shape::{Shape, SharedShape};
+use weft_solver::Motion;
+
+use crate::convert::{compose, pose};
+use crate::error::ShapeError;
+use crate::friction::Friction;
+use crate::shape::ShapeDesc;
+
+/// How to build a collider: shape, placement at t = 0, motion and friction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColliderDesc {
+    /// The geometry, in the collider's frame.
+    pub shape: ShapeDesc,
+    /// Position of the collider's frame at rest (m).
+    pub position: Vec3,
+    /// Orientation of the collider's frame at rest.
+    pub rotation: Quat,
+    /// Prescribed motion applied to the rest placement ([`Motion::Static`] for a fixed collider).
+    pub motion: Motion,
+    /// Coulomb friction against cloth particles.
+    pub friction: Friction,
+}
+
+impl ColliderDesc {
+    /// A static collider at the origin with default friction.
+    pub fn new(shape: ShapeDesc) -> Self {
+        Self {
+            shape,
+            position: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            motion: Motion::Static,
+            friction: Friction::default(),
+        }
+    }
+
+    /// Builder-style: sets the rest position.
+    pub fn at(mut self, position: Vec3) -> Self {
+        self.position = position;
+        self
+    }
+
+    /// Builder-style: sets the rest orientation.
+    pub fn rotated(mut self, rotation: Quat) -> Self {
+        self.rotation = rotation;
+        self
+    }
+
+    /// Builder-style: makes the collider kinematic with `motion`.
+    pub fn moving(mut self, motion: Motion) -> Self {
+        self.motion = motion;
+        self
+    }
+
+    /// Builder-style: sets the friction.
+    pub fn with_friction(mut self, friction: Friction) -> Self {
+        self.friction = friction;
+        self
+    }
+}
+
+/// The closest surface point of a collider to a particle, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// Closest point on the surface (m).
+    pub point: DVec3,
+    /// Outward unit normal there.
+    pub normal: DVec3,
+    /// Signed distance of the particle from the surface, negative inside (m).
+    pub distance: f64,
+}
+
+/// A built collider: parry shape, rest pose, motion, friction and the current pose.
+#[derive(Clone)]
+pub struct Collider {
+    shape: SharedShape,
+    kind: &'static str,
+    rest: Pose,
+    motion: Motion,
+    friction: Friction,
+    pose: Pose,
+    prev_pose: Pose,
+    /// Local AABB; `None` for unbounded shapes (half-spaces).
+    local_aabb: Option<Aabb>,
+}
+
+impl std::fmt::Debug for Collider {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Collider")
+            .field("kind", &self.kind)
+            .field("pose", &self.pose)
+            .field("motion", &self.motion)
+            .field("friction", &self.friction)
+            .finish()
+    }
+}
+
+impl Collider {
+    /// Validates and builds a collider.
+    pub fn new(desc: &ColliderDesc) -> Result<Self, ShapeError> {
+        desc.friction.validate()?;
+        if !(desc.position.is_finite() && desc.rotation.is_finite()) {
+            return Err(ShapeError::InvalidParameter {
+                name: "collider.position",
+                value: f64::NAN,
+                expected: "finite position and rotation",
+            });
+        }
+        let shape = desc.shape.build()?;
+        let local_aabb = match desc.shape {
+            ShapeDesc::HalfSpace { .. } => None,
+            _ => Some(shape.compute_local_aabb()),
+        };
+        let rest = pose(desc.position, desc.rotation.normalize());
+        let start = compose(desc.motion.transform(0.0), &rest);
+        Ok(Self {
+            shape,
+            kind: desc.shape.kind(),
+            rest,
+            motion: desc.motion,
+            friction: desc.friction,
+            pose: start,
+            prev_pose: start,
+            local_aabb,
+        })
+    }
+
+    /// The parry shape.
+    pub fn shape(&self) -> &SharedShape {
+        &self.shape
+    }
+
+    /// The kind of shape (`"sphere"`, `"triangle mesh"`, …).
+    pub fn kind(&self) -> &'static str {
+        self.kind
+    }
+
+    /// The current pose (at the end of the current substep).
+    pub fn pose(&self) -> &Pose {
+        &self.pose
+    }
+
+    /// The prescribed motion.
+    pub fn motion(&self) -> Motion {
+        self.motion
+    }
+
+    /// The friction coefficients.
+    pub fn friction(&self) -> Friction {
+        self.friction
+    }
+
+    /// Moves the collider to its poses at the start (`t0`) and end (`t1`) of a substep (s).
+    pub fn set_time(&mut self, t0: f64, t1: f64) {
+        self.prev_pose = compose(self.motion.transform(t0), &self.rest);
+        self.pose = compose(self.motion.transform(t1), &self.rest);
+    }
+
+    /// World AABB at the current pose grown by `margin`, or `None` if unbounded.
+    pub fn world_aabb(&self, margin: f32) -> Option<Aabb> {
+        self.local_aabb.map(|a| {
+            let w = a.transform_by(&self.pose);
+            Aabb::new(w.mins - Vec3::splat(margin), w.maxs + Vec3::splat(margin))
+        })
+    }
+
+    /// The closest surface point to `x` if it lies within `max_dist` of the surface or `x` is
+    /// inside (for meshes: within `max_dist` on either side).
+    ///
+    /// Particles are f64; parry works in f32, so the query point is rounded to f32 here and
+    /// the answer widened back (a ~1e-7 m error on the surface point, none on the state).
+    pub fn closest(&self, x: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        let local = self.pose.inverse_transform_point(x.as_vec3());
+        let (q, n, d) = local_closest(self.shape.as_ref(), local, max_dist as f32)?;
+        Some(SurfacePoint {
+            point: self.pose.transform_point(q).as_dvec3(),
+            normal: (self.pose.rotation * n).as_dvec3().normalize_or_zero(),
+            distance: f64::from(d),
+        })
+    }
+
+    /// How far the material point of the collider now at `point` moved during this substep.
+    pub fn displacement_at(&self, point: DVec3) -> DVec3 {
+        if self.pose == self.prev_pose {
+            // Exactly zero: a round trip through the inverse pose would leave a rounding error
+            // that is the same every substep, which friction would read as a slowly moving
+            // surface and follow.
+            return DVec3::ZERO;
+        }
+        let local = self.pose.inverse_transform_point(point.as_vec3());
+        (self.pose.transform_point(local) - self.prev_pose.transform_point(local)).as_dvec3()
+    }
+
+    /// First hit of the segment `from → to` with the surface: `(fraction, normal facing from)`.
+    pub fn sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
+        let a = self.pose.inverse_transform_point(from.as_vec3());
+        let b = self.pose.inverse_transform_point(to.as_vec3());
+        let ray = Ray::new(a, b - a);
+        let hit = self.shape.cast_local_ray_and_get_normal(&ray, 1.0, false)?;
+        let mut n = hit.normal;
+        if n.dot(b - a) > 0.0 {
+            n = -n;
+        }
+        Some((
+            f64::from(hit.time_of_impact),
+            (self.pose.rotation * n).as_dvec3().normalize_or_zero(),
+        ))
+    }
+}
+
+/// Signed closest-point query in the shape's frame: `(point, outward normal, signed distance)`.
+fn local_closest(shape: &dyn Shape, p: Vec3, max_dist: f32) -> Option<(Vec3, Vec3, f32)> {
+    if let Some(mesh) = shape.as_trimesh() {
+        // BVH-pruned: only triangles within max_dist are visited. With pseudo-normals
+        // (TriMeshFlags::ORIENTED) `is_inside` says which side of the surface `p` is on.
+        let (proj, (tri, _)) =
+            mesh.project_local_point_and_get_location_with_max_dist(p, false, max_dist)?;
+        let face = mesh.triangle(tri).normal().unwrap_or(Vec3::Y);
+        return Some(signed(p, &proj, face));
+    }
+    if let Some(compound) = shape.as_compound() {
+        // The deepest part wins; the caller re-queries after resolving it.
+        let mut best: Option<(Vec3, Vec3, f32)> = None;
+        for ((part_pose, part), aabb) in compound.shapes().iter().zip(compound.aabbs()) {
+            if aabb.distance_to_local_point(p, true) > max_dist {
+                continue;
+            }
+            let lp = part_pose.inverse_transform_point(p);
+            if let Some((q, n, d)) = local_closest(part.as_ref(), lp, max_dist)
+                && best.is_none_or(|b| d < b.2)
+            {
+                best = Some((part_pose.transform_point(q), part_pose.rotation * n, d));
+            }
+        }
+        return best;
+    }
+    if let Some(h) = shape.as_halfspace() {
+        let d = h.normal.dot(p);
+        return (d <= max_dist).then_some((p - h.normal * d, h.normal, d));
+    }
+    // solid = false: a point inside is projected onto the boundary (with is_inside set),
+    // rather than onto itself.
+    let proj = shape.project_local_point(p, false);
+    let delta = p - proj.point;
+    let hit = if delta.length_squared() > 1e-18 {
+        signed(p, &proj, Vec3::Y)
+    } else {
+        // Exactly on the surface: push away from the shape's middle.
+        let fallback = (p - shape.compute_local_aabb().center()).normalize_or(Vec3::Y);
+        signed(p, &proj, fallback)
+    };
+    (hit.2 <= max_dist).then_some(hit)
+}
+
+/// Turns a projection into (point, outward normal, signed distance); `fallback` is the normal
+/// when `p` lies exactly on the surface.
+fn signed(p: Vec3, proj: &PointProjection, fallback: Vec3) -> (Vec3, Vec3, f32) {
+    let delta = p - proj.point;
+    let len = delta.length();
+    if len <= 1e-9 {
+        return (proj.point, fallback, 0.0);
+    }
+    if proj.is_inside {
+        (proj.point, -delta / len, -len)
+    } else {
+        (proj.point, delta / len, len)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriangleMesh;
+    use crate::shape::CompoundPart;
+
+    fn at(shape: ShapeDesc, position: Vec3) -> Collider {
+        Collider::new(&ColliderDesc::new(shape).at(position)).expect("valid collider")
+    }
+
+    /// Signed distance and normal of a point outside and a point inside, per shape.
+    #[test]
+    fn signed_distance_and_normal_for_every_shape() {
+        let cube_points: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+            .map(|v| v * 2.0 - Vec3::ONE)
+            .collect();
+        // The same cube as a closed triangle mesh (vertex i has coordinates from its bits).
+        let cube = TriangleMesh::new(
+            cube_points.clone(),
+            vec![
+                [0, 4, 6],
+                [0, 6, 2],
+                [1, 3, 7],
+                [1, 7, 5],
+                [0, 1, 5],
+                [0, 5, 4],
+                [2, 6, 7],
+                [2, 7, 3],
+                [0, 2, 3],
+                [0, 3, 1],
+                [4, 5, 7],
+                [4, 7, 6],
+            ],
+        )
+        .expect("cube mesh");
+        let up = Vec3::Y * 10.0;
+        let shapes = [
+            ShapeDesc::Sphere { radius: 1.0 },
+            ShapeDesc::Cuboid {
+                half_extents: Vec3::ONE,
+            },
+            ShapeDesc::Capsule {
+                half_height: 0.5,
+                radius: 0.5,
+            },
+            ShapeDesc::HalfSpace { normal: Vec3::Y },
+            ShapeDesc::ConvexHull {
+                points: cube_points,
+            },
+            ShapeDesc::Compound(vec![
+                CompoundPart::at(Vec3::new(0.0, 0.5, 0.0), ShapeDesc::Sphere { radius: 0.5 }),
+                CompoundPart::at(
+                    Vec3::new(0.0, -2.0, 0.0),
+                    ShapeDesc::Cuboid {
+                        half_extents: Vec3::splat(0.5),
+                    },
+                ),
+            ]),
+            ShapeDesc::TriMesh(cube),
+        ];
+        for shape in shapes {
+            let kind = shape.kind();
+            // The half-space's surface passes through its origin: lift it to match the others.
+            let lift = if kind == "half-space" {
+                Vec3::Y
+            } else {
+                Vec3::ZERO
+            };
+            let c = at(shape, up + lift);
+            // Top surface of every shape is at y = 1 (local) → 11 (world).
+            let above = c
+                .closest((up + Vec3::new(0.0, 1.3, 0.0)).as_dvec3(), 1.0)
+                .unwrap_or_else(|| panic!("{kind}: nothing near"));
+            assert!((above.distance - 0.3).abs() < 1e-4, "{kind}: {above:?}");
+            assert!(
+                (above.normal - DVec3::Y).length() < 1e-4,
+                "{kind}: {above:?}"
+            );
+            let inside = c
+                .closest((up + Vec3::new(0.0, 0.9, 0.0)).as_dvec3(), 1.0)
+                .expect("inside");
+            assert!((inside.distance + 0.1).abs() < 1e-4, "{kind}: {inside:?}");
+            assert!(
+                (inside.normal - DVec3::Y).length() < 1e-4,
+                "{kind}: {inside:?}"
+            );
+            assert!(
+                (inside.point - (up + Vec3::Y).as_dvec3()).length() < 1e-4,
+                "{kind}: {inside:?}"
+            );
+        }
+    }
+}

@@ -1,0 +1,29 @@
+//! Weft's collisions: parry3d colliders (static or kinematic), Coulomb friction and
+//! particle self-collision, plugged into the solver's substeps as a
+//! [`weft_solver::SubstepHook`] ([`CollisionWorld`]).
+#![warn(missing_docs)]
+
+mod collider;
+mod convert;
+mod error;
+mod friction;
+mod mesh;
+mod obj;
+pub mod scenarios;
+mod self_collision;
+mod shape;
+mod spatial_hash;
+mod world;
+
+pub use collider::{Collider, ColliderDesc, SurfacePoint};
+pub use error::{CollideError, MeshError, ShapeError};
+pub use friction::Friction;
+pub use mesh::TriangleMesh;
+pub use obj::{load_obj, parse_obj};
+pub use self_collision::SelfCollisionParams;
+pub use shape::{CompoundPart, ShapeDesc};
+pub use spatial_hash::SpatialHash;
+pub use world::{CollisionWorld, ContactStats};
+
+/// Re-export of parry, so users name the same shape types.
+pub use parry3d;

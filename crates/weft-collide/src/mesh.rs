@@ -1,0 +1,117 @@
+//! Triangle meshes for mesh colliders, and the checks that make them safe to collide with.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::error::MeshError;
+
+/// A validated triangle soup: finite vertices, in-range indices, no degenerate triangle,
+/// no edge shared by more than two triangles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions (m).
+    pub vertices: Vec<Vec3>,
+    /// Triangles, counter-clockwise seen from outside (the side particles are pushed to).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    /// Validates a mesh built in memory (errors name `<memory>` and line 0).
+    pub fn new(vertices: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
+        let lines = vec![0; triangles.len()];
+        validate(Path::new("<memory>"), &vertices, &triangles, &lines, &[])?;
+        Ok(Self {
+            vertices,
+            triangles,
+        })
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the vertices.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.vertices.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+        )
+    }
+
+    /// A copy scaled by `scale` about the origin, then moved by `offset`.
+    pub fn transformed(&self, scale: f32, offset: Vec3) -> Self {
+        Self {
+            vertices: self.vertices.iter().map(|v| *v * scale + offset).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+}
+
+/// Checks a mesh; `lines[t]` is the source line of triangle `t`, `vertex_lines[v]` that of
+/// vertex `v` (either may be shorter, then 0 is reported).
+pub(crate) fn validate(
+    path: &Path,
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    lines: &[usize],
+    vertex_lines: &[usize],
+) -> Result<(), MeshError> {
+    let path_buf = || PathBuf::from(path);
+    let line_of = |t: usize| lines.get(t).copied().unwrap_or(0);
+    if triangles.is_empty() {
+        return Err(MeshError::Empty { path: path_buf() });
+    }
+    if let Some(v) = vertices.iter().position(|v| !v.is_finite()) {
+        return Err(MeshError::NonFiniteVertex {
+            path: path_buf(),
+            line: vertex_lines.get(v).copied().unwrap_or(0),
+            vertex: v,
+        });
+    }
+    for (t, tri) in triangles.iter().enumerate() {
+        if let Some(&i) = tri.iter().find(|&&i| i as usize >= vertices.len()) {
+            return Err(MeshError::IndexOutOfRange {
+                path: path_buf(),
+                line: line_of(t),
+                index: i64::from(i),
+                vertices: vertices.len(),
+            });
+        }
+        let [a, b, c] = tri.map(|i| vertices[i as usize]);
+        let twice_area = (b - a).cross(c - a).length();
+        let longest = (b - a)
+            .length_squared()
+            .max((c - b).length_squared())
+            .max((a - c).length_squared());
+        // Relative test: a sliver whose area is tiny against its longest edge is as bad as a
+        // repeated vertex for the normal and the BVH.
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || twice_area <= 1e-7 * longest
+        {
+            return Err(MeshError::DegenerateTriangle {
+                path: path_buf(),
+                line: line_of(t),
+                triangle: t,
+            });
+        }
+    }
+    // Non-manifold edges: sort (edge, triangle) so that the report is deterministic.
+    let mut edges: Vec<(u32, u32, usize)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| {
+            (0..3).map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                (a.min(b), a.max(b), t)
+            })
+        })
+        .collect();
+    edges.sort_unstable();
+    for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        if run.len() > 2 {
+            return Err(MeshError::NonManifoldEdge {
+                path: path_buf(),
+                line: line_of(run[2].2),
+                a: run[0].0,
+                b: run[0].1,
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,48 @@
+//! Shared test helpers: a hook that wraps the collision world and checks every substep.
+#![allow(dead_code)]
+
+use weft_collide::CollisionWorld;
+use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
+
+/// Runs the world, then calls `check` after every substep with the final positions.
+pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles)> {
+    /// The wrapped world.
+    pub world: &'a mut CollisionWorld,
+    /// Called at the end of every substep.
+    pub check: F,
+}
+
+impl<F: FnMut(&SubstepContext, &Particles)> SubstepHook for Watch<'_, F> {
+    fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
+        self.world.begin_substep(ctx, particles);
+    }
+
+    fn project(&mut self, ctx: &SubstepContext, particles: &mut Particles) -> usize {
+        self.world.project(ctx, particles)
+    }
+
+    fn end_substep(&mut self, ctx: &SubstepContext, particles: &mut Particles) {
+        self.world.end_substep(ctx, particles);
+        (self.check)(ctx, particles);
+    }
+}
+
+/// Steps `frames` frames, checking every substep.
+pub fn run(
+    solver: &mut Solver,
+    world: &mut CollisionWorld,
+    frames: usize,
+    check: impl FnMut(&SubstepContext, &Particles),
+) {
+    let mut hook = Watch { world, check };
+    for frame in 0..frames {
+        if let Err(e) = solver.step_with(&mut hook) {
+            panic!("frame {frame}: {e}");
+        }
+    }
+}
+
+/// Largest particle speed (m/s).
+pub fn max_speed(p: &Particles) -> f64 {
+    p.velocities.iter().map(|v| v.length()).fold(0.0, f64::max)
+}
