@@ -94,7 +94,7 @@ impl Simulation {
         let start = Instant::now();
         let mut contacts = 0;
         for g in &mut self.groups {
-            contacts += g.solver.step()?.contacts;
+            contacts += g.step()?.contacts;
         }
         self.frame += 1;
         Ok(self.stats(start.elapsed().as_secs_f64() * 1e3, contacts))

@@ -1,6 +1,7 @@
 //! Builds the solvers of a scene: one per method, cloths in name order.
 
-use weft_solver::{Method, Motion, Settings, Solver, SolverBuilder};
+use weft_collide::CollisionWorld;
+use weft_solver::{Method, Motion, Settings, Solver, SolverBuilder, SolverError, StepStats};
 
 use crate::error::{Origin, SceneError};
 use crate::scene::Scene;
@@ -14,10 +15,23 @@ pub struct SolverGroup {
     pub solver: Solver,
     /// Indices into [`Scene::cloths`], in the solver's cloth order.
     pub cloths: Vec<usize>,
+    /// Colliders and self-collision acting on this solver, if any.
+    pub world: Option<CollisionWorld>,
+}
+
+impl SolverGroup {
+    /// Steps the solver one frame through its collision world (if any).
+    pub fn step(&mut self) -> Result<StepStats, SolverError> {
+        match self.world.as_mut() {
+            Some(w) => self.solver.step_with(w),
+            None => self.solver.step(),
+        }
+    }
 }
 
 impl Scene {
-    /// Builds one solver per method (in [`Scene::methods`] order), to be stepped in lockstep.
+    /// Builds one solver per method (in [`Scene::methods`] order), each with its collision
+    /// world, to be stepped in lockstep.
     pub fn build(&self) -> Result<Vec<SolverGroup>, SceneError> {
         let err = |key: String, e: &dyn std::fmt::Display| SceneError {
             origin: Origin::File {
@@ -52,10 +66,13 @@ impl Scene {
                 }
                 members.push(i);
             }
+            let solver = b.build();
+            let world = self.collision_world(&solver, &members)?;
             groups.push(SolverGroup {
                 method,
-                solver: b.build(),
+                solver,
                 cloths: members,
+                world,
             });
         }
         Ok(groups)

@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 mod build;
+mod collide;
 mod error;
 pub mod family;
 mod load;
@@ -15,6 +16,7 @@ pub mod schema;
 mod source;
 
 pub use build::SolverGroup;
+pub use collide::collider_desc;
 pub use error::{Origin, SceneError, SceneErrors};
 pub use load::{from_text, load};
 pub use obj::{ObjMesh, parse_obj};
