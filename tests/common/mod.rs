@@ -1,0 +1,118 @@
+//! Helpers for the `weft` binary's tests: run it, write scenes, read its MCAP logs.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use foxglove::Decode;
+use foxglove::messages::PointCloud;
+
+/// The binary under test.
+pub fn weft() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_weft"));
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+/// Runs `weft` with `args`, returning its output.
+pub fn run(args: &[&str]) -> Output {
+    weft().args(args).output().expect("weft starts")
+}
+
+/// A fresh directory for one test.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+/// Writes `text` to `dir/name` and returns the path as a string.
+pub fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write file");
+    p.to_string_lossy().into_owned()
+}
+
+/// A small, quick scene: an 8×8 cloth hanging from two corners.
+pub const SMALL: &str = r#"[sim]
+method = "xpbd"
+dt = "1/60"
+substeps = 4
+damping = 0.1
+
+[cloth.flag]
+resolution = [8, 8]
+size = [0.5, 0.5]
+center = [0.0, 1.0, 0.0]
+mass = 0.1
+pins = ["top-left", "top-right"]
+"#;
+
+/// stdout and stderr as text.
+pub fn texts(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// What a test reads back from a log.
+pub struct Log {
+    /// Message counts by topic.
+    pub counts: BTreeMap<String, usize>,
+    /// The last particle positions by cloth topic.
+    pub last: BTreeMap<String, Vec<[f32; 3]>>,
+    /// Metadata records by name.
+    pub metadata: BTreeMap<String, BTreeMap<String, String>>,
+    /// Attachment names.
+    pub attachments: Vec<String>,
+}
+
+/// Reads a log with the `mcap` crate (CRCs checked), decoding particle clouds.
+pub fn read_log(path: &Path) -> Log {
+    let bytes = std::fs::read(path).expect("log exists");
+    let summary = mcap::Summary::read(&bytes)
+        .expect("summary readable")
+        .expect("log has a summary");
+    let mut counts = BTreeMap::new();
+    let mut last = BTreeMap::new();
+    let mut previous_time = 0;
+    for m in mcap::MessageStream::new(&bytes).expect("readable") {
+        let m = m.expect("message decodes");
+        let topic = m.channel.topic.clone();
+        *counts.entry(topic.clone()).or_insert(0) += 1;
+        assert!(m.log_time >= previous_time, "log time goes backwards");
+        previous_time = m.log_time;
+        if topic.ends_with("/particles") {
+            let pc = PointCloud::decode(&m.data[..]).expect("PointCloud decodes");
+            assert_eq!(pc.point_stride, 12);
+            let pts = pc
+                .data
+                .chunks_exact(12)
+                .map(|c| {
+                    let f = |k: usize| f32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+                    [f(0), f(4), f(8)]
+                })
+                .collect();
+            last.insert(topic, pts);
+        }
+    }
+    let mut metadata = BTreeMap::new();
+    for idx in &summary.metadata_indexes {
+        let md = mcap::read::metadata(&bytes, idx).expect("metadata");
+        metadata.insert(md.name, md.metadata);
+    }
+    let attachments = summary
+        .attachment_indexes
+        .iter()
+        .map(|a| a.name.clone())
+        .collect();
+    Log {
+        counts,
+        last,
+        metadata,
+        attachments,
+    }
+}
