@@ -83,7 +83,9 @@ fn run_command(args: &RunArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
 fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
     match weft_scene::load(&args.scene, &args.set) {
         Ok(scene) => {
-            scene.build()?;
+            if let Err(e) = scene.build() {
+                return Ok(report(&e.into()));
+            }
             let methods: Vec<&str> = scene.methods().iter().map(|m| m.name()).collect();
             println!(
                 "{}: ok ({} cloth(s), {} collider(s), methods: {})",

@@ -105,6 +105,23 @@ fn bad_collider_values_are_named() {
 }
 
 #[test]
+fn absurd_grids_are_refused_without_overflow() {
+    let text =
+        "[cloth.a]\nresolution = [9223372036854775807, 9223372036854775807]\npins = [5, -1]\n";
+    let (path, err) = check_fails("absurd", text, &[]);
+    assert!(
+        err.contains(&format!(
+            "{path}:2: cloth.a.resolution: each count must be in 2..=4096"
+        )),
+        "{err}"
+    );
+    assert!(
+        err.contains("cloth.a.pins[1]: vertex -1 does not exist"),
+        "{err}"
+    );
+}
+
+#[test]
 fn invalid_toml_is_reported_with_its_line() {
     let text = SMALL.replace("damping = 0.1", "damping = = 0.1");
     let (path, err) = check_fails("syntax", &text, &[]);

@@ -393,14 +393,14 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
                         ),
                     ),
                 },
-                PinSpec::Index(v) if *v >= 0 && *v < nx * ny => {
+                PinSpec::Index(v) if *v >= 0 && *v < nx.saturating_mul(ny) => {
                     grid_pins.push(Pin::Index(*v as u32))
                 }
                 PinSpec::Index(v) => c.bad(
                     &key,
                     format!(
                         "vertex {v} does not exist (the grid has {})",
-                        nx.max(0) * ny.max(0)
+                        nx.max(0).saturating_mul(ny.max(0))
                     ),
                 ),
             }
