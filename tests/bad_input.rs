@@ -84,6 +84,28 @@ fn missing_mesh_file_is_named() {
 }
 
 #[test]
+fn malformed_cloth_mesh_names_scene_key_and_obj_line() {
+    let dir = temp_dir("bad-obj");
+    write(&dir, "shirt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+    let scene = write(
+        &dir,
+        "scene.toml",
+        "[cloth.shirt]\nmesh = \"shirt.obj\"\nmass = 0.2\n",
+    );
+    let out = run(&["check", &scene]);
+    let (_, err) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!("{scene}:2: cloth.shirt.mesh: bad mesh:")),
+        "{err}"
+    );
+    assert!(
+        err.contains("shirt.obj:4: face uses vertex 6, but only 3 vertices"),
+        "{err}"
+    );
+}
+
+#[test]
 fn bad_collider_values_are_named() {
     let text = format!(
         "{SMALL}\n[[collider]]\nshape = \"sphere\"\nradius = -0.5\n\n[[collider]]\nshape = \"cuboid\"\nradius = 1.0\n"

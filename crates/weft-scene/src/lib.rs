@@ -8,7 +8,6 @@ mod collide;
 mod error;
 pub mod family;
 mod load;
-mod obj;
 mod overrides;
 mod resolve;
 mod scene;
@@ -19,7 +18,6 @@ pub use build::SolverGroup;
 pub use collide::collider_desc;
 pub use error::{Origin, SceneError, SceneErrors};
 pub use load::{from_text, load};
-pub use obj::{ObjMesh, parse_obj};
 pub use overrides::{Override, parse_value};
 pub use scene::{
     ClothSpec, ColliderSpec, DirFiles, Files, MapFiles, Scene, SelfCollisionSpec, ShapeSpec,

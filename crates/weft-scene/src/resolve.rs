@@ -11,7 +11,6 @@ use weft_solver::{
 
 use crate::error::SceneError;
 use crate::family;
-use crate::obj::parse_obj;
 use crate::scene::{ClothSpec, ColliderSpec, Files, SelfCollisionSpec, ShapeSpec};
 use crate::schema::{
     ClothSection, ColliderSection, MotionSpec, OrientationName, PartSection, PinSpec, SceneFile,
@@ -108,13 +107,14 @@ impl<'a> Checker<'a> {
         };
         let text = String::from_utf8_lossy(&bytes).into_owned();
         self.read.insert(path.to_owned(), bytes);
-        match parse_obj(&text) {
+        // One OBJ reader serves colliders and cloths; its errors name the file and line.
+        match weft_collide::parse_obj(&text, path) {
             Ok(m) => Some((
-                m.positions.into_iter().map(|p| p * scale).collect(),
+                m.vertices.iter().map(|p| p.as_dvec3() * scale).collect(),
                 m.triangles,
             )),
             Err(e) => {
-                self.bad(key, format!("mesh file `{path}`: {e}"));
+                self.bad(key, format!("bad mesh: {e}"));
                 None
             }
         }
