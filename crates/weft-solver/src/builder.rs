@@ -7,7 +7,7 @@ use crate::constraints::{BlockBuilder, ConstraintSet, Dihedral, Distance, Tether
 use crate::error::{BuildError, ParamError};
 use crate::forces::Forces;
 use crate::motion::{KinematicPin, Motion};
-use crate::params::{ClothParams, Family, FamilyParams};
+use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
 use crate::settings::Settings;
 use crate::solver::{Cloth, Solver};
@@ -58,14 +58,7 @@ impl SolverBuilder {
     ) -> Result<usize, BuildError> {
         let name = name.into();
         params.validate()?;
-        if !(thickness.is_finite() && thickness >= 0.0) {
-            return Err(ParamError {
-                name: "thickness".into(),
-                value: thickness,
-                expected: "finite and >= 0",
-            }
-            .into());
-        }
+        check_thickness(thickness)?;
         if mesh.masses.len() != mesh.positions.len() {
             return Err(BuildError::MassCount {
                 name,

@@ -184,3 +184,16 @@ impl ClothParams {
             .try_for_each(|&f| self.get(f).validate(f))
     }
 }
+
+/// Checks a cloth thickness (m) is finite and non-negative.
+pub(crate) fn check_thickness(thickness: f64) -> Result<(), ParamError> {
+    if thickness.is_finite() && thickness >= 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError {
+            name: "thickness".into(),
+            value: thickness,
+            expected: "finite and >= 0",
+        })
+    }
+}

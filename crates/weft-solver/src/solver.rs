@@ -9,7 +9,7 @@ use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
 use crate::hook::{SubstepContext, SubstepHook};
 use crate::motion::KinematicPin;
-use crate::params::{ClothParams, Family, FamilyParams};
+use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
 use crate::settings::Settings;
 
@@ -190,13 +190,7 @@ impl Solver {
     /// Changes the thickness of cloth `cloth`.
     pub fn set_thickness(&mut self, cloth: usize, thickness: f64) -> Result<(), ParamError> {
         self.check_cloth(cloth)?;
-        if !(thickness.is_finite() && thickness >= 0.0) {
-            return Err(ParamError {
-                name: "thickness".into(),
-                value: thickness,
-                expected: "finite and >= 0",
-            });
-        }
+        check_thickness(thickness)?;
         self.cloths[cloth].thickness = thickness;
         Ok(())
     }
