@@ -76,6 +76,27 @@ fn build_one(
     Ok(builder.build())
 }
 
+/// A horizontal square sheet (`n`×`n`, `size` m, `mass` kg) centred at height `y`, as a solver.
+fn falling_sheet(
+    method: Method,
+    n: usize,
+    size: f64,
+    y: f64,
+    mass: f64,
+) -> Result<Solver, CollideError> {
+    let mesh = GridDesc {
+        resolution: (n, n),
+        size: (size, size),
+        center: DVec3::new(0.0, y, 0.0),
+        orientation: Orientation::Horizontal,
+        mass: Mass::Total(mass),
+        pins: vec![],
+    }
+    .build()
+    .map_err(solver_error)?;
+    build_one(method, "cloth", &mesh, THICKNESS)
+}
+
 /// The ground: a half-space below y = `height` with friction.
 pub fn ground(height: f32) -> ColliderDesc {
     ColliderDesc::new(ShapeDesc::HalfSpace { normal: Vec3::Y }).at(Vec3::Y * height)
@@ -89,17 +110,7 @@ pub const THICKNESS: f64 = 0.01;
 /// A horizontal 1.6 m cloth (`n`×`n` particles, 0.4 kg) falls from 0.2 m above a static
 /// sphere of radius 0.5 m at the origin that sits on the ground, and drapes over it.
 pub fn sphere_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
-    let mesh = GridDesc {
-        resolution: (n, n),
-        size: (1.6, 1.6),
-        center: DVec3::new(0.0, SPHERE_RADIUS + 0.2, 0.0),
-        orientation: Orientation::Horizontal,
-        mass: Mass::Total(0.4),
-        pins: vec![],
-    }
-    .build()
-    .map_err(solver_error)?;
-    let solver = build_one(method, "cloth", &mesh, THICKNESS)?;
+    let solver = falling_sheet(method, n, 1.6, SPHERE_RADIUS + 0.2, 0.4)?;
     let mut world = CollisionWorld::new(&solver);
     world.add_collider(
         &ColliderDesc::new(ShapeDesc::Sphere {
@@ -118,17 +129,7 @@ pub const TABLE_HALF_EXTENTS: DVec3 = DVec3::new(0.4, 0.4, 0.4);
 /// over its edges.
 pub fn table_drape(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
     let top = 2.0 * TABLE_HALF_EXTENTS.y;
-    let mesh = GridDesc {
-        resolution: (n, n),
-        size: (1.4, 1.4),
-        center: DVec3::new(0.0, top + 0.1, 0.0),
-        orientation: Orientation::Horizontal,
-        mass: Mass::Total(0.3),
-        pins: vec![],
-    }
-    .build()
-    .map_err(solver_error)?;
-    let solver = build_one(method, "cloth", &mesh, THICKNESS)?;
+    let solver = falling_sheet(method, n, 1.4, top + 0.1, 0.3)?;
     let mut world = CollisionWorld::new(&solver);
     world.add_collider(
         &ColliderDesc::new(ShapeDesc::Cuboid {
@@ -185,17 +186,7 @@ pub fn blob_path() -> PathBuf {
 /// A horizontal 1.2 m cloth (`n`×`n`) falls onto the triangle-mesh blob loaded from
 /// [`blob_path`], which rests on the ground with its centre at y = 0.45 m.
 pub fn mesh_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
-    let mesh = GridDesc {
-        resolution: (n, n),
-        size: (1.2, 1.2),
-        center: DVec3::new(0.0, 1.0, 0.0),
-        orientation: Orientation::Horizontal,
-        mass: Mass::Total(0.3),
-        pins: vec![],
-    }
-    .build()
-    .map_err(solver_error)?;
-    let solver = build_one(method, "cloth", &mesh, THICKNESS)?;
+    let solver = falling_sheet(method, n, 1.2, 1.0, 0.3)?;
     let mut world = CollisionWorld::new(&solver);
     world.add_collider(
         &ColliderDesc::new(ShapeDesc::from_obj(blob_path(), 1.0)?)
