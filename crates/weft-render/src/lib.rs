@@ -1,0 +1,1 @@
+//! Weft's wgpu renderer (work in progress).
