@@ -30,6 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         s.constraints().len(),
         s.constraints().color_counts()
     );
+    println!("{:?}", s.domain_stats());
     s.step()?; // warm-up
     let mut times = Vec::with_capacity(frames);
     for _ in 0..frames {

@@ -33,7 +33,16 @@ pub trait SubstepHook {
 
     /// After velocities are derived from positions: velocity-level corrections.
     fn end_substep(&mut self, _ctx: &SubstepContext, _particles: &mut Particles) {}
+
+    /// Whether the hook does anything; an inactive hook lets the solver fuse a substep's phases.
+    fn is_active(&self) -> bool {
+        true
+    }
 }
 
 /// No hook: nothing but the cloth's own constraints.
-impl SubstepHook for () {}
+impl SubstepHook for () {
+    fn is_active(&self) -> bool {
+        false
+    }
+}

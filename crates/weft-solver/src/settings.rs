@@ -16,8 +16,10 @@ pub struct Settings {
     pub iterations: u32,
     /// A particle farther than this from the origin (m) means the simulation diverged.
     pub divergence_bound: f64,
-    /// Colours with at least this many constraints are solved in parallel.
-    pub parallel_min_batch: usize,
+    /// Particles per parallel domain (rounded up to a multiple of 8). Domains solve their own
+    /// constraints concurrently; constraints across domains are solved after them, serially.
+    /// The split, and so the result, depends on this and the mesh, never on the thread count.
+    pub domain_size: usize,
 }
 
 impl Default for Settings {
@@ -28,7 +30,7 @@ impl Default for Settings {
             substeps: 10,
             iterations: 1,
             divergence_bound: 1.0e4,
-            parallel_min_batch: 4096,
+            domain_size: 2048,
         }
     }
 }

@@ -4,7 +4,8 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::constraints::{ConstraintSet, Residual};
+use crate::constraints::{ConstraintSet, Residual, Rule};
+use crate::domains::{DomainStats, Domains, Integration};
 use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
 use crate::hook::{SubstepContext, SubstepHook};
@@ -59,6 +60,10 @@ pub struct Solver {
     constraints: ConstraintSet,
     pins: Vec<KinematicPin>,
     grab: Option<Grab>,
+    /// The distance constraints cut into domains (the parallel SIMD solve).
+    domains: Domains,
+    /// Pin and grab targets of the current substep (scratch).
+    targets: Vec<(usize, DVec3)>,
     accel: Vec<DVec3>,
     force: Vec<DVec3>,
     time: f64,
@@ -81,9 +86,12 @@ impl Solver {
             .iter()
             .flat_map(|c| c.triangles.iter().copied())
             .collect();
+        let domains = Domains::new(&constraints.distance, particles.len(), settings.domain_size);
         Self {
             settings,
             forces,
+            domains,
+            targets: Vec::new(),
             initial: particles.clone(),
             particles,
             cloths,
@@ -124,6 +132,11 @@ impl Solver {
         &self.constraints
     }
 
+    /// How the distance constraints are cut into domains and SIMD chunks.
+    pub fn domain_stats(&self) -> DomainStats {
+        self.domains.stats()
+    }
+
     /// The kinematic pins.
     pub fn kinematic_pins(&self) -> &[KinematicPin] {
         &self.pins
@@ -137,6 +150,13 @@ impl Solver {
     /// Changes settings (method, time step, substeps, iterations) from the next frame on.
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), ParamError> {
         settings.validate()?;
+        if settings.domain_size != self.settings.domain_size {
+            self.domains = Domains::new(
+                &self.constraints.distance,
+                self.particles.len(),
+                settings.domain_size,
+            );
+        }
         self.settings = settings;
         Ok(())
     }
@@ -266,15 +286,109 @@ impl Solver {
     }
 
     /// Advances one frame of Δt: `substeps` substeps of the shared loop, calling `hook` inside.
+    ///
+    /// When nothing needs the particle store between the phases of a substep (no active hook, no
+    /// aerodynamics, only distance constraints, a position-based method), the frame runs fused:
+    /// each domain integrates, pins and projects its own particles in one parallel region per
+    /// substep and iteration. That path does the same arithmetic in the same order as the
+    /// general loop, so both give the same bits.
     pub fn step_with(&mut self, hook: &mut dyn SubstepHook) -> Result<StepStats, SolverError> {
+        let s = self.settings;
+        let rule = s.method.strategy().rule(s.h());
+        let stats = match rule {
+            Some(rule) if !hook.is_active() && self.fusable() => {
+                self.frame_fused(rule);
+                StepStats::default()
+            }
+            _ => self.frame_general(hook),
+        };
+        if let Some(g) = &mut self.grab {
+            g.from = g.target;
+        }
+        self.time += s.dt;
+        let frame = self.frame;
+        self.frame += 1;
+        self.check_divergence(frame)?;
+        Ok(stats)
+    }
+
+    /// Whether a frame can run fused (see [`Solver::step_with`]).
+    fn fusable(&self) -> bool {
+        self.forces.wind.aero.is_none()
+            && self.constraints.dihedral.len() == 0
+            && self.constraints.tethers.len() == 0
+    }
+
+    /// Time at the end of substep `k`, and the pin and grab targets there, into `self.targets`.
+    fn substep_targets(&mut self, k: u32) -> f64 {
+        let s = self.settings;
+        let time = self.time + s.dt * f64::from(k + 1) / f64::from(s.substeps);
+        self.targets.clear();
+        for pin in &self.pins {
+            self.targets
+                .push((pin.particle as usize, pin.motion.position(pin.rest, time)));
+        }
+        if let Some(g) = &self.grab {
+            let f = (k + 1) as f64 / s.substeps as f64;
+            self.targets.push((g.particle, g.from.lerp(g.target, f)));
+        }
+        time
+    }
+
+    /// One frame with every substep phase inside the domains' parallel regions.
+    fn frame_fused(&mut self, rule: Rule) {
+        let s = self.settings;
+        let h = s.h();
+        let inv_h = 1.0 / h;
+        let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
+        self.domains.prepare(&self.params, rule);
+        for k in 0..s.substeps {
+            self.substep_targets(k);
+            let step = Integration {
+                h,
+                forces: &self.forces,
+                pins: &self.targets,
+            };
+            let p = &self.particles;
+            self.domains.reset_link_multipliers();
+            self.domains
+                .project_after(&p.positions, &p.velocities, &p.inv_masses, |d, aos| {
+                    if k == 0 {
+                        d.load(aos);
+                    } else {
+                        d.finish_velocities(inv_h, keep);
+                    }
+                    d.integrate(&step);
+                });
+            for _ in 1..s.iterations {
+                self.domains.project();
+            }
+        }
+        let p = &mut self.particles;
+        self.domains.finish(
+            inv_h,
+            keep,
+            &mut p.positions,
+            &mut p.prev_positions,
+            &mut p.velocities,
+        );
+    }
+
+    /// One frame of the general loop: every phase on the particle store, the hook in between.
+    fn frame_general(&mut self, hook: &mut dyn SubstepHook) -> StepStats {
         let s = self.settings;
         let h = s.h();
         let strategy = s.method.strategy();
         let mut stats = StepStats::default();
+        let rule = strategy.rule(h);
+        if let Some(rule) = rule {
+            self.domains.prepare(&self.params, rule);
+        }
         for k in 0..s.substeps {
+            let time = self.substep_targets(k);
             let ctx = SubstepContext {
                 method: s.method,
-                time: self.time + s.dt * f64::from(k + 1) / f64::from(s.substeps),
+                time,
                 h,
                 substep: k,
             };
@@ -297,25 +411,27 @@ impl Solver {
                     p.positions[i] += p.velocities[i] * h;
                 }
             }
-            for pin in &self.pins {
-                p.positions[pin.particle as usize] = pin.motion.position(pin.rest, ctx.time);
-            }
-            if let Some(g) = &self.grab {
-                let f = (k + 1) as f64 / s.substeps as f64;
-                p.positions[g.particle] = g.from.lerp(g.target, f);
+            for &(i, x) in &self.targets {
+                p.positions[i] = x;
             }
             hook.begin_substep(&ctx, p);
             strategy.begin_substep(&mut self.constraints);
-            match strategy.rule(h) {
+            match rule {
                 Some(rule) => {
-                    for _ in 0..s.iterations {
-                        self.constraints.project(
+                    for it in 0..s.iterations {
+                        self.domains.project_global(
+                            &mut p.positions,
+                            &p.prev_positions,
+                            &p.inv_masses,
+                            it == 0,
+                        );
+                        self.constraints.project_others(
                             &mut p.positions,
                             &p.prev_positions,
                             &p.inv_masses,
                             &self.params,
                             rule,
-                            s.parallel_min_batch,
+                            s.domain_size,
                         );
                         stats.contacts = hook.project(&ctx, p);
                     }
@@ -338,14 +454,7 @@ impl Solver {
                 }
             }
         }
-        if let Some(g) = &mut self.grab {
-            g.from = g.target;
-        }
-        self.time += s.dt;
-        let frame = self.frame;
-        self.frame += 1;
-        self.check_divergence(frame)?;
-        Ok(stats)
+        stats
     }
 
     fn check_divergence(&self, frame: u64) -> Result<(), SolverError> {

@@ -1,16 +1,16 @@
 //! Same build, inputs and settings give bit-identical states, whatever the thread count and
-//! whether colours run in parallel or in sequence.
+//! whether a frame runs fused or through the general loop.
 
 mod common;
 
 use common::*;
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    Aero, ClothParams, Edge, Family, Forces, GridDesc, Method, Pin, Settings, Solver,
-    SolverBuilder, Wind,
+    Aero, ClothParams, Edge, Family, Forces, GridDesc, Method, Motion, Pin, Settings, Solver,
+    SolverBuilder, SubstepHook, Wind,
 };
 
-fn build(method: Method, parallel_min_batch: usize) -> Solver {
+fn build(method: Method, domain_size: usize) -> Solver {
     let mesh = GridDesc {
         resolution: (48, 48),
         pins: vec![Pin::Edge(Edge::Top)],
@@ -42,7 +42,7 @@ fn build(method: Method, parallel_min_batch: usize) -> Solver {
         method,
         substeps: 5,
         iterations: 2,
-        parallel_min_batch,
+        domain_size,
         ..Settings::default()
     };
     let mut b = SolverBuilder::new(settings, forces).expect("valid");
@@ -58,46 +58,116 @@ fn bits(s: &Solver) -> Vec<[u64; 3]> {
         .collect()
 }
 
-fn run_in_pool(threads: usize, method: Method, parallel_min_batch: usize) -> Vec<[u64; 3]> {
+fn run_in_pool(threads: usize, method: Method, domain_size: usize) -> Vec<[u64; 3]> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("thread pool");
     pool.install(|| {
-        let mut s = build(method, parallel_min_batch);
+        let mut s = build(method, domain_size);
         run(&mut s, 40);
         bits(&s)
     })
 }
 
 #[test]
-fn results_are_bit_identical_across_threads_and_paths() {
-    for method in [Method::Xpbd, Method::Pbd] {
-        let reference = run_in_pool(1, method, usize::MAX);
-        assert_eq!(
-            reference,
-            run_in_pool(1, method, usize::MAX),
-            "{method}: same run twice"
-        );
-        assert_eq!(
-            reference,
-            run_in_pool(1, method, 1),
-            "{method}: parallel path, 1 thread"
-        );
-        assert_eq!(
-            reference,
-            run_in_pool(2, method, 1),
-            "{method}: parallel path, 2 threads"
-        );
-        assert_eq!(
-            reference,
-            run_in_pool(4, method, 64),
-            "{method}: parallel path, 4 threads"
-        );
+fn results_are_bit_identical_across_thread_counts() {
+    // 48² = 2304 particles in domains of 256: nine domains and their links.
+    for method in [Method::Xpbd, Method::Pbd, Method::MassSpring] {
+        let reference = run_in_pool(1, method, 256);
+        assert_eq!(reference, run_in_pool(1, method, 256), "{method}: twice");
+        assert_eq!(reference, run_in_pool(2, method, 256), "{method}: 2 threads");
+        assert_eq!(reference, run_in_pool(4, method, 256), "{method}: 4 threads");
         // The run really moved the cloth (a frozen state would be trivially identical).
-        let start = bits(&build(method, usize::MAX));
+        let start = bits(&build(method, 256));
         assert_ne!(reference, start);
     }
-    let ms = run_in_pool(1, Method::MassSpring, usize::MAX);
-    assert_eq!(ms, run_in_pool(2, Method::MassSpring, 1));
+}
+
+/// A hook that does nothing but says it is active, forcing the general loop.
+struct Active;
+
+impl SubstepHook for Active {}
+
+/// A flag in linear wind with a moving pin, global and XPBD damping, and a dragged corner:
+/// everything the fused frame handles.
+fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    pool.install(|| {
+        let mesh = GridDesc {
+            resolution: (40, 40),
+            pins: vec![Pin::Edge(Edge::Top)],
+            ..GridDesc::default()
+        }
+        .build()
+        .expect("valid grid");
+        let params = ClothParams::default()
+            .edit(Family::BendDistance, |p| p.enabled = true)
+            .edit(Family::Stretch, |p| {
+                p.compliance = 1e-6;
+                p.damping = 0.5;
+            });
+        let forces = Forces {
+            wind: Wind {
+                velocity: DVec3::new(0.0, 0.0, 3.0),
+                drag: 0.2,
+                aero: None,
+            },
+            damping: 0.1,
+            ..Forces::default()
+        };
+        let settings = Settings {
+            method,
+            substeps: 4,
+            iterations: 2,
+            domain_size: 200,
+            ..Settings::default()
+        };
+        let mut b = SolverBuilder::new(settings, forces).expect("valid");
+        b.add_cloth("flag", &mesh, params, 0.01).expect("valid");
+        b.add_kinematic_pin(
+            0,
+            0,
+            Motion::Linear {
+                velocity: DVec3::new(0.5, 0.0, 0.0),
+            },
+        )
+        .expect("valid pin");
+        let mut s = b.build();
+        assert!(s.domain_stats().domains > 1 && s.domain_stats().links > 0);
+        let corner = 40 * 40 - 1;
+        for frame in 0..30 {
+            match frame {
+                5 => s.grab(corner).expect("particle exists"),
+                6..15 => s.drag_to(DVec3::new(0.3, -0.6 + 0.02 * frame as f64, 0.4)),
+                15 => s.release(),
+                _ => {}
+            }
+            if active {
+                s.step_with(&mut Active).expect("stable");
+            } else {
+                s.step().expect("stable");
+            }
+        }
+        let p = s.particles();
+        assert!((p.positions[corner] - mesh.positions[corner]).length() > 0.1);
+        p.positions
+            .iter()
+            .chain(&p.velocities)
+            .map(|v| v.to_array().map(f64::to_bits))
+            .collect()
+    })
+}
+
+#[test]
+fn fused_frames_match_the_general_loop_bit_for_bit() {
+    for method in [Method::Xpbd, Method::Pbd] {
+        let fused = fusable(method, 1, false);
+        assert_eq!(fused, fusable(method, 1, true), "{method}");
+        assert_eq!(fused, fusable(method, 2, false), "{method}, 2 threads");
+        assert_eq!(fused, fusable(method, 2, true), "{method}, 2 threads");
+    }
 }

@@ -127,7 +127,7 @@ fn bending_stiffness_holds_a_cantilever_up() {
             ..Forces::default()
         };
         let mut s = solver(
-            settings(Method::Xpbd, 1.0 / 60.0, 20, 2),
+            settings(Method::Xpbd, 1.0 / 60.0, 20, 8),
             forces,
             &mesh,
             params,

@@ -3,6 +3,7 @@
 mod block;
 mod dihedral;
 mod distance;
+pub(crate) mod lanes;
 mod tether;
 
 pub(crate) use block::{Block, BlockBuilder, Rule};
@@ -69,8 +70,9 @@ impl ConstraintSet {
         self.tethers.reset_multipliers();
     }
 
-    /// One Gauss–Seidel sweep over every constraint, colour by colour.
-    pub(crate) fn project(
+    /// One Gauss–Seidel sweep over the dihedral and tether constraints, colour by colour (the
+    /// distance constraints are solved by [`crate::domains::Domains`]).
+    pub(crate) fn project_others(
         &mut self,
         x: &mut [DVec3],
         prev: &[DVec3],
@@ -79,7 +81,6 @@ impl ConstraintSet {
         rule: Rule,
         par_min: usize,
     ) {
-        self.distance.project(x, prev, w, params, rule, par_min);
         self.dihedral.project(x, prev, w, params, rule, par_min);
         self.tethers.project(x, prev, w, params, rule, par_min);
     }

@@ -1,0 +1,755 @@
+//! Domain decomposition of the distance constraints for parallel, SIMD Gauss–Seidel.
+//!
+//! Particles are cut into contiguous index ranges of `size` particles (domains). A distance
+//! constraint whose two particles lie in one domain is *interior*: each domain keeps its own
+//! struct-of-arrays copy of its particles and projects its interior constraints colour by colour,
+//! eight at a time, without touching any other domain — so domains run on any threads, in any
+//! order, with no synchronisation. Constraints across domains (*links*, a few per cent on
+//! meshes with local particle order) are projected after the domains, serially. The split
+//! depends on `size` and the mesh only, never on the thread count: results are bit-identical
+//! for 1, 2 or 64 threads.
+//!
+//! Inside a colour, constraints are sorted by parameter group and particle index, so that on
+//! structured meshes eight consecutive constraints usually touch eight consecutive particles
+//! (`Layout::Contiguous`, e.g. a row of vertical grid edges) or sixteen consecutive ones
+//! pairwise (`Layout::Paired`, every other horizontal edge): those chunks load and store with
+//! unit stride, and anything else is gathered lane by lane.
+
+use std::ops::Range;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::coloring::color;
+use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
+use crate::constraints::{Block, Distance, Rule};
+use crate::forces::Forces;
+use crate::params::FamilyParams;
+
+/// How the eight constraints of a chunk reach their particles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Layout {
+    /// p = p₀ + l and q = q₀ + l: two unit-stride loads per axis.
+    Contiguous,
+    /// p = p₀ + 2l and q = p + 1: one unit-stride load of 16 particles, de-interleaved.
+    Paired,
+    /// Anything else: one load per lane.
+    Gathered,
+}
+
+/// How a solver's distance constraints are laid out for the parallel SIMD solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DomainStats {
+    /// Number of domains.
+    pub domains: usize,
+    /// Particles per domain.
+    pub domain_size: usize,
+    /// Constraints across domains, solved serially after them.
+    pub links: usize,
+    /// Interior constraints in chunks of 8 with unit-stride ends.
+    pub contiguous: usize,
+    /// Interior constraints in chunks of 8 over 16 consecutive particles, pairwise.
+    pub paired: usize,
+    /// Interior constraints in chunks of 8 loaded lane by lane.
+    pub gathered: usize,
+    /// Interior constraints solved one at a time (the tail of each colour).
+    pub remainder: usize,
+}
+
+/// A full chunk of [`LANES`] constraints.
+#[derive(Clone, Copy, Debug)]
+struct Chunk {
+    start: usize,
+    layout: Layout,
+    /// All lanes share one parameter group.
+    uniform: bool,
+}
+
+/// Distance constraints as struct-of-arrays.
+#[derive(Clone, Debug, Default)]
+struct Pairs {
+    p: Vec<u32>,
+    q: Vec<u32>,
+    rest: Vec<f64>,
+    group: Vec<u32>,
+    lambda: Vec<f64>,
+}
+
+impl Pairs {
+    fn push(&mut self, p: u32, q: u32, rest: f64, group: u32) {
+        self.p.push(p);
+        self.q.push(q);
+        self.rest.push(rest);
+        self.group.push(group);
+        self.lambda.push(0.0);
+    }
+}
+
+/// One domain: its particles (struct-of-arrays, local indices) and interior constraints.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Domain {
+    /// Global index of the first particle.
+    start: usize,
+    /// Positions per axis (m).
+    x: [Vec<f64>; 3],
+    /// Positions at the start of the substep per axis (m).
+    prev: [Vec<f64>; 3],
+    /// Velocities per axis (m/s).
+    v: [Vec<f64>; 3],
+    /// Inverse masses (1/kg).
+    w: Vec<f64>,
+    /// Interior constraints in local indices, sorted by colour, group and particle.
+    pairs: Pairs,
+    /// Range of each colour in `pairs`.
+    colours: Vec<Range<usize>>,
+    /// Full chunks of every colour, in order.
+    chunks: Vec<Chunk>,
+    /// For each colour: its range in `chunks` and where its scalar remainder starts.
+    plan: Vec<(Range<usize>, usize)>,
+}
+
+/// A domain's share of the global particle arrays.
+pub(crate) struct AosChunk<'a> {
+    /// Positions.
+    pub x: &'a [DVec3],
+    /// Velocities.
+    pub v: &'a [DVec3],
+    /// Inverse masses.
+    pub w: &'a [f64],
+}
+
+/// Per-substep inputs of the fused integration.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Integration<'a> {
+    /// Substep length (s).
+    pub h: f64,
+    /// External forces (gravity and linear wind drag; no aerodynamics).
+    pub forces: &'a Forces,
+    /// Kinematic pins as (global particle, position at the substep's end).
+    pub pins: &'a [(usize, DVec3)],
+}
+
+impl Domain {
+    fn len(&self) -> usize {
+        self.w.len()
+    }
+
+    fn resize(&mut self, n: usize) {
+        for a in 0..3 {
+            self.x[a].resize(n, 0.0);
+            self.prev[a].resize(n, 0.0);
+            self.v[a].resize(n, 0.0);
+        }
+        self.w.resize(n, 0.0);
+    }
+
+    /// Copies positions, velocities and inverse masses in from the global arrays.
+    pub fn load(&mut self, aos: &AosChunk<'_>) {
+        for (i, (x, v)) in aos.x.iter().zip(aos.v).enumerate() {
+            for a in 0..3 {
+                self.x[a][i] = x[a];
+                self.v[a][i] = v[a];
+            }
+        }
+        self.w.copy_from_slice(aos.w);
+    }
+
+    /// Copies positions (and, when `prev` is given, previous positions) in.
+    fn load_positions(&mut self, x: &[DVec3], prev: Option<&[DVec3]>, w: &[f64]) {
+        for (i, p) in x.iter().enumerate() {
+            for a in 0..3 {
+                self.x[a][i] = p[a];
+            }
+        }
+        if let Some(prev) = prev {
+            for (i, p) in prev.iter().enumerate() {
+                for a in 0..3 {
+                    self.prev[a][i] = p[a];
+                }
+            }
+        }
+        self.w.copy_from_slice(w);
+    }
+
+    /// Copies positions back out.
+    fn store_positions(&self, x: &mut [DVec3]) {
+        for (i, p) in x.iter_mut().enumerate() {
+            *p = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
+        }
+    }
+
+    /// Copies positions, previous positions and velocities back out.
+    pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3]) {
+        for i in 0..self.len() {
+            x[i] = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
+            prev[i] = DVec3::new(self.prev[0][i], self.prev[1][i], self.prev[2][i]);
+            v[i] = DVec3::new(self.v[0][i], self.v[1][i], self.v[2][i]);
+        }
+    }
+
+    /// The PBD velocity update v = (x − x_prev)/h, then global damping v ← v e^(−c h) of free
+    /// particles when `keep` is given — the same arithmetic as the solver's general loop.
+    pub fn finish_velocities(&mut self, inv_h: f64, keep: Option<f64>) {
+        for a in 0..3 {
+            for i in 0..self.len() {
+                self.v[a][i] = (self.x[a][i] - self.prev[a][i]) * inv_h;
+            }
+        }
+        if let Some(keep) = keep {
+            for a in 0..3 {
+                for i in 0..self.len() {
+                    if self.w[i] > 0.0 {
+                        self.v[a][i] *= keep;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Semi-implicit Euler prediction with a = g + c_d (v_wind − v), then pins; clears the
+    /// multipliers — the same arithmetic as the solver's general loop.
+    pub fn integrate(&mut self, step: &Integration<'_>) {
+        let h = step.h;
+        let f = step.forces;
+        for a in 0..3 {
+            let (g, wv) = (f.gravity[a], f.wind.velocity[a]);
+            let (x, v, prev) = (&mut self.x[a], &mut self.v[a], &mut self.prev[a]);
+            for i in 0..self.w.len() {
+                prev[i] = x[i];
+                let acc = g + f.wind.drag * (wv - v[i]);
+                let vi = v[i] + acc * h;
+                let xi = x[i] + vi * h;
+                let free = self.w[i] > 0.0;
+                v[i] = if free { vi } else { v[i] };
+                x[i] = if free { xi } else { x[i] };
+            }
+        }
+        let range = self.start..self.start + self.len();
+        for &(i, p) in step.pins {
+            if range.contains(&i) {
+                for a in 0..3 {
+                    self.x[a][i - self.start] = p[a];
+                }
+            }
+        }
+        self.pairs.lambda.fill(0.0);
+    }
+
+    /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
+    pub fn project(&mut self, coef: &[Coef], damped: bool) {
+        if damped {
+            self.project_with::<true>(coef);
+        } else {
+            self.project_with::<false>(coef);
+        }
+    }
+
+    fn project_with<const DAMPED: bool>(&mut self, coef: &[Coef]) {
+        let Self {
+            x,
+            prev,
+            w,
+            pairs,
+            chunks,
+            plan,
+            colours,
+            ..
+        } = self;
+        for (c, (chunk_range, tail)) in plan.iter().enumerate() {
+            for chunk in &chunks[chunk_range.clone()] {
+                project_chunk::<DAMPED>(chunk, pairs, x, prev, w, coef);
+            }
+            for k in *tail..colours[c].end {
+                let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
+                let mut e = Ends {
+                    p: [[x[0][p]], [x[1][p]], [x[2][p]]],
+                    q: [[x[0][q]], [x[1][q]], [x[2][q]]],
+                };
+                let pr = if DAMPED {
+                    Ends {
+                        p: [[prev[0][p]], [prev[1][p]], [prev[2][p]]],
+                        q: [[prev[0][q]], [prev[1][q]], [prev[2][q]]],
+                    }
+                } else {
+                    e
+                };
+                let mut lambda = [pairs.lambda[k]];
+                lanes::project::<1, DAMPED>(
+                    &mut e,
+                    &pr,
+                    &[w[p]],
+                    &[w[q]],
+                    &[pairs.rest[k]],
+                    &Coefs::splat(coef[pairs.group[k] as usize]),
+                    &mut lambda,
+                );
+                pairs.lambda[k] = lambda[0];
+                for a in 0..3 {
+                    x[a][p] = e.p[a][0];
+                    x[a][q] = e.q[a][0];
+                }
+            }
+        }
+    }
+}
+
+/// Loads one end of a chunk: `idx` gives each lane's particle when gathered.
+#[inline(always)]
+fn gather(src: &[f64], idx: &[u32]) -> [f64; LANES] {
+    std::array::from_fn(|l| src[idx[l] as usize])
+}
+
+#[inline(always)]
+fn scatter(dst: &mut [f64], idx: &[u32], val: &[f64; LANES]) {
+    for l in 0..LANES {
+        dst[idx[l] as usize] = val[l];
+    }
+}
+
+/// Both ends of a chunk from one array (positions, previous positions or inverse masses).
+#[inline(always)]
+fn load_ends(src: &[f64], layout: Layout, p: &[u32], q: &[u32]) -> ([f64; LANES], [f64; LANES]) {
+    match layout {
+        Layout::Contiguous => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            let mut a = [0.0; LANES];
+            let mut b = [0.0; LANES];
+            a.copy_from_slice(&src[p0..p0 + LANES]);
+            b.copy_from_slice(&src[q0..q0 + LANES]);
+            (a, b)
+        }
+        Layout::Paired => {
+            let p0 = p[0] as usize;
+            let s = &src[p0..p0 + 2 * LANES];
+            (
+                std::array::from_fn(|l| s[2 * l]),
+                std::array::from_fn(|l| s[2 * l + 1]),
+            )
+        }
+        Layout::Gathered => (gather(src, p), gather(src, q)),
+    }
+}
+
+#[inline(always)]
+fn store_ends(
+    dst: &mut [f64],
+    layout: Layout,
+    p: &[u32],
+    q: &[u32],
+    a: &[f64; LANES],
+    b: &[f64; LANES],
+) {
+    match layout {
+        Layout::Contiguous => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            dst[p0..p0 + LANES].copy_from_slice(a);
+            dst[q0..q0 + LANES].copy_from_slice(b);
+        }
+        Layout::Paired => {
+            let p0 = p[0] as usize;
+            let s = &mut dst[p0..p0 + 2 * LANES];
+            for l in 0..LANES {
+                s[2 * l] = a[l];
+                s[2 * l + 1] = b[l];
+            }
+        }
+        Layout::Gathered => {
+            scatter(dst, p, a);
+            scatter(dst, q, b);
+        }
+    }
+}
+
+#[inline(always)]
+fn project_chunk<const DAMPED: bool>(
+    chunk: &Chunk,
+    pairs: &mut Pairs,
+    x: &mut [Vec<f64>; 3],
+    prev: &[Vec<f64>; 3],
+    w: &[f64],
+    coef: &[Coef],
+) {
+    let r = chunk.start..chunk.start + LANES;
+    let (p, q) = (&pairs.p[r.clone()], &pairs.q[r.clone()]);
+    let mut e = Ends {
+        p: [[0.0; LANES]; 3],
+        q: [[0.0; LANES]; 3],
+    };
+    for a in 0..3 {
+        (e.p[a], e.q[a]) = load_ends(&x[a], chunk.layout, p, q);
+    }
+    let pr = if DAMPED {
+        let mut pr = e;
+        for a in 0..3 {
+            (pr.p[a], pr.q[a]) = load_ends(&prev[a], chunk.layout, p, q);
+        }
+        pr
+    } else {
+        e
+    };
+    let (wp, wq) = load_ends(w, chunk.layout, p, q);
+    let mut rest = [0.0; LANES];
+    rest.copy_from_slice(&pairs.rest[r.clone()]);
+    let groups = &pairs.group[r.clone()];
+    let k = if chunk.uniform {
+        Coefs::splat(coef[groups[0] as usize])
+    } else {
+        Coefs::from_fn(|l| coef[groups[l] as usize])
+    };
+    let mut lambda = [0.0; LANES];
+    lambda.copy_from_slice(&pairs.lambda[r.clone()]);
+    lanes::project::<LANES, DAMPED>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
+    pairs.lambda[r].copy_from_slice(&lambda);
+    for a in 0..3 {
+        store_ends(&mut x[a], chunk.layout, p, q, &e.p[a], &e.q[a]);
+    }
+}
+
+/// Constraints whose particles lie in different domains, projected serially in colour order.
+#[derive(Clone, Debug, Default)]
+struct Links {
+    /// Domain and local index of each end.
+    ends: Vec<[(u32, u32); 2]>,
+    rest: Vec<f64>,
+    group: Vec<u32>,
+    lambda: Vec<f64>,
+}
+
+/// The distance constraints cut into domains, plus the links between them.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Domains {
+    /// Particles per domain (the last may hold fewer).
+    size: usize,
+    /// The domains, in particle order.
+    list: Vec<Domain>,
+    links: Links,
+    /// Multiplier-step coefficients per parameter group, refreshed every frame.
+    coef: Vec<Coef>,
+    /// Whether any enabled group has XPBD damping (γ > 0).
+    damped: bool,
+}
+
+impl Domains {
+    /// Cuts `block` (coloured distance constraints over `n` particles) into domains of `size`.
+    pub fn new(block: &Block<2, Distance>, n: usize, size: usize) -> Self {
+        let size = size.clamp(LANES, n.max(LANES)).next_multiple_of(LANES);
+        let count = n.div_ceil(size).max(1);
+        let mut list: Vec<Domain> = (0..count)
+            .map(|d| {
+                let mut dom = Domain {
+                    start: d * size,
+                    ..Domain::default()
+                };
+                dom.resize(size.min(n - (d * size).min(n)));
+                dom
+            })
+            .collect();
+        let mut links = Links::default();
+        let locate = |i: u32| ((i as usize / size) as u32, (i as usize % size) as u32);
+        let mut interior: Vec<Vec<Interior>> = vec![Vec::new(); count];
+        for k in block.colors.iter().flat_map(|c| c.clone()) {
+            let [p, q] = block.particles[k];
+            let (dp, dq) = (locate(p), locate(q));
+            let (rest, group) = (block.shapes[k].rest, block.group[k]);
+            if dp.0 == dq.0 {
+                // C and its corrections are symmetric in the two ends: store p < q.
+                let (p, q) = (dp.1.min(dq.1), dp.1.max(dq.1));
+                interior[dp.0 as usize].push(Interior { p, q, rest, group });
+            } else {
+                links.ends.push([dp, dq]);
+                links.rest.push(rest);
+                links.group.push(group);
+                links.lambda.push(0.0);
+            }
+        }
+        for (dom, cons) in list.iter_mut().zip(interior) {
+            dom.order(cons);
+        }
+        Self {
+            size,
+            list,
+            links,
+            coef: Vec::new(),
+            damped: false,
+        }
+    }
+
+    /// How the distance constraints were laid out.
+    pub fn stats(&self) -> DomainStats {
+        let mut s = DomainStats {
+            domains: self.list.len(),
+            domain_size: self.size,
+            links: self.links.rest.len(),
+            ..DomainStats::default()
+        };
+        for d in &self.list {
+            for c in &d.chunks {
+                match c.layout {
+                    Layout::Contiguous => s.contiguous += LANES,
+                    Layout::Paired => s.paired += LANES,
+                    Layout::Gathered => s.gathered += LANES,
+                }
+            }
+            for ((_, tail), colour) in d.plan.iter().zip(&d.colours) {
+                s.remainder += colour.end - tail;
+            }
+        }
+        s
+    }
+
+    /// Sets the per-group coefficients for `rule` (with every group's parameters).
+    pub fn prepare(&mut self, params: &[FamilyParams], rule: Rule) {
+        self.coef.clear();
+        self.damped = false;
+        for p in params {
+            let c = match (p.enabled, rule) {
+                (false, _) => Coef {
+                    k: 0.0,
+                    alpha: 1.0,
+                    gamma: 0.0,
+                },
+                (true, Rule::Xpbd { h }) => Coef {
+                    k: 1.0,
+                    alpha: p.compliance / (h * h),
+                    gamma: p.compliance * p.damping / h,
+                },
+                (true, Rule::Pbd) => Coef {
+                    k: p.pbd_stiffness,
+                    alpha: 0.0,
+                    gamma: 0.0,
+                },
+            };
+            self.damped |= c.gamma > 0.0;
+            self.coef.push(c);
+        }
+    }
+
+    /// The domains with their slices of the global arrays, for a parallel region.
+    pub fn par_with<'a>(
+        &'a mut self,
+        x: &'a [DVec3],
+        v: &'a [DVec3],
+        w: &'a [f64],
+    ) -> impl IndexedParallelIterator<Item = (&'a mut Domain, AosChunk<'a>)> + 'a {
+        let size = self.size;
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks(size))
+            .zip(v.par_chunks(size))
+            .zip(w.par_chunks(size))
+            .map(|(((d, x), v), w)| (d, AosChunk { x, v, w }))
+    }
+
+    /// Projects every domain in parallel, then the links; `coef`/`damped` from [`Self::prepare`].
+    pub fn project(&mut self) {
+        let (coef, damped) = (&self.coef[..], self.damped);
+        self.list.par_iter_mut().for_each(|d| d.project(coef, damped));
+        self.project_links();
+    }
+
+    /// Projects every domain (in parallel) and link once, for the given domain-side closure
+    /// run first in the same parallel region (e.g. integration).
+    pub fn project_after<F>(&mut self, x: &[DVec3], v: &[DVec3], w: &[f64], before: F)
+    where
+        F: Fn(&mut Domain, &AosChunk<'_>) + Sync,
+    {
+        let coef = std::mem::take(&mut self.coef);
+        let damped = self.damped;
+        self.par_with(x, v, w).for_each(|(d, aos)| {
+            before(d, &aos);
+            d.project(&coef, damped);
+        });
+        self.coef = coef;
+        self.project_links();
+    }
+
+    /// Clears the link multipliers (the domains clear theirs when integrating).
+    pub fn reset_link_multipliers(&mut self) {
+        self.links.lambda.fill(0.0);
+    }
+
+    /// Projects the links serially, in colour order.
+    fn project_links(&mut self) {
+        if self.damped {
+            self.project_links_with::<true>();
+        } else {
+            self.project_links_with::<false>();
+        }
+    }
+
+    fn project_links_with<const DAMPED: bool>(&mut self) {
+        let Self {
+            list, links, coef, ..
+        } = self;
+        for k in 0..links.rest.len() {
+            let [(dp, ip), (dq, iq)] = links.ends[k];
+            let (dp, ip, dq, iq) = (dp as usize, ip as usize, dq as usize, iq as usize);
+            let get = |d: &Domain, i: usize, prev: bool| {
+                let s = if prev { &d.prev } else { &d.x };
+                [[s[0][i]], [s[1][i]], [s[2][i]]]
+            };
+            let mut e = Ends {
+                p: get(&list[dp], ip, false),
+                q: get(&list[dq], iq, false),
+            };
+            let pr = if DAMPED {
+                Ends {
+                    p: get(&list[dp], ip, true),
+                    q: get(&list[dq], iq, true),
+                }
+            } else {
+                e
+            };
+            let mut lambda = [links.lambda[k]];
+            lanes::project::<1, DAMPED>(
+                &mut e,
+                &pr,
+                &[list[dp].w[ip]],
+                &[list[dq].w[iq]],
+                &[links.rest[k]],
+                &Coefs::splat(coef[links.group[k] as usize]),
+                &mut lambda,
+            );
+            links.lambda[k] = lambda[0];
+            for a in 0..3 {
+                list[dp].x[a][ip] = e.p[a][0];
+                list[dq].x[a][iq] = e.q[a][0];
+            }
+        }
+    }
+
+    /// One sweep on global arrays: copy in, project domains and links, copy positions out.
+    /// `prev` is needed only for XPBD damping. Clears every multiplier first when `fresh`.
+    pub fn project_global(&mut self, x: &mut [DVec3], prev: &[DVec3], w: &[f64], fresh: bool) {
+        let size = self.size;
+        let damped = self.damped;
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks(size))
+            .zip(prev.par_chunks(size))
+            .zip(w.par_chunks(size))
+            .for_each(|(((d, x), prev), w)| {
+                d.load_positions(x, damped.then_some(prev), w);
+                if fresh {
+                    d.pairs.lambda.fill(0.0);
+                }
+            });
+        if fresh {
+            self.reset_link_multipliers();
+        }
+        self.project();
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks_mut(size))
+            .for_each(|(d, x)| d.store_positions(x));
+    }
+
+    /// Ends a fused frame: velocity update and damping, then copies the state back out.
+    pub fn finish(
+        &mut self,
+        inv_h: f64,
+        keep: Option<f64>,
+        x: &mut [DVec3],
+        prev: &mut [DVec3],
+        v: &mut [DVec3],
+    ) {
+        let size = self.size;
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks_mut(size))
+            .zip(prev.par_chunks_mut(size))
+            .zip(v.par_chunks_mut(size))
+            .for_each(|(((d, x), prev), v)| {
+                d.finish_velocities(inv_h, keep);
+                d.store(x, prev, v);
+            });
+    }
+}
+
+/// An interior constraint before ordering (local indices, p < q).
+#[derive(Clone, Copy, Debug)]
+struct Interior {
+    p: u32,
+    q: u32,
+    rest: f64,
+    group: u32,
+}
+
+/// Classes (group, q − p) with at least this many constraints get the structured order.
+const MIN_CLASS: usize = 8 * LANES;
+
+impl Domain {
+    /// Orders the interior constraints into independent sets ("colours") that chunk well.
+    ///
+    /// Constraints of one parameter group and one index offset d = q − p (a grid's rows,
+    /// columns or diagonals) split into two sets by the parity of ⌊p/d⌋: inside a set no two
+    /// constraints share a particle (p and p' = p ± d never have the same parity of ⌊p/d⌋), and
+    /// sorted by p their ends mostly run with unit stride (d ≥ 8) or pairwise (d = 1). Smaller
+    /// classes (irregular meshes) are coloured greedily. The order is a valid Gauss–Seidel
+    /// order and depends only on the mesh and the domain size.
+    fn order(&mut self, mut cons: Vec<Interior>) {
+        cons.sort_by_key(|c| (c.group, c.q - c.p, c.p));
+        let mut rest: Vec<Interior> = Vec::new();
+        let mut sets: Vec<Vec<Interior>> = Vec::new();
+        for class in cons.chunk_by(|a, b| (a.group, a.q - a.p) == (b.group, b.q - b.p)) {
+            if class.len() < MIN_CLASS {
+                rest.extend_from_slice(class);
+                continue;
+            }
+            let d = class[0].q - class[0].p;
+            let (even, odd): (Vec<Interior>, Vec<Interior>) =
+                class.iter().partition(|c| (c.p / d) % 2 == 0);
+            sets.extend([even, odd].into_iter().filter(|s| !s.is_empty()));
+        }
+        let pairs: Vec<[u32; 2]> = rest.iter().map(|c| [c.p, c.q]).collect();
+        let colours = color(&pairs, &vec![true; self.len()]);
+        let mut by_colour: Vec<Vec<Interior>> = Vec::new();
+        for (c, colour) in rest.iter().zip(colours) {
+            let colour = colour as usize;
+            if by_colour.len() <= colour {
+                by_colour.resize(colour + 1, Vec::new());
+            }
+            by_colour[colour].push(*c);
+        }
+        sets.extend(by_colour);
+        for set in sets {
+            let begin = self.pairs.p.len();
+            for c in set {
+                self.pairs.push(c.p, c.q, c.rest, c.group);
+            }
+            self.colours.push(begin..self.pairs.p.len());
+        }
+        self.plan_chunks();
+    }
+
+    /// Splits every colour into full chunks of [`LANES`] (classified by layout) and a remainder.
+    fn plan_chunks(&mut self) {
+        let pairs = &self.pairs;
+        for colour in &self.colours {
+            let first = self.chunks.len();
+            let mut k = colour.start;
+            while k + LANES <= colour.end {
+                let (p, q) = (&pairs.p[k..k + LANES], &pairs.q[k..k + LANES]);
+                let contiguous =
+                    (0..LANES).all(|l| p[l] == p[0] + l as u32 && q[l] == q[0] + l as u32);
+                let paired =
+                    (0..LANES).all(|l| p[l] == p[0] + 2 * l as u32 && q[l] == p[l] + 1);
+                let layout = if contiguous {
+                    Layout::Contiguous
+                } else if paired {
+                    Layout::Paired
+                } else {
+                    Layout::Gathered
+                };
+                let g = &pairs.group[k..k + LANES];
+                self.chunks.push(Chunk {
+                    start: k,
+                    layout,
+                    uniform: g.iter().all(|&x| x == g[0]),
+                });
+                k += LANES;
+            }
+            self.plan.push((first..self.chunks.len(), k));
+        }
+    }
+}
