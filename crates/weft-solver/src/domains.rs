@@ -15,9 +15,14 @@
 //! pairwise (`Layout::Paired`, every other horizontal edge): those chunks load and store with
 //! unit stride, and anything else is gathered lane by lane.
 
+// Lane and axis loops index several arrays in step; written as index loops on purpose so
+// that each compiles to one vector operation per axis.
+#![allow(clippy::needless_range_loop)]
+
 use std::ops::Range;
 
 use glam::DVec3;
+use multiversion::multiversion;
 use rayon::prelude::*;
 
 use crate::coloring::color;
@@ -206,24 +211,12 @@ impl Domain {
         }
     }
 
-    /// Semi-implicit Euler prediction with a = g + c_d (v_wind − v), then pins; clears the
-    /// multipliers — the same arithmetic as the solver's general loop.
-    pub fn integrate(&mut self, step: &Integration<'_>) {
-        let h = step.h;
-        let f = step.forces;
-        for a in 0..3 {
-            let (g, wv) = (f.gravity[a], f.wind.velocity[a]);
-            let (x, v, prev) = (&mut self.x[a], &mut self.v[a], &mut self.prev[a]);
-            for i in 0..self.w.len() {
-                prev[i] = x[i];
-                let acc = g + f.wind.drag * (wv - v[i]);
-                let vi = v[i] + acc * h;
-                let xi = x[i] + vi * h;
-                let free = self.w[i] > 0.0;
-                v[i] = if free { vi } else { v[i] };
-                x[i] = if free { xi } else { x[i] };
-            }
-        }
+    /// Ends the previous substep when `finish` is given (v = (x − x_prev)/h, then damping
+    /// v ← v·keep of free particles), then predicts with semi-implicit Euler, a = g + c_d (v_wind
+    /// − v), and applies the pins — the same arithmetic, particle by particle, as the solver's
+    /// general loop. Clears the multipliers when `lambda`.
+    pub fn integrate(&mut self, step: &Integration<'_>, finish: Option<Finish>, lambda: bool) {
+        advance(self, step, finish);
         let range = self.start..self.start + self.len();
         for &(i, p) in step.pins {
             if range.contains(&i) {
@@ -232,62 +225,134 @@ impl Domain {
                 }
             }
         }
-        self.pairs.lambda.fill(0.0);
-    }
-
-    /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
-    pub fn project(&mut self, coef: &[Coef], damped: bool) {
-        if damped {
-            self.project_with::<true>(coef);
-        } else {
-            self.project_with::<false>(coef);
+        if lambda {
+            self.pairs.lambda.fill(0.0);
         }
     }
 
-    fn project_with<const DAMPED: bool>(&mut self, coef: &[Coef]) {
-        let Self {
-            x,
-            prev,
-            w,
-            pairs,
-            chunks,
-            plan,
-            colours,
-            ..
-        } = self;
-        for (c, (chunk_range, tail)) in plan.iter().enumerate() {
-            for chunk in &chunks[chunk_range.clone()] {
-                project_chunk::<DAMPED>(chunk, pairs, x, prev, w, coef);
+    /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
+    pub fn project(&mut self, coef: &[Coef], mode: Mode) {
+        sweep(self, coef, mode);
+    }
+}
+
+/// Which optional terms a sweep evaluates; both off gives the same bits as both on with
+/// γ = 0 and α̃ = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Mode {
+    /// Some group has XPBD damping (γ > 0): read previous positions.
+    pub damped: bool,
+    /// Some group has compliance (α̃ > 0): keep multipliers.
+    pub lambda: bool,
+}
+
+/// How a fused substep ends the previous one: 1/h and the damping factor, if any.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Finish {
+    /// 1/h (1/s).
+    pub inv_h: f64,
+    /// Velocity factor e^(−c h) of global damping, if any.
+    pub keep: Option<f64>,
+}
+
+/// The per-particle part of [`Domain::integrate`], compiled like [`sweep`].
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
+    "x86_64+avx2+fma",
+    "aarch64+neon"
+))]
+fn advance<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    let h = step.h;
+    let f = step.forces;
+    let w = &dom.w[..];
+    for a in 0..3 {
+        let (g, wv, drag) = (f.gravity[a], f.wind.velocity[a], f.wind.drag);
+        let (x, v, prev) = (&mut dom.x[a][..], &mut dom.v[a][..], &mut dom.prev[a][..]);
+        let (x, v, prev) = (&mut x[..w.len()], &mut v[..w.len()], &mut prev[..w.len()]);
+        if let Some(Finish { inv_h, keep }) = finish {
+            for i in 0..w.len() {
+                v[i] = (x[i] - prev[i]) * inv_h;
             }
-            for k in *tail..colours[c].end {
-                let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
-                let mut e = Ends {
-                    p: [[x[0][p]], [x[1][p]], [x[2][p]]],
-                    q: [[x[0][q]], [x[1][q]], [x[2][q]]],
-                };
-                let pr = if DAMPED {
-                    Ends {
-                        p: [[prev[0][p]], [prev[1][p]], [prev[2][p]]],
-                        q: [[prev[0][q]], [prev[1][q]], [prev[2][q]]],
-                    }
-                } else {
-                    e
-                };
-                let mut lambda = [pairs.lambda[k]];
-                lanes::project::<1, DAMPED>(
-                    &mut e,
-                    &pr,
-                    &[w[p]],
-                    &[w[q]],
-                    &[pairs.rest[k]],
-                    &Coefs::splat(coef[pairs.group[k] as usize]),
-                    &mut lambda,
-                );
-                pairs.lambda[k] = lambda[0];
-                for a in 0..3 {
-                    x[a][p] = e.p[a][0];
-                    x[a][q] = e.q[a][0];
+            if let Some(keep) = keep {
+                for i in 0..w.len() {
+                    v[i] = if w[i] > 0.0 { v[i] * keep } else { v[i] };
                 }
+            }
+        }
+        for i in 0..w.len() {
+            prev[i] = x[i];
+            let acc = g + drag * (wv - v[i]);
+            let vi = v[i] + acc * h;
+            let xi = x[i] + vi * h;
+            let free = w[i] > 0.0;
+            v[i] = if free { vi } else { v[i] };
+            x[i] = if free { xi } else { x[i] };
+        }
+    }
+}
+
+/// [`Domain::project`], compiled for the widest vector unit the CPU has (picked at run time;
+/// every version does the same IEEE operations, so results do not depend on the CPU).
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
+    "x86_64+avx2+fma",
+    "aarch64+neon"
+))]
+fn sweep(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+    match (mode.damped, mode.lambda) {
+        (false, false) => sweep_with::<false, false>(dom, coef),
+        (false, true) => sweep_with::<false, true>(dom, coef),
+        (true, false) => sweep_with::<true, false>(dom, coef),
+        (true, true) => sweep_with::<true, true>(dom, coef),
+    }
+}
+
+#[inline(always)]
+fn sweep_with<const DAMPED: bool, const LAMBDA: bool>(dom: &mut Domain, coef: &[Coef]) {
+    let Domain {
+        x,
+        prev,
+        w,
+        pairs,
+        chunks,
+        plan,
+        colours,
+        ..
+    } = dom;
+    for (c, (chunk_range, tail)) in plan.iter().enumerate() {
+        for chunk in &chunks[chunk_range.clone()] {
+            project_chunk::<DAMPED, LAMBDA>(chunk, pairs, x, prev, w, coef);
+        }
+        for k in *tail..colours[c].end {
+            let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
+            let mut e = Ends {
+                p: [[x[0][p]], [x[1][p]], [x[2][p]]],
+                q: [[x[0][q]], [x[1][q]], [x[2][q]]],
+            };
+            let pr = if DAMPED {
+                Ends {
+                    p: [[prev[0][p]], [prev[1][p]], [prev[2][p]]],
+                    q: [[prev[0][q]], [prev[1][q]], [prev[2][q]]],
+                }
+            } else {
+                e
+            };
+            let mut lambda = [if LAMBDA { pairs.lambda[k] } else { 0.0 }];
+            lanes::project::<1, DAMPED>(
+                &mut e,
+                &pr,
+                &[w[p]],
+                &[w[q]],
+                &[pairs.rest[k]],
+                &Coefs::splat(coef[pairs.group[k] as usize]),
+                &mut lambda,
+            );
+            if LAMBDA {
+                pairs.lambda[k] = lambda[0];
+            }
+            for a in 0..3 {
+                x[a][p] = e.p[a][0];
+                x[a][q] = e.q[a][0];
             }
         }
     }
@@ -308,8 +373,8 @@ fn scatter(dst: &mut [f64], idx: &[u32], val: &[f64; LANES]) {
 
 /// Both ends of a chunk from one array (positions, previous positions or inverse masses).
 #[inline(always)]
-fn load_ends(src: &[f64], layout: Layout, p: &[u32], q: &[u32]) -> ([f64; LANES], [f64; LANES]) {
-    match layout {
+fn load_ends<const LAYOUT: u8>(src: &[f64], p: &[u32], q: &[u32]) -> ([f64; LANES], [f64; LANES]) {
+    match layout_of(LAYOUT) {
         Layout::Contiguous => {
             let (p0, q0) = (p[0] as usize, q[0] as usize);
             let mut a = [0.0; LANES];
@@ -331,15 +396,14 @@ fn load_ends(src: &[f64], layout: Layout, p: &[u32], q: &[u32]) -> ([f64; LANES]
 }
 
 #[inline(always)]
-fn store_ends(
+fn store_ends<const LAYOUT: u8>(
     dst: &mut [f64],
-    layout: Layout,
     p: &[u32],
     q: &[u32],
     a: &[f64; LANES],
     b: &[f64; LANES],
 ) {
-    match layout {
+    match layout_of(LAYOUT) {
         Layout::Contiguous => {
             let (p0, q0) = (p[0] as usize, q[0] as usize);
             dst[p0..p0 + LANES].copy_from_slice(a);
@@ -360,8 +424,37 @@ fn store_ends(
     }
 }
 
+/// The layout a `const` layout number stands for (const generics take no enums on stable).
 #[inline(always)]
-fn project_chunk<const DAMPED: bool>(
+const fn layout_of(n: u8) -> Layout {
+    match n {
+        0 => Layout::Contiguous,
+        1 => Layout::Paired,
+        _ => Layout::Gathered,
+    }
+}
+
+#[inline(always)]
+fn project_chunk<const DAMPED: bool, const LAMBDA: bool>(
+    chunk: &Chunk,
+    pairs: &mut Pairs,
+    x: &mut [Vec<f64>; 3],
+    prev: &[Vec<f64>; 3],
+    w: &[f64],
+    coef: &[Coef],
+) {
+    // One specialised body per layout keeps every lane array in registers (a layout
+    // switch inside the per-axis loops made the compiler spill them and reload with
+    // masked loads, which cannot forward from the stores).
+    match chunk.layout {
+        Layout::Contiguous => project_laid_out::<DAMPED, LAMBDA, 0>(chunk, pairs, x, prev, w, coef),
+        Layout::Paired => project_laid_out::<DAMPED, LAMBDA, 1>(chunk, pairs, x, prev, w, coef),
+        Layout::Gathered => project_laid_out::<DAMPED, LAMBDA, 2>(chunk, pairs, x, prev, w, coef),
+    }
+}
+
+#[inline(always)]
+fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8>(
     chunk: &Chunk,
     pairs: &mut Pairs,
     x: &mut [Vec<f64>; 3],
@@ -375,19 +468,20 @@ fn project_chunk<const DAMPED: bool>(
         p: [[0.0; LANES]; 3],
         q: [[0.0; LANES]; 3],
     };
-    for a in 0..3 {
-        (e.p[a], e.q[a]) = load_ends(&x[a], chunk.layout, p, q);
-    }
+    let [x0, x1, x2] = x;
+    (e.p[0], e.q[0]) = load_ends::<LAYOUT>(x0, p, q);
+    (e.p[1], e.q[1]) = load_ends::<LAYOUT>(x1, p, q);
+    (e.p[2], e.q[2]) = load_ends::<LAYOUT>(x2, p, q);
     let pr = if DAMPED {
         let mut pr = e;
         for a in 0..3 {
-            (pr.p[a], pr.q[a]) = load_ends(&prev[a], chunk.layout, p, q);
+            (pr.p[a], pr.q[a]) = load_ends::<LAYOUT>(&prev[a], p, q);
         }
         pr
     } else {
         e
     };
-    let (wp, wq) = load_ends(w, chunk.layout, p, q);
+    let (wp, wq) = load_ends::<LAYOUT>(w, p, q);
     let mut rest = [0.0; LANES];
     rest.copy_from_slice(&pairs.rest[r.clone()]);
     let groups = &pairs.group[r.clone()];
@@ -397,12 +491,16 @@ fn project_chunk<const DAMPED: bool>(
         Coefs::from_fn(|l| coef[groups[l] as usize])
     };
     let mut lambda = [0.0; LANES];
-    lambda.copy_from_slice(&pairs.lambda[r.clone()]);
-    lanes::project::<LANES, DAMPED>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
-    pairs.lambda[r].copy_from_slice(&lambda);
-    for a in 0..3 {
-        store_ends(&mut x[a], chunk.layout, p, q, &e.p[a], &e.q[a]);
+    if LAMBDA {
+        lambda.copy_from_slice(&pairs.lambda[r.clone()]);
     }
+    lanes::project::<LANES, DAMPED>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
+    if LAMBDA {
+        pairs.lambda[r].copy_from_slice(&lambda);
+    }
+    store_ends::<LAYOUT>(x0, p, q, &e.p[0], &e.q[0]);
+    store_ends::<LAYOUT>(x1, p, q, &e.p[1], &e.q[1]);
+    store_ends::<LAYOUT>(x2, p, q, &e.p[2], &e.q[2]);
 }
 
 /// Constraints whose particles lie in different domains, projected serially in colour order.
@@ -425,8 +523,8 @@ pub(crate) struct Domains {
     links: Links,
     /// Multiplier-step coefficients per parameter group, refreshed every frame.
     coef: Vec<Coef>,
-    /// Whether any enabled group has XPBD damping (γ > 0).
-    damped: bool,
+    /// Which optional terms the coefficients need.
+    mode: Mode,
 }
 
 impl Domains {
@@ -470,7 +568,7 @@ impl Domains {
             list,
             links,
             coef: Vec::new(),
-            damped: false,
+            mode: Mode::default(),
         }
     }
 
@@ -497,10 +595,15 @@ impl Domains {
         s
     }
 
+    /// Which optional terms the current coefficients need.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
     /// Sets the per-group coefficients for `rule` (with every group's parameters).
     pub fn prepare(&mut self, params: &[FamilyParams], rule: Rule) {
         self.coef.clear();
-        self.damped = false;
+        self.mode = Mode::default();
         for p in params {
             let c = match (p.enabled, rule) {
                 (false, _) => Coef {
@@ -519,7 +622,10 @@ impl Domains {
                     gamma: 0.0,
                 },
             };
-            self.damped |= c.gamma > 0.0;
+            if p.enabled {
+                self.mode.damped |= c.gamma > 0.0;
+                self.mode.lambda |= c.alpha > 0.0;
+            }
             self.coef.push(c);
         }
     }
@@ -542,8 +648,8 @@ impl Domains {
 
     /// Projects every domain in parallel, then the links; `coef`/`damped` from [`Self::prepare`].
     pub fn project(&mut self) {
-        let (coef, damped) = (&self.coef[..], self.damped);
-        self.list.par_iter_mut().for_each(|d| d.project(coef, damped));
+        let (coef, mode) = (&self.coef[..], self.mode);
+        self.list.par_iter_mut().for_each(|d| d.project(coef, mode));
         self.project_links();
     }
 
@@ -554,10 +660,10 @@ impl Domains {
         F: Fn(&mut Domain, &AosChunk<'_>) + Sync,
     {
         let coef = std::mem::take(&mut self.coef);
-        let damped = self.damped;
+        let mode = self.mode;
         self.par_with(x, v, w).for_each(|(d, aos)| {
             before(d, &aos);
-            d.project(&coef, damped);
+            d.project(&coef, mode);
         });
         self.coef = coef;
         self.project_links();
@@ -570,7 +676,7 @@ impl Domains {
 
     /// Projects the links serially, in colour order.
     fn project_links(&mut self) {
-        if self.damped {
+        if self.mode.damped {
             self.project_links_with::<true>();
         } else {
             self.project_links_with::<false>();
@@ -622,7 +728,7 @@ impl Domains {
     /// `prev` is needed only for XPBD damping. Clears every multiplier first when `fresh`.
     pub fn project_global(&mut self, x: &mut [DVec3], prev: &[DVec3], w: &[f64], fresh: bool) {
         let size = self.size;
-        let damped = self.damped;
+        let damped = self.mode.damped;
         self.list
             .par_iter_mut()
             .zip(x.par_chunks(size))
@@ -732,8 +838,7 @@ impl Domain {
                 let (p, q) = (&pairs.p[k..k + LANES], &pairs.q[k..k + LANES]);
                 let contiguous =
                     (0..LANES).all(|l| p[l] == p[0] + l as u32 && q[l] == q[0] + l as u32);
-                let paired =
-                    (0..LANES).all(|l| p[l] == p[0] + 2 * l as u32 && q[l] == p[l] + 1);
+                let paired = (0..LANES).all(|l| p[l] == p[0] + 2 * l as u32 && q[l] == p[l] + 1);
                 let layout = if contiguous {
                     Layout::Contiguous
                 } else if paired {

@@ -30,7 +30,7 @@ impl Default for Settings {
             substeps: 10,
             iterations: 1,
             divergence_bound: 1.0e4,
-            domain_size: 2048,
+            domain_size: 4096,
         }
     }
 }

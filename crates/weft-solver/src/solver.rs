@@ -5,7 +5,7 @@ use std::ops::Range;
 use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, Residual, Rule};
-use crate::domains::{DomainStats, Domains, Integration};
+use crate::domains::{DomainStats, Domains, Finish, Integration};
 use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
 use crate::hook::{SubstepContext, SubstepHook};
@@ -342,6 +342,7 @@ impl Solver {
         let inv_h = 1.0 / h;
         let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
         self.domains.prepare(&self.params, rule);
+        let lambda = self.domains.mode().lambda;
         for k in 0..s.substeps {
             self.substep_targets(k);
             let step = Integration {
@@ -353,12 +354,13 @@ impl Solver {
             self.domains.reset_link_multipliers();
             self.domains
                 .project_after(&p.positions, &p.velocities, &p.inv_masses, |d, aos| {
-                    if k == 0 {
+                    let finish = if k == 0 {
                         d.load(aos);
+                        None
                     } else {
-                        d.finish_velocities(inv_h, keep);
-                    }
-                    d.integrate(&step);
+                        Some(Finish { inv_h, keep })
+                    };
+                    d.integrate(&step, finish, lambda);
                 });
             for _ in 1..s.iterations {
                 self.domains.project();
@@ -431,7 +433,6 @@ impl Solver {
                             &p.inv_masses,
                             &self.params,
                             rule,
-                            s.domain_size,
                         );
                         stats.contacts = hook.project(&ctx, p);
                     }

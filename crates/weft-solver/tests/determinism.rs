@@ -76,8 +76,16 @@ fn results_are_bit_identical_across_thread_counts() {
     for method in [Method::Xpbd, Method::Pbd, Method::MassSpring] {
         let reference = run_in_pool(1, method, 256);
         assert_eq!(reference, run_in_pool(1, method, 256), "{method}: twice");
-        assert_eq!(reference, run_in_pool(2, method, 256), "{method}: 2 threads");
-        assert_eq!(reference, run_in_pool(4, method, 256), "{method}: 4 threads");
+        assert_eq!(
+            reference,
+            run_in_pool(2, method, 256),
+            "{method}: 2 threads"
+        );
+        assert_eq!(
+            reference,
+            run_in_pool(4, method, 256),
+            "{method}: 4 threads"
+        );
         // The run really moved the cloth (a frozen state would be trivially identical).
         let start = bits(&build(method, 256));
         assert_ne!(reference, start);

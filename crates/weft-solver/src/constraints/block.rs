@@ -9,6 +9,9 @@ use super::Shape;
 use crate::coloring::color;
 use crate::params::FamilyParams;
 
+/// Colours with at least this many constraints are computed in parallel (dihedral, tethers).
+const PARALLEL_MIN_BATCH: usize = 4096;
+
 /// How a position-based method turns C and ∇C into a multiplier step Δλ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Rule {
@@ -173,7 +176,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
 
     /// One Gauss–Seidel sweep, colour by colour.
     ///
-    /// A colour with at least `par_min` constraints is computed in parallel into scratch and then
+    /// A colour with at least [`PARALLEL_MIN_BATCH`] constraints is computed in parallel into scratch and then
     /// applied in order; a smaller one is computed and applied constraint by constraint. Inside a
     /// colour no two constraints share a free particle, so both paths read the same inputs, do the
     /// same arithmetic and give bit-identical results, whatever the thread count.
@@ -184,7 +187,6 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
         w: &[f64],
         params: &[FamilyParams],
         rule: Rule,
-        par_min: usize,
     ) {
         for c in 0..self.colors.len() {
             let r = self.colors[c].clone();
@@ -192,7 +194,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
             let shapes = &self.shapes[r.clone()];
             let groups = &self.group[r.clone()];
             let lambda = &mut self.lambda[r.clone()];
-            if r.len() >= par_min.max(1) {
+            if r.len() >= PARALLEL_MIN_BATCH {
                 let xr: &[DVec3] = x;
                 let deltas = &mut self.deltas[..r.len()];
                 deltas

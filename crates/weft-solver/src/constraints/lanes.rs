@@ -5,6 +5,10 @@
 //! the same order, so a constraint gets bit-identical results whichever path projects it; that is
 //! what keeps runs independent of the thread count and of how constraints fall into chunks.
 
+// Lane and axis loops index several arrays in step; written as index loops on purpose so
+// that each compiles to one vector operation per axis.
+#![allow(clippy::needless_range_loop)]
+
 /// Lanes per SIMD chunk (8 × f64: one AVX-512 register, two AVX2 ones, four SSE2 ones).
 pub(crate) const LANES: usize = 8;
 
@@ -107,7 +111,8 @@ pub(crate) fn project<const L: usize, const DAMPED: bool>(
             let inv = 1.0 / len[l];
             let c = len[l] - rest[l];
             let denom = (1.0 + coef.gamma[l]) * (wp[l] + wq[l]) + coef.alpha[l];
-            let num = -coef.k[l] * c - coef.alpha[l] * lambda[l] - coef.gamma[l] * (grad_dx[l] * inv);
+            let num =
+                -coef.k[l] * c - coef.alpha[l] * lambda[l] - coef.gamma[l] * (grad_dx[l] * inv);
             let ok = (len[l] >= 1e-9) & (denom > f64::MIN_POSITIVE);
             let dl = if ok { num / denom } else { 0.0 };
             lambda[l] += dl;

@@ -79,10 +79,9 @@ impl ConstraintSet {
         w: &[f64],
         params: &[FamilyParams],
         rule: Rule,
-        par_min: usize,
     ) {
-        self.dihedral.project(x, prev, w, params, rule, par_min);
-        self.tethers.project(x, prev, w, params, rule, par_min);
+        self.dihedral.project(x, prev, w, params, rule);
+        self.tethers.project(x, prev, w, params, rule);
     }
 
     /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N).
