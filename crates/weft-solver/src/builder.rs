@@ -95,8 +95,16 @@ impl SolverBuilder {
         }
         let topo = Topology::new(&mesh.triangles);
         if params.get(Family::BendDistance).enabled {
-            for wing in &topo.wings {
-                let (a, b) = (wing.wing_a, wing.wing_b);
+            // Two edges can share a wing pair (on a grid with alternating diagonals, the pair
+            // two apart across a vertex); each pair gets one constraint, not one per edge.
+            let mut pairs: Vec<(u32, u32)> = topo
+                .wings
+                .iter()
+                .map(|w| (w.wing_a.min(w.wing_b), w.wing_a.max(w.wing_b)))
+                .collect();
+            pairs.sort_unstable();
+            pairs.dedup();
+            for (a, b) in pairs {
                 self.distance.push(
                     [g(a), g(b)],
                     group(Family::BendDistance),

@@ -38,6 +38,15 @@ pub(crate) enum Layout {
     Contiguous,
     /// p = p₀ + 2l and q = p + 1: one unit-stride load of 16 particles, de-interleaved.
     Paired,
+    /// p = p₀ + (0, 1, 4, 5, 8, 9, 12, 13) and q = p + 2 (every other pair of a row's
+    /// two-apart bending pairs): one unit-stride load of 16 particles, permuted.
+    Quad,
+    /// p = p₀ + 4l and q = p + 2 (two-apart bending pairs at every other vertex): one
+    /// unit-stride load of 31 particles, permuted.
+    Spaced,
+    /// p = p₀ + 2l and q = q₀ + 2l with the two 15-particle windows apart: two unit-stride
+    /// loads, even slots taken (a diagonal family on alternating-diagonal grids).
+    Strided,
     /// Anything else: one load per lane.
     Gathered,
 }
@@ -53,8 +62,8 @@ pub struct DomainStats {
     pub links: usize,
     /// Interior constraints in chunks of 8 with unit-stride ends.
     pub contiguous: usize,
-    /// Interior constraints in chunks of 8 over 16 consecutive particles, pairwise.
-    pub paired: usize,
+    /// Interior constraints in chunks of 8 loaded from 16-particle windows and permuted.
+    pub strided: usize,
     /// Interior constraints in chunks of 8 loaded lane by lane.
     pub gathered: usize,
     /// Interior constraints solved one at a time (the tail of each colour).
@@ -391,9 +400,42 @@ fn load_ends<const LAYOUT: u8>(src: &[f64], p: &[u32], q: &[u32]) -> ([f64; LANE
                 std::array::from_fn(|l| s[2 * l + 1]),
             )
         }
+        Layout::Quad => {
+            let p0 = p[0] as usize;
+            let s = &src[p0..p0 + 2 * LANES];
+            (
+                std::array::from_fn(|l| s[QUAD[l]]),
+                std::array::from_fn(|l| s[QUAD[l] + 2]),
+            )
+        }
+        Layout::Spaced => {
+            let p0 = p[0] as usize;
+            let s = &src[p0..p0 + SPACED];
+            (
+                std::array::from_fn(|l| s[4 * l]),
+                std::array::from_fn(|l| s[4 * l + 2]),
+            )
+        }
+        Layout::Strided => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            let (sp, sq) = (&src[p0..p0 + STRIDED], &src[q0..q0 + STRIDED]);
+            (
+                std::array::from_fn(|l| sp[2 * l]),
+                std::array::from_fn(|l| sq[2 * l]),
+            )
+        }
         Layout::Gathered => (gather(src, p), gather(src, q)),
     }
 }
+
+/// Offsets of the first ends in a [`Layout::Quad`] chunk.
+const QUAD: [usize; LANES] = [0, 1, 4, 5, 8, 9, 12, 13];
+
+/// Window of a [`Layout::Spaced`] chunk: first ends at 0, 4, …, 28, second ends 2 further.
+const SPACED: usize = 4 * LANES - 1;
+
+/// Window of a [`Layout::Strided`] end: lanes at even offsets 0..=14.
+const STRIDED: usize = 2 * LANES - 1;
 
 #[inline(always)]
 fn store_ends<const LAYOUT: u8>(
@@ -417,6 +459,39 @@ fn store_ends<const LAYOUT: u8>(
                 s[2 * l + 1] = b[l];
             }
         }
+        Layout::Quad => {
+            let p0 = p[0] as usize;
+            let s = &mut dst[p0..p0 + 2 * LANES];
+            for l in 0..LANES {
+                s[QUAD[l]] = a[l];
+                s[QUAD[l] + 2] = b[l];
+            }
+        }
+        Layout::Spaced => {
+            // Read, replace the chunk's slots, write back: the other slots (odd offsets) are
+            // particles no lane of this chunk touches, so they keep their values.
+            let p0 = p[0] as usize;
+            let mut win = [0.0; SPACED];
+            win.copy_from_slice(&dst[p0..p0 + SPACED]);
+            for l in 0..LANES {
+                win[4 * l] = a[l];
+                win[4 * l + 2] = b[l];
+            }
+            dst[p0..p0 + SPACED].copy_from_slice(&win);
+        }
+        Layout::Strided => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            for (start, v) in [(p0, a), (q0, b)] {
+                // Read, replace the even slots, write the window back: the odd slots are
+                // particles no other lane of this chunk touches, so they keep their values.
+                let mut win = [0.0; STRIDED];
+                win.copy_from_slice(&dst[start..start + STRIDED]);
+                for l in 0..LANES {
+                    win[2 * l] = v[l];
+                }
+                dst[start..start + STRIDED].copy_from_slice(&win);
+            }
+        }
         Layout::Gathered => {
             scatter(dst, p, a);
             scatter(dst, q, b);
@@ -430,6 +505,9 @@ const fn layout_of(n: u8) -> Layout {
     match n {
         0 => Layout::Contiguous,
         1 => Layout::Paired,
+        2 => Layout::Quad,
+        3 => Layout::Strided,
+        4 => Layout::Spaced,
         _ => Layout::Gathered,
     }
 }
@@ -449,7 +527,10 @@ fn project_chunk<const DAMPED: bool, const LAMBDA: bool>(
     match chunk.layout {
         Layout::Contiguous => project_laid_out::<DAMPED, LAMBDA, 0>(chunk, pairs, x, prev, w, coef),
         Layout::Paired => project_laid_out::<DAMPED, LAMBDA, 1>(chunk, pairs, x, prev, w, coef),
-        Layout::Gathered => project_laid_out::<DAMPED, LAMBDA, 2>(chunk, pairs, x, prev, w, coef),
+        Layout::Quad => project_laid_out::<DAMPED, LAMBDA, 2>(chunk, pairs, x, prev, w, coef),
+        Layout::Strided => project_laid_out::<DAMPED, LAMBDA, 3>(chunk, pairs, x, prev, w, coef),
+        Layout::Spaced => project_laid_out::<DAMPED, LAMBDA, 4>(chunk, pairs, x, prev, w, coef),
+        Layout::Gathered => project_laid_out::<DAMPED, LAMBDA, 5>(chunk, pairs, x, prev, w, coef),
     }
 }
 
@@ -584,7 +665,9 @@ impl Domains {
             for c in &d.chunks {
                 match c.layout {
                     Layout::Contiguous => s.contiguous += LANES,
-                    Layout::Paired => s.paired += LANES,
+                    Layout::Paired | Layout::Quad | Layout::Spaced | Layout::Strided => {
+                        s.strided += LANES
+                    }
                     Layout::Gathered => s.gathered += LANES,
                 }
             }
@@ -803,8 +886,19 @@ impl Domain {
                 continue;
             }
             let d = class[0].q - class[0].p;
-            let (even, odd): (Vec<Interior>, Vec<Interior>) =
-                class.iter().partition(|c| (c.p / d) % 2 == 0);
+            // A repeated pair (a mesh may give the same bending pair twice) would share both
+            // particles with its twin: the repeats go to the greedy colouring.
+            let mut even = Vec::new();
+            let mut odd = Vec::new();
+            for (k, c) in class.iter().enumerate() {
+                if k > 0 && class[k - 1].p == c.p {
+                    rest.push(*c);
+                } else if (c.p / d) % 2 == 0 {
+                    even.push(*c);
+                } else {
+                    odd.push(*c);
+                }
+            }
             sets.extend([even, odd].into_iter().filter(|s| !s.is_empty()));
         }
         let pairs: Vec<[u32; 2]> = rest.iter().map(|c| [c.p, c.q]).collect();
@@ -830,31 +924,192 @@ impl Domain {
 
     /// Splits every colour into full chunks of [`LANES`] (classified by layout) and a remainder.
     fn plan_chunks(&mut self) {
-        let pairs = &self.pairs;
-        for colour in &self.colours {
+        for c in 0..self.colours.len() {
+            let colour = self.colours[c].clone();
+            // Greedy scan in particle order: eight constraints that fit a unit-stride layout
+            // make a chunk; a constraint that starts no such chunk (a run's ragged end, say at
+            // the end of a grid row) waits for the gathered chunks at the end of the set.
+            let mut order = Vec::with_capacity(colour.len());
+            let mut leftovers = Vec::new();
+            let mut layouts = Vec::new();
+            let mut k = colour.start;
+            while k < colour.end {
+                if k + LANES <= colour.end
+                    && let Some(layout) =
+                        structured_layout(&self.pairs.p[k..k + LANES], &self.pairs.q[k..k + LANES])
+                {
+                    order.extend(k..k + LANES);
+                    layouts.push(layout);
+                    k += LANES;
+                } else {
+                    leftovers.push(k);
+                    k += 1;
+                }
+            }
+            order.extend(leftovers);
+            let pairs = &mut self.pairs;
+            let take = |v: &Vec<u32>| order.iter().map(|&k| v[k]).collect::<Vec<u32>>();
+            let (p, q, group) = (take(&pairs.p), take(&pairs.q), take(&pairs.group));
+            let rest: Vec<f64> = order.iter().map(|&k| pairs.rest[k]).collect();
+            pairs.p[colour.clone()].copy_from_slice(&p);
+            pairs.q[colour.clone()].copy_from_slice(&q);
+            pairs.group[colour.clone()].copy_from_slice(&group);
+            pairs.rest[colour.clone()].copy_from_slice(&rest);
             let first = self.chunks.len();
             let mut k = colour.start;
-            while k + LANES <= colour.end {
-                let (p, q) = (&pairs.p[k..k + LANES], &pairs.q[k..k + LANES]);
-                let contiguous =
-                    (0..LANES).all(|l| p[l] == p[0] + l as u32 && q[l] == q[0] + l as u32);
-                let paired = (0..LANES).all(|l| p[l] == p[0] + 2 * l as u32 && q[l] == p[l] + 1);
-                let layout = if contiguous {
-                    Layout::Contiguous
-                } else if paired {
-                    Layout::Paired
-                } else {
-                    Layout::Gathered
-                };
+            let structured = layouts.into_iter().map(Some);
+            for layout in structured.chain(std::iter::repeat(None)) {
+                if k + LANES > colour.end {
+                    break;
+                }
                 let g = &pairs.group[k..k + LANES];
                 self.chunks.push(Chunk {
                     start: k,
-                    layout,
+                    layout: layout.unwrap_or(Layout::Gathered),
                     uniform: g.iter().all(|&x| x == g[0]),
                 });
                 k += LANES;
             }
             self.plan.push((first..self.chunks.len(), k));
         }
+    }
+}
+
+/// The unit-stride layout eight independent constraints fit, if any.
+fn structured_layout(p: &[u32], q: &[u32]) -> Option<Layout> {
+    let all = |f: &dyn Fn(usize) -> bool| (0..LANES).all(f);
+    if all(&|l| p[l] == p[0] + l as u32 && q[l] == q[0] + l as u32) {
+        Some(Layout::Contiguous)
+    } else if all(&|l| p[l] == p[0] + 2 * l as u32 && q[l] == p[l] + 1) {
+        Some(Layout::Paired)
+    } else if all(&|l| p[l] == p[0] + QUAD[l] as u32 && q[l] == p[l] + 2) {
+        Some(Layout::Quad)
+    } else if all(&|l| p[l] == p[0] + 4 * l as u32 && q[l] == p[l] + 2) {
+        Some(Layout::Spaced)
+    } else if all(&|l| p[l] == p[0] + 2 * l as u32 && q[l] == q[0] + 2 * l as u32)
+        && p[0].abs_diff(q[0]) as usize >= STRIDED
+    {
+        Some(Layout::Strided)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ClothMesh, ClothParams, Family, Forces, GridDesc, Mass, Settings, SolverBuilder};
+
+    /// An `n` × `n` grid with stretch, shear and bend-distance; `shuffle` renumbers its
+    /// particles pseudo-randomly, so that index offsets stop being regular (the greedy path).
+    fn block(n: usize, shuffle: bool) -> (Block<2, Distance>, usize) {
+        let grid = GridDesc {
+            resolution: (n, n),
+            ..GridDesc::default()
+        }
+        .build()
+        .expect("valid grid");
+        let n = grid.positions.len();
+        let perm: Vec<u32> = if shuffle {
+            (0..n as u64)
+                .map(|i| ((i * 7919 + 13) % n as u64) as u32)
+                .collect()
+        } else {
+            (0..n as u32).collect()
+        };
+        let mut positions = vec![DVec3::ZERO; n];
+        for (i, &j) in perm.iter().enumerate() {
+            positions[j as usize] = grid.positions[i];
+        }
+        let triangles = grid
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| perm[i as usize]))
+            .collect();
+        let mesh = ClothMesh::from_triangles(positions, triangles, Mass::Total(1.0), vec![])
+            .expect("valid mesh");
+        let params = ClothParams::default().edit(Family::BendDistance, |p| p.enabled = true);
+        let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("valid");
+        b.add_cloth("c", &mesh, params, 0.0).expect("valid");
+        (b.build().constraints().distance.clone(), n)
+    }
+
+    fn global(d: &Domain, k: usize) -> (u32, u32) {
+        let s = d.start as u32;
+        (s + d.pairs.p[k], s + d.pairs.q[k])
+    }
+
+    #[test]
+    fn every_constraint_is_solved_once_and_no_set_shares_a_particle() {
+        for shuffle in [false, true] {
+            let (block, n) = block(30, shuffle);
+            let domains = Domains::new(&block, n, 200);
+            assert!(domains.list.len() > 3);
+            let mut seen: Vec<(u32, u32)> = Vec::new();
+            for d in &domains.list {
+                for colour in &d.colours {
+                    let mut used: Vec<u32> = colour
+                        .clone()
+                        .flat_map(|k| {
+                            let (p, q) = global(d, k);
+                            [p, q]
+                        })
+                        .collect();
+                    let len = used.len();
+                    used.sort_unstable();
+                    used.dedup();
+                    assert_eq!(
+                        used.len(),
+                        len,
+                        "a set shares a particle (shuffle {shuffle})"
+                    );
+                    seen.extend(colour.clone().map(|k| global(d, k)));
+                }
+            }
+            let size = domains.size as u32;
+            for [(dp, ip), (dq, iq)] in &domains.links.ends {
+                assert_ne!(dp, dq);
+                let (p, q) = (dp * size + ip, dq * size + iq);
+                seen.push((p.min(q), p.max(q)));
+            }
+            let mut expected: Vec<(u32, u32)> = block
+                .particles
+                .iter()
+                .map(|&[p, q]| (p.min(q), p.max(q)))
+                .collect();
+            expected.sort_unstable();
+            seen.sort_unstable();
+            assert_eq!(seen, expected, "shuffle {shuffle}");
+        }
+    }
+
+    #[test]
+    fn chunk_layouts_match_their_lanes_and_grids_mostly_load_with_unit_stride() {
+        // Rows of 32 split into whole chunks (a row of 30 leaves a ragged end of 6 per row).
+        let (block, n) = block(32, false);
+        let domains = Domains::new(&block, n, 4096);
+        for d in &domains.list {
+            for c in &d.chunks {
+                let (p, q) = (&d.pairs.p[c.start..], &d.pairs.q[c.start..]);
+                for l in 0..LANES {
+                    let (ep, eq) = match c.layout {
+                        Layout::Contiguous => (p[0] + l as u32, q[0] + l as u32),
+                        Layout::Paired => (p[0] + 2 * l as u32, p[0] + 2 * l as u32 + 1),
+                        Layout::Quad => (p[0] + QUAD[l] as u32, p[0] + QUAD[l] as u32 + 2),
+                        Layout::Strided => (p[0] + 2 * l as u32, q[0] + 2 * l as u32),
+                        Layout::Spaced => (p[0] + 4 * l as u32, p[0] + 4 * l as u32 + 2),
+                        Layout::Gathered => (p[l], q[l]),
+                    };
+                    assert_eq!((p[l], q[l]), (ep, eq), "{:?}", c.layout);
+                }
+            }
+        }
+        let s = domains.stats();
+        let structured = s.contiguous + s.strided;
+        assert!(
+            structured as f64 > 0.7 * block.len() as f64,
+            "{s:?} of {}",
+            block.len()
+        );
     }
 }
