@@ -83,7 +83,8 @@ done
 stat() {  # stat median|min VALUES...
   python3 -c 'import statistics, sys
 v = [float(x) for x in sys.argv[2:]]
-print(f"{(statistics.median(v) if sys.argv[1] == "median" else min(v)):.3f}" if v else "")' "$@"
+x = statistics.median(v) if sys.argv[1] == "median" else min(v)
+print("%.3f" % x)' "$@"
 }
 ratio() { python3 -c 'import sys; print(f"{float(sys.argv[1]) / float(sys.argv[2]):.2f}")' "$1" "$2"; }
 
