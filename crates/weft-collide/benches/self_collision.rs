@@ -4,7 +4,11 @@
 //! triangle-mesh blob (every particle in contact in all three).
 #![allow(clippy::unwrap_used)]
 
-use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use std::time::Duration;
+
+use criterion::{
+    BatchSize, BenchmarkId, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
+};
 use weft_collide::scenarios::blob_path;
 use weft_collide::{ColliderDesc, CollisionWorld, SelfCollisionParams, ShapeDesc};
 use weft_solver::glam::DVec3;
@@ -57,7 +61,10 @@ fn place(p: &mut Particles, n: usize, f: impl Fn(usize, usize, DVec3) -> DVec3) 
 fn bench_one(c: &mut Criterion, group: &str, n: usize, solver: &Solver, world: &CollisionWorld) {
     let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements((n * n) as u64));
-    g.sample_size(10);
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2));
     let ctx = ctx();
     let mut world = world.clone();
     g.bench_with_input(BenchmarkId::from_parameter(n * n), &n, |b, _| {

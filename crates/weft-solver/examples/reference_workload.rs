@@ -1,15 +1,88 @@
-//! The shared reference workload (see `../shared/peers/README.md`): an N×N 1 m grid of 1 kg,
-//! top edge pinned, stretch + shear at α = 0, dt = 1/60, 10 substeps × 1 iteration.
-//! Prints ms per frame. Usage: `cargo run --release -p weft-solver --example reference_workload -- N FRAMES`.
+//! The shared reference workload (see `../shared/peers/README.md` and
+//! `assets/scenes/reference.toml`): an N×N 1 m grid of 1 kg, top edge pinned, stretch + shear
+//! at α = 0, dt = 1/60, 10 substeps × 1 iteration, no bending.
+//!
+//! Prints one line in the peers' style (`ms/frame=MEAN (median MEDIAN)`, over the frames after
+//! the warm-up), so `scripts/compare_peers.sh` and `../shared/peers/summarize.py` read it:
+//!
+//! ```sh
+//! cargo run --release -p weft-solver --example reference_workload -- --n 128 --frames 60 --threads 1
+//! ```
+//!
+//! The old positional form `-- N FRAMES` still works. `--threads 0` uses rayon's default pool.
 
+use std::process::ExitCode;
 use std::time::Instant;
 
 use weft_solver::{ClothParams, Edge, Family, Forces, GridDesc, Pin, Settings, SolverBuilder};
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// Command-line options.
+struct Options {
+    n: usize,
+    frames: usize,
+    warmup: usize,
+    threads: usize,
+}
+
+const USAGE: &str =
+    "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] | [N [FRAMES]]";
+
+fn parse_args() -> Result<Options, String> {
+    let mut o = Options {
+        n: 128,
+        frames: 60,
+        warmup: 3,
+        threads: 1,
+    };
+    let mut positional = 0;
     let mut args = std::env::args().skip(1);
-    let n: usize = args.next().map_or(Ok(128), |a| a.parse())?;
-    let frames: usize = args.next().map_or(Ok(60), |a| a.parse())?;
+    while let Some(a) = args.next() {
+        let mut value = |name: &str| -> Result<usize, String> {
+            let v = args
+                .next()
+                .ok_or(format!("{name} needs a value\n{USAGE}"))?;
+            v.parse()
+                .map_err(|e| format!("{name} {v}: {e}, expected a whole number\n{USAGE}"))
+        };
+        match a.as_str() {
+            "--n" => o.n = value("--n")?,
+            "--frames" => o.frames = value("--frames")?,
+            "--warmup" => o.warmup = value("--warmup")?,
+            "--threads" => o.threads = value("--threads")?,
+            "-h" | "--help" => return Err(USAGE.to_owned()),
+            _ if !a.starts_with('-') && positional < 2 => {
+                let v: usize = a
+                    .parse()
+                    .map_err(|e| format!("{a}: {e}, expected a whole number\n{USAGE}"))?;
+                if positional == 0 {
+                    o.n = v;
+                } else {
+                    o.frames = v;
+                }
+                positional += 1;
+            }
+            _ => return Err(format!("unexpected argument `{a}`\n{USAGE}")),
+        }
+    }
+    if o.n < 2 || o.frames == 0 {
+        return Err(format!("need N >= 2 and FRAMES >= 1\n{USAGE}"));
+    }
+    Ok(o)
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("reference_workload: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let o = parse_args()?;
+    let n = o.n;
     let mesh = GridDesc {
         resolution: (n, n),
         pins: vec![Pin::Edge(Edge::Top)],
@@ -21,28 +94,62 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         params.get_mut(f).enabled = matches!(f, Family::Stretch | Family::Shear);
         params.get_mut(f).compliance = 0.0;
     }
-    let mut b = SolverBuilder::new(Settings::default(), Forces::default())?;
+    let settings = Settings::default();
+    let mut b = SolverBuilder::new(settings, Forces::default())?;
     b.add_cloth("cloth", &mesh, params, 0.0)?;
     let mut s = b.build();
+    // Stretch 2N(N−1) + shear 2(N−1)²: 64,770 at N = 128.
+    let expected = 2 * n * (n - 1) + 2 * (n - 1) * (n - 1);
+    let constraints = s.constraints().len();
+    if constraints != expected {
+        return Err(format!("N = {n}: {constraints} constraints, expected {expected}").into());
+    }
     println!(
-        "N = {n}: {} particles, {} constraints, colours {:?}",
+        "N = {n}: {} particles, {constraints} constraints, colours {:?}",
         s.particles().len(),
-        s.constraints().len(),
         s.constraints().color_counts()
     );
     println!("{:?}", s.domain_stats());
-    s.step()?; // warm-up
-    let mut times = Vec::with_capacity(frames);
-    for _ in 0..frames {
-        let t = Instant::now();
-        s.step()?;
-        times.push(t.elapsed().as_secs_f64() * 1e3);
-    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(o.threads)
+        .build()?;
+    let threads = pool.current_num_threads();
+    let mut times = Vec::with_capacity(o.frames);
+    pool.install(|| -> Result<(), weft_solver::SolverError> {
+        for _ in 0..o.warmup {
+            s.step()?;
+        }
+        for _ in 0..o.frames {
+            let t = Instant::now();
+            s.step()?;
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        Ok(())
+    })?;
+    let total_ms: f64 = times.iter().sum();
     times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let mean = total_ms / times.len() as f64;
+    let substeps = u64::from(settings.substeps);
+    let iterations = u64::from(settings.iterations);
+    let projections = (constraints as u64 * substeps * iterations) as f64;
+    let r = s.residual();
     println!(
-        "median {:.3} ms/frame, min {:.3} ms/frame",
-        times[frames / 2],
-        times[0]
+        "{:<14} threads={threads} N={n:<4} particles={:<6} constraints={constraints:<6} substeps={substeps:<3} iters={iterations} frames={} seconds={:.3} ms/frame={mean:.3} (median {median:.3}) ns/proj={:.2} proj/s={:.4e}",
+        "weft-xpbd",
+        s.particles().len(),
+        o.frames,
+        total_ms / 1e3,
+        1e6 * median / projections,
+        projections / median * 1e3,
+    );
+    println!(
+        "  min {:.3} ms/frame, max {:.3} ms/frame; residual after {} frames: max |C| {:.3e} m, RMS {:.3e} m",
+        times[0],
+        times[times.len() - 1],
+        o.warmup + o.frames,
+        r.max,
+        r.rms
     );
     Ok(())
 }

@@ -1,0 +1,198 @@
+#!/usr/bin/env python3
+"""Summarise Weft's `cargo bench` results as the Markdown tables of the README.
+
+Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.8) and
+`<criterion>/substeps_error.json` (written by benches/substeps.rs), and prints:
+
+- step time per frame of XPBD / PBD / mass-spring at 32²…256² particles, projections per
+  second, and the scaling exponent p of cost ∝ particles^p (least-squares fit in log-log);
+- the reference workload at N = 64/128/256 on 1 and 2 threads;
+- substeps × iterations at equal cost with the constraint error reached after 1 s;
+- collisions (sphere, triangle mesh, self) with and without, and their exponents;
+- self-collision vs constraint solve at N = 128; MCAP logging overhead.
+
+Figures are criterion's median point estimates. Usage:
+    python3 scripts/bench_summary.py [CRITERION_DIR]
+CRITERION_DIR defaults to $CRITERION_HOME, else $CARGO_TARGET_DIR/criterion, else
+target/criterion.
+"""
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+
+def criterion_dir():
+    if len(sys.argv) > 1:
+        return Path(sys.argv[1])
+    if os.environ.get("CRITERION_HOME"):
+        return Path(os.environ["CRITERION_HOME"])
+    if os.environ.get("CARGO_TARGET_DIR"):
+        return Path(os.environ["CARGO_TARGET_DIR"]) / "criterion"
+    return Path("target/criterion")
+
+
+def load(root):
+    """full_id -> (median ns per iteration, elements per iteration or None)."""
+    out = {}
+    for bj in root.glob("**/new/benchmark.json"):
+        est = bj.with_name("estimates.json")
+        if not est.exists():
+            continue
+        b = json.loads(bj.read_text())
+        e = json.loads(est.read_text())
+        thr = b.get("throughput") or {}
+        elements = thr.get("Elements") if isinstance(thr, dict) else None
+        out[b["full_id"]] = (e["median"]["point_estimate"], elements)
+    return out
+
+
+def exponent(xs, ys):
+    """Least-squares slope of log y against log x (None with fewer than 2 points)."""
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x > 0 and y and y > 0]
+    if len(pts) < 2:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+
+
+def ms(r, key):
+    v = r.get(key)
+    return None if v is None else v[0] / 1e6
+
+
+def fmt(x):
+    if x is None:
+        return "–"
+    if x >= 100:
+        return f"{x:.0f}"
+    if x >= 10:
+        return f"{x:.1f}"
+    if x >= 1:
+        return f"{x:.2f}"
+    return f"{x:.3g}"
+
+
+def fmt_p(p):
+    return "–" if p is None else f"{p:.2f}"
+
+
+SIZES = [32, 64, 128, 256]
+
+
+def methods(r):
+    print("### Step time per frame (reference cloth, 10 substeps × 1 iteration)\n")
+    head = " | ".join(f"{n}² ms/frame" for n in SIZES)
+    print(f"| method | {head} | Mproj/s at 128² | exponent p (cost ∝ particles^p) |")
+    print("|---" * (len(SIZES) + 3) + "|")
+    any_row = False
+    for m in ["xpbd", "pbd", "mass-spring"]:
+        t = [ms(r, f"step/{m}/{n * n}") for n in SIZES]
+        if all(x is None for x in t):
+            continue
+        any_row = True
+        v = r.get(f"step/{m}/{128 * 128}")
+        rate = f"{v[1] / v[0] * 1e3:.0f}" if v and v[1] else "–"
+        p = exponent([n * n for n, x in zip(SIZES, t) if x], [x for x in t if x])
+        print(f"| {m} | " + " | ".join(fmt(x) for x in t) + f" | {rate} | {fmt_p(p)} |")
+    if not any_row:
+        print("(no results: run `cargo bench --bench methods`)")
+    print()
+
+
+def reference(r):
+    print("### Reference workload (N×N, stretch + shear, α = 0, 10 × 1, dt = 1/60)\n")
+    print("| threads | N=64 ms/frame | N=128 ms/frame | N=256 ms/frame | ns/projection at 128 |")
+    print("|---|---|---|---|---|")
+    for t in [1, 2]:
+        vals = [ms(r, f"reference/threads={t}/{n}") for n in [64, 128, 256]]
+        v = r.get(f"reference/threads={t}/128")
+        nsp = f"{v[0] / v[1]:.2f}" if v and v[1] else "–"
+        print(f"| {t} | " + " | ".join(fmt(x) for x in vals) + f" | {nsp} |")
+    print()
+
+
+def substeps(r, root):
+    print("### Substeps × iterations at equal cost (64², XPBD, α = 0, error after 1 s)\n")
+    path = root / "substeps_error.json"
+    rows = json.loads(path.read_text()) if path.exists() else []
+    if not rows:
+        print(f"(no {path}: run `cargo bench --bench substeps`)\n")
+        return
+    print("| substeps × iterations | ms/frame (criterion) | RMS C at 1 s (m) | max abs C at 1 s (m) "
+          "| mean RMS C, 0.5–1 s (m) |")
+    print("|---|---|---|---|---|")
+    for row in rows:
+        s, i = row["substeps"], row["iterations"]
+        t = ms(r, f"substeps_x_iterations/4096/{s}x{i}")
+        print(f"| {s} × {i} | {fmt(t)} | {row['rms']:.2e} | {row['max']:.2e} | "
+              f"{row.get('mean_rms', float('nan')):.2e} |")
+    print()
+
+
+def collisions(r):
+    print("### Collisions: step time per frame with and without (XPBD scenarios)\n")
+    head = " | ".join(f"{n}²" for n in SIZES)
+    print(f"| scenario | | {head} | exponent p |")
+    print("|---" * (len(SIZES) + 3) + "|")
+    for name, label in [("collide_sphere", "sphere"), ("collide_trimesh", "triangle mesh"),
+                        ("collide_self", "self-collision")]:
+        wo = [ms(r, f"{name}/without/{n * n}") for n in SIZES]
+        wi = [ms(r, f"{name}/with/{n * n}") for n in SIZES]
+        extra = [b - a if a is not None and b is not None else None for a, b in zip(wo, wi)]
+        for tag, vals in [("without", wo), ("with", wi), ("collision cost", extra)]:
+            p = exponent([n * n for n, x in zip(SIZES, vals) if x], [x for x in vals if x])
+            print(f"| {label} | {tag} ms | " + " | ".join(fmt(x) for x in vals) + f" | {fmt_p(p)} |")
+    print()
+    print("Collision handling alone, one substep (`self_collision` bench), ms:\n")
+    print(f"| shape | {head} | exponent p |")
+    print("|---" * (len(SIZES) + 2) + "|")
+    for g in ["self_collision", "sphere", "trimesh"]:
+        vals = [ms(r, f"{g}/{n * n}") for n in SIZES]
+        p = exponent([n * n for n, x in zip(SIZES, vals) if x], [x for x in vals if x])
+        print(f"| {g} | " + " | ".join(fmt(x) for x in vals) + f" | {fmt_p(p)} |")
+    print()
+
+
+def self_vs_solve(r):
+    print("### Self-collision vs constraint solve, 128² self-fold strip, per frame\n")
+    print("| what | ms/frame |")
+    print("|---|---|")
+    for f, label in [("constraint_solve", "constraint solve (no collisions)"),
+                     ("solve_and_self_collision", "solve + self-collision"),
+                     ("self_collision_hook", "self-collision hook alone")]:
+        print(f"| {label} | {fmt(ms(r, f'self_vs_solve/16384/{f}'))} |")
+    print()
+
+
+def logging(r):
+    print("### MCAP logging, default scene at 128² (`weft run` with and without `--out`)\n")
+    a, b, w = (ms(r, f"weft_run/16384/{k}") for k in ["no_log", "mcap", "writer_only"])
+    over = f"{100 * (b - a) / a:+.0f} %" if a and b else "–"
+    print("| no log ms/frame | with MCAP ms/frame | overhead | writer alone ms/frame |")
+    print("|---|---|---|---|")
+    print(f"| {fmt(a)} | {fmt(b)} | {over} | {fmt(w)} |")
+    print()
+
+
+def main():
+    root = criterion_dir()
+    r = load(root)
+    if not r:
+        print(f"no criterion results under {root}: run `cargo bench` first", file=sys.stderr)
+        return 1
+    print(f"<!-- {len(r)} benchmarks from {root}; criterion median point estimates -->\n")
+    methods(r)
+    reference(r)
+    substeps(r, root)
+    collisions(r)
+    self_vs_solve(r)
+    logging(r)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
