@@ -201,8 +201,9 @@ mod tests {
 
     #[test]
     fn folded_strip_normal_bisects_the_fold() {
-        // Two unit squares at a right angle along the x axis: the shared vertices' normal is
-        // the bisector of +Y and +Z.
+        // Two unit squares at a right angle along the x axis. Each shared vertex touches two
+        // equal-area triangles on one side and one on the other, so its normal is
+        // (2 n₁ + n₂) / |…|.
         let p = [
             Vec3::ZERO,
             Vec3::X,
@@ -214,8 +215,16 @@ mod tests {
         let tris = [[0, 1, 2], [0, 2, 3], [5, 4, 1], [5, 1, 0]];
         let mut n = Vec::new();
         vertex_normals(&p, &tris, &mut n);
-        let bisector = (Vec3::Y + Vec3::Z).normalize();
-        assert!((n[0] - bisector).length() < 1e-6, "{:?}", n[0]);
+        assert!(
+            (n[0] - (2.0 * Vec3::Y + Vec3::Z).normalize()).length() < 1e-6,
+            "{:?}",
+            n[0]
+        );
+        assert!(
+            (n[1] - (Vec3::Y + 2.0 * Vec3::Z).normalize()).length() < 1e-6,
+            "{:?}",
+            n[1]
+        );
         assert!((n[2] - Vec3::Y).length() < 1e-6);
         assert!((n[4] - Vec3::Z).length() < 1e-6);
     }
