@@ -99,7 +99,19 @@ pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
     colliders(sim).iter().map(|c| c.world_matrix()).collect()
 }
 
-/// A camera that frames the cloths and bounded colliders of `sim` as they are now.
+/// Height of the floor drawn under `sim`: its upward half-space if it has one, else y = 0,
+/// lowered under any cloth that starts below it.
+pub fn floor_height(sim: &Simulation, view: &SceneView) -> f32 {
+    view.ground.unwrap_or_else(|| {
+        let lowest = (0..sim.scene.cloths.len())
+            .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
+            .fold(0.0f32, f32::min);
+        if lowest < 0.0 { lowest - 0.01 } else { 0.0 }
+    })
+}
+
+/// A camera that frames the cloths and bounded colliders of `sim` as they are now, and the
+/// floor under them when it is near (so shadows and the drop are in view).
 pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for i in 0..sim.scene.cloths.len() {
@@ -120,6 +132,11 @@ pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
             lo = lo.min(a);
             hi = hi.max(b);
         }
+    }
+    let floor = floor_height(sim, view);
+    if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length()
+    {
+        lo.y = floor;
     }
     Camera::framing(lo, hi)
 }
@@ -191,15 +208,7 @@ impl<'g> VideoRecorder<'g> {
 
         let view = scene_meshes(sim);
         let mut renderer = Renderer::new(&gpu.device, OFFSCREEN_FORMAT, &view.meshes);
-        if let Some(y) = view.ground {
-            renderer.set_ground_height(y);
-        } else {
-            // No ground collider: put the floor just under everything so nothing sinks in it.
-            let lowest = (0..sim.scene.cloths.len())
-                .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
-                .fold(0.0f32, f32::min);
-            renderer.set_ground_height(lowest.min(0.0) - 0.01 * (lowest < 0.0) as u8 as f32);
-        }
+        renderer.set_ground_height(floor_height(sim, &view));
         let camera = framing_camera(sim, &view);
         Ok(Self {
             gpu,

@@ -24,7 +24,7 @@ struct Globals {
 
 const SKY_TOP: vec3<f32> = vec3<f32>(0.20, 0.30, 0.46);
 const HORIZON: vec3<f32> = vec3<f32>(0.62, 0.66, 0.71);
-const GROUND: vec3<f32> = vec3<f32>(0.50, 0.51, 0.53);
+const GROUND: vec3<f32> = vec3<f32>(0.40, 0.41, 0.43);
 const SUN: vec3<f32> = vec3<f32>(1.05, 1.0, 0.92);
 
 // ACES filmic curve, Narkowicz 2015 ("ACES Filmic Tone Mapping Curve").
