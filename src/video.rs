@@ -136,7 +136,20 @@ pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
     let floor = floor_height(sim, view);
     if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length()
     {
-        lo.y = floor;
+        // Take in the floor and the shadow of the box's underside on it (its corners carried
+        // down along the sunlight), so hanging things show where their shadow falls.
+        let sun = weft_render::sun_direction();
+        let (a, b) = (lo, hi);
+        for i in 0..4 {
+            let c = Vec3::new(
+                if i & 1 == 0 { a.x } else { b.x },
+                a.y,
+                if i & 2 == 0 { a.z } else { b.z },
+            );
+            let shadow = c - sun * ((c.y - floor) / sun.y.max(0.1));
+            lo = lo.min(shadow);
+            hi = hi.max(shadow);
+        }
     }
     Camera::framing(lo, hi)
 }
