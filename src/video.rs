@@ -134,8 +134,7 @@ pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
         }
     }
     let floor = floor_height(sim, view);
-    if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length()
-    {
+    if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length() {
         // Take in the floor and the shadow of the box's underside on it (its corners carried
         // down along the sunlight), so hanging things show where their shadow falls.
         let sun = weft_render::sun_direction();
@@ -254,9 +253,7 @@ impl<'g> VideoRecorder<'g> {
         }
         let image = self.draw(sim)?;
         let png = self.dir.join(format!("frame_{:05}.png", self.images));
-        image
-            .save(&png)
-            .with_context(|| format!("cannot write {}", png.display()))?;
+        save_png(&image, &png).with_context(|| format!("cannot write {}", png.display()))?;
         if self.images % self.gif_stride == 0
             && let Some(gif) = self.gif.as_mut()
         {
@@ -373,6 +370,22 @@ impl Drop for VideoRecorder<'_> {
             let _ = std::fs::remove_file(&self.gif_partial);
         }
     }
+}
+
+/// Writes `image` as a PNG with the strongest compression (about half the default's size).
+fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
+    use image::ImageEncoder;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let mut out = BufWriter::new(File::create(path)?);
+    PngEncoder::new_with_quality(&mut out, CompressionType::Best, FilterType::Adaptive)
+        .write_image(
+            image.as_raw(),
+            image.width(),
+            image.height(),
+            image::ExtendedColorType::Rgba8,
+        )?;
+    std::io::Write::flush(&mut out)?;
+    Ok(())
 }
 
 /// Whether the file at `path` ends with the GIF trailer byte.
