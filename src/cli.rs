@@ -34,6 +34,8 @@ pub enum Command {
     Experiments(ExperimentArgs),
     /// Open a scene in the interactive viewer (the default command).
     View(ViewArgs),
+    /// Render a scene offscreen: PNG frames, an animated GIF and (with ffmpeg) an MP4.
+    Render(RenderArgs),
 }
 
 /// `weft run`.
@@ -197,4 +199,44 @@ pub struct ExperimentArgs {
     /// (e.g. after every shard of a batch job has finished).
     #[arg(long)]
     pub report_only: bool,
+    /// Also render each run (PNG frames and a GIF, ~30 images/s) into `runs/<run>/`.
+    #[arg(long)]
+    pub render: bool,
+}
+
+/// `weft render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Scene file (default: the built-in hanging cloth).
+    pub scene: Option<PathBuf>,
+    /// Frames to simulate.
+    #[arg(long, default_value_t = 180)]
+    pub frames: u64,
+    /// Output directory (created if missing): frame_00000.png…, <scene>.gif, <scene>.mp4.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Image size in pixels.
+    #[arg(long, default_value = "800x600", value_name = "WxH", value_parser = crate::video::parse_size)]
+    pub size: glam::UVec2,
+    /// Render every K-th frame.
+    #[arg(long, default_value_t = 1, value_name = "K")]
+    pub every: u64,
+    /// Override a scene key: `--set sim.substeps=20` (repeatable; values are TOML, else strings).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<Override>,
+    /// Draw the cloth's edges.
+    #[arg(long)]
+    pub wireframe: bool,
+    /// Draw the particles.
+    #[arg(long)]
+    pub particles: bool,
+    /// No shadows.
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// No ground grid lines.
+    #[arg(long)]
+    pub no_grid: bool,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
 }

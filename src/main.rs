@@ -9,6 +9,7 @@ mod record;
 mod replay;
 mod run;
 mod sim;
+mod video;
 
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -36,6 +37,7 @@ fn main() -> ExitCode {
         Some(Command::Check(args)) => check(&args),
         Some(Command::Replay(args)) => replay::replay(&args, &stop),
         Some(Command::Experiments(args)) => experiments::run(&args, &stop),
+        Some(Command::Render(args)) => render_command(&args, &stop),
     };
     match result {
         Ok(code) => code,
@@ -80,6 +82,27 @@ fn run_command(args: &RunArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
         progress: !args.quiet,
     };
     run::run(scene, &plan, stop)
+}
+
+fn render_command(args: &cli::RenderArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
+    let scene = match load_scene(args.scene.as_deref(), &args.set) {
+        Ok(s) => s,
+        Err(e) => return Ok(report(&e)),
+    };
+    let plan = video::VideoPlan {
+        frames: args.frames,
+        every: args.every,
+        out: &args.out,
+        size: args.size,
+        options: weft_render::RenderOptions {
+            wireframe: args.wireframe,
+            particles: args.particles,
+            grid: !args.no_grid,
+            shadows: !args.no_shadows,
+        },
+        progress: !args.quiet,
+    };
+    video::render(scene, &plan, stop)
 }
 
 fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {

@@ -160,7 +160,8 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     let scene_path = write(&dir, "sheet.toml", SCENE);
     let log = dir.join("session.mcap");
 
-    // The viewer opens with Camera::framing of the cloth's bounding box (app/meshes.rs):
+    // The viewer opens with Camera::framing of the bounding box of the cloths and bounded
+    // colliders (app/meshes.rs, src/video.rs); this scene has no collider, so
     // frame it the same way and find the pixel of the particle nearest the cloth's centre.
     let scene = weft_scene::load(Path::new(&scene_path), &[]).expect("scene loads");
     let groups = scene.build().expect("solvers");

@@ -109,6 +109,12 @@ impl<T: TimeSource> FixedClock<T> {
         self.accumulator = 0.0;
     }
 
+    /// Forgets the real time since the last tick (e.g. the time a window took to open).
+    pub fn restart(&mut self) {
+        self.resync = true;
+        self.accumulator = 0.0;
+    }
+
     /// Whether the clock is paused.
     pub fn paused(&self) -> bool {
         self.paused
@@ -198,6 +204,15 @@ mod tests {
         c.set_paused(false);
         assert_eq!(c.tick(DT).steps, 0, "the 64 Δt paused are not stepped");
         assert_eq!(c.tick(DT).steps, 2);
+    }
+
+    #[test]
+    fn a_restart_forgets_the_time_before_it() {
+        let mut c = clock(&[0.0, 50.0 * DT, 51.0 * DT], 8);
+        c.restart();
+        assert_eq!(c.tick(DT), Tick::default());
+        assert_eq!(c.tick(DT).steps, 1);
+        assert_eq!(c.dropped_total(), 0);
     }
 
     #[test]

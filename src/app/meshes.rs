@@ -1,46 +1,37 @@
-//! What the renderer needs from a simulation: cloth topology, collider meshes and poses, and
-//! the camera that frames the scene when it opens.
+//! The renderer for a simulation, and the camera that frames it when the viewer opens:
+//! the same meshes, ground and framing as `weft render` (src/video.rs).
 
-use glam::{Mat4, Vec3};
-use weft_render::{Camera, ClothTopology, SceneMeshes};
+use weft_render::{Camera, Renderer};
 
 use crate::sim::Simulation;
+use crate::video::{framing_camera, scene_meshes};
 
-/// The scene's cloths (in scene order) and colliders, for [`weft_render::Renderer::new`].
-pub fn scene_meshes(sim: &Simulation) -> SceneMeshes {
-    let cloths = sim
-        .scene
-        .cloths
-        .iter()
-        .enumerate()
-        .map(|(i, c)| ClothTopology {
-            particle_count: sim.cloth_positions(i).len(),
-            triangles: c.mesh.triangles.clone(),
-        })
-        .collect();
-    SceneMeshes {
-        cloths,
-        colliders: Vec::new(),
-    }
+pub use crate::video::frame_poses as collider_poses;
+
+/// A renderer drawing `sim` into targets of `format`, with its ground at the scene's ground
+/// collider (or just under the lowest particle), and the camera framing the scene now.
+pub fn renderer_for(
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
+    sim: &Simulation,
+) -> (Renderer, Camera) {
+    let view = scene_meshes(sim);
+    let mut renderer = Renderer::new(device, format, &view.meshes);
+    renderer.set_ground_height(view.ground.unwrap_or_else(|| floor_under(sim)));
+    (renderer, framing_camera(sim, &view))
 }
 
-/// The pose of every collider in [`scene_meshes`] order, at the current time.
-pub fn collider_poses(_sim: &Simulation) -> Vec<Mat4> {
-    Vec::new()
-}
-
-/// The camera the viewer opens with: [`Camera::framing`] of the bounding box of every
-/// cloth particle at the current state. (The end-to-end test frames its camera the same way
-/// to find a cloth pixel.)
+/// The camera the viewer opens with (see [`crate::video::framing_camera`]: the bounding box
+/// of the cloths and bounded colliders, framed by [`Camera::framing`]). The end-to-end test
+/// frames its camera the same way to find a cloth pixel.
 pub fn initial_camera(sim: &Simulation) -> Camera {
-    let mut min = Vec3::splat(f32::INFINITY);
-    let mut max = Vec3::splat(f32::NEG_INFINITY);
-    for i in 0..sim.scene.cloths.len() {
-        for p in sim.cloth_positions(i) {
-            let p = p.as_vec3();
-            min = min.min(p);
-            max = max.max(p);
-        }
-    }
-    Camera::framing(min, max)
+    framing_camera(sim, &scene_meshes(sim))
+}
+
+/// A floor just under everything when the scene has no ground, so nothing sinks into it.
+fn floor_under(sim: &Simulation) -> f32 {
+    let lowest = (0..sim.scene.cloths.len())
+        .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
+        .fold(0.0f32, f32::min);
+    if lowest < 0.0 { lowest - 0.01 } else { 0.0 }
 }

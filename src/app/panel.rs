@@ -149,9 +149,7 @@ fn scene_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out
     }
     ui.horizontal(|ui| {
         let paused = session.clock.paused();
-        out.toggle_pause = ui
-            .button(if paused { "▶ run" } else { "⏸ pause" })
-            .clicked();
+        out.toggle_pause = ui.button(if paused { "run" } else { "pause" }).clicked();
         out.step = ui.button("step").clicked();
         out.reset = ui.button("reset").clicked();
     });
@@ -202,6 +200,19 @@ fn stats_section(ui: &mut Ui, session: &Session) {
         row("contacts", s.contacts.to_string());
         row("sim time", format!("{time:.3} s"));
         row("frames", session.frames.to_string());
+        let grabbed = session.grab.map_or_else(
+            || "nothing (left-drag the cloth)".to_owned(),
+            |g| {
+                let name = session
+                    .sim
+                    .scene
+                    .cloths
+                    .get(g.cloth)
+                    .map_or("?", |c| c.name.as_str());
+                format!("{name} particle {}", g.particle)
+            },
+        );
+        row("grabbed", grabbed);
         let dropped = session.clock.dropped_total();
         row(
             "dropped",

@@ -146,11 +146,8 @@ impl App {
         config.format = format;
         config.present_mode = wgpu::PresentMode::AutoVsync;
         surface.configure(&gpu.device, &config);
-        let renderer = Renderer::new(
-            &gpu.device,
-            format,
-            &meshes::scene_meshes(&self.session.sim),
-        );
+        let (renderer, camera) = meshes::renderer_for(&gpu.device, format, &self.session.sim);
+        self.camera = camera;
         let egui_state = egui_winit::State::new(
             self.egui.clone(),
             egui::ViewportId::ROOT,
@@ -223,11 +220,10 @@ impl App {
     fn rebuild_scene(&mut self) {
         self.camera = meshes::initial_camera(&self.session.sim);
         if let Some(g) = self.gfx.as_mut() {
-            g.renderer = Renderer::new(
-                &g.gpu.device,
-                g.config.format,
-                &meshes::scene_meshes(&self.session.sim),
-            );
+            let (renderer, camera) =
+                meshes::renderer_for(&g.gpu.device, g.config.format, &self.session.sim);
+            g.renderer = renderer;
+            self.camera = camera;
             g.window
                 .set_title(&format!("Weft — {}", self.session.sim.scene.name));
         }
@@ -479,6 +475,7 @@ impl ApplicationHandler for App {
             Ok(g) => {
                 self.gfx = Some(g);
                 self.session.clock.set_paused(self.config.paused);
+                self.session.clock.restart();
                 event_loop.set_control_flow(ControlFlow::Poll);
             }
             Err(e) => self.fail(event_loop, e),

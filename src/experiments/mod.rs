@@ -100,11 +100,16 @@ pub fn run(args: &ExperimentArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode>
             jobs,
             out.display()
         );
+        let gpu = args
+            .render
+            .then(weft_render::Gpu::headless)
+            .transpose()
+            .context("cannot render (--render)")?;
         let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
                 .zip(scenes)
-                .map(|(r, scene)| execute(&spec, r, scene, &out, !args.no_mcap, stop))
+                .map(|(r, scene)| execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop))
                 .collect()
         });
         for (r, res) in mine.iter().zip(results) {
@@ -146,6 +151,7 @@ fn execute(
     scene: weft_scene::Scene,
     out: &Path,
     mcap: bool,
+    gpu: Option<&weft_render::Gpu>,
     stop: &AtomicBool,
 ) -> anyhow::Result<RunResult> {
     let dt = scene.settings.dt;
@@ -170,6 +176,16 @@ fn execute(
     } else {
         None
     };
+    // With --render: about 30 images per simulated second, into the run's own directory.
+    let mut video = gpu
+        .map(|gpu| {
+            let dir = out.join(rel.trim_end_matches(".mcap"));
+            let every = (1.0 / (30.0 * dt)).round().max(1.0) as u64;
+            let size = glam::UVec2::new(640, 480);
+            let options = weft_render::RenderOptions::default();
+            crate::video::VideoRecorder::new(gpu, &sim, &dir, size, every, options)
+        })
+        .transpose()?;
     let mut meter = Meter::new(&sim);
     let start = Instant::now();
     let mut status = Status::Complete;
@@ -190,6 +206,9 @@ fn execute(
                     if let Some(rec) = rec.as_mut() {
                         rec.frame(&sim, &stats)?;
                     }
+                    if let Some(v) = video.as_mut() {
+                        v.frame(&sim)?;
+                    }
                 }
                 Err(e) => {
                     status = Status::Diverged(e.to_string());
@@ -203,6 +222,11 @@ fn execute(
         rec.finish(&status, sim.frame())?;
     }
     logged?;
+    if let Some(v) = video
+        && !matches!(status, Status::Diverged(_))
+    {
+        v.finish()?;
+    }
     let _ = start;
     let metrics = meter
         .values(&sim)

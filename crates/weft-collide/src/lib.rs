@@ -13,6 +13,7 @@ pub mod scenarios;
 mod self_collision;
 mod shape;
 mod spatial_hash;
+mod tessellate;
 mod world;
 
 pub use collider::{Collider, ColliderDesc, SurfacePoint};
@@ -23,6 +24,7 @@ pub use obj::{load_obj, parse_obj};
 pub use self_collision::SelfCollisionParams;
 pub use shape::{CompoundPart, ShapeDesc};
 pub use spatial_hash::SpatialHash;
+pub use tessellate::{HALF_SPACE_EXTENT, Tessellation, tessellate_shape};
 pub use world::{CollisionWorld, ContactStats};
 
 /// Re-export of parry, so users name the same shape types.

@@ -1,0 +1,475 @@
+//! `weft render`: a scene stepped headless and drawn offscreen every K frames, written as
+//! numbered PNGs, an animated GIF and (when `ffmpeg` is on PATH) an MP4. Also the
+//! simulation → renderer glue ([`scene_meshes`], [`frame_poses`]) the window shares.
+
+use std::fs::File;
+use std::io::{BufWriter, IsTerminal};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context, bail};
+use glam::{Mat4, UVec2, Vec3};
+use image::codecs::gif::{GifEncoder, Repeat};
+use image::{Delay, Frame};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use weft_render::{
+    Camera, ClothTopology, FrameData, Gpu, OFFSCREEN_FORMAT, Offscreen, RenderOptions, Renderer,
+    SceneMeshes, TriMesh,
+};
+use weft_scene::Scene;
+
+use crate::run::{EXIT_DIVERGED, EXIT_INTERRUPTED};
+use crate::sim::Simulation;
+
+/// Shortest GIF frame delay players honour (ms); faster frames are dropped to keep real time.
+const GIF_MIN_DELAY_MS: f64 = 20.0;
+/// GIF colour quantisation speed (1 best … 30 fastest).
+const GIF_SPEED: i32 = 10;
+
+/// Parses `WxH` (e.g. `800x600`) into a size in pixels.
+pub fn parse_size(s: &str) -> Result<UVec2, String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size `{s}` is not WIDTHxHEIGHT (e.g. 800x600)"))?;
+    let dim = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=8192).contains(&n))
+            .ok_or_else(|| format!("size `{s}`: `{v}` is not a whole number of pixels in 1..=8192"))
+    };
+    Ok(UVec2::new(dim(w)?, dim(h)?))
+}
+
+/// What the renderer draws for a simulation, and where its ground is.
+pub struct SceneView {
+    /// Cloth topologies and collider meshes, in scene order.
+    pub meshes: SceneMeshes,
+    /// Height of an upward-facing half-space collider, drawn as the ground (and left out of
+    /// the meshes, so the two do not fight).
+    pub ground: Option<f32>,
+}
+
+/// The colliders of a simulation (those of its first collision world: every solver group
+/// holds the same ones).
+fn colliders(sim: &Simulation) -> &[weft_collide::Collider] {
+    sim.groups
+        .iter()
+        .find_map(|g| g.world.as_ref())
+        .map(|w| w.colliders())
+        .unwrap_or(&[])
+}
+
+/// Cloth topologies and tessellated colliders of `sim`.
+pub fn scene_meshes(sim: &Simulation) -> SceneView {
+    let cloths = sim
+        .scene
+        .cloths
+        .iter()
+        .map(|c| ClothTopology {
+            particle_count: c.mesh.positions.len(),
+            triangles: c.mesh.triangles.clone(),
+        })
+        .collect();
+    let mut ground: Option<f32> = None;
+    let colliders = colliders(sim)
+        .iter()
+        .map(|c| match c.half_space_normal() {
+            Some(n) if n.y > 0.999 => {
+                let y = c.world_matrix().w_axis.y;
+                ground = Some(ground.map_or(y, |g| g.max(y)));
+                TriMesh::default()
+            }
+            _ => {
+                let (positions, indices) = c.tessellate();
+                TriMesh { positions, indices }
+            }
+        })
+        .collect();
+    SceneView {
+        meshes: SceneMeshes { cloths, colliders },
+        ground,
+    }
+}
+
+/// The current world pose of each collider of `sim`.
+pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
+    colliders(sim).iter().map(|c| c.world_matrix()).collect()
+}
+
+/// A camera that frames the cloths and bounded colliders of `sim` as they are now.
+pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for i in 0..sim.scene.cloths.len() {
+        for p in sim.cloth_positions(i) {
+            lo = lo.min(p.as_vec3());
+            hi = hi.max(p.as_vec3());
+        }
+    }
+    for (mesh, pose) in view.meshes.colliders.iter().zip(frame_poses(sim)) {
+        let (mut a, mut b) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for p in &mesh.positions {
+            let w = pose.transform_point3(*p);
+            a = a.min(w);
+            b = b.max(w);
+        }
+        // Large walls (half-spaces) would shrink everything else to a dot.
+        if (b - a).length() < 20.0 {
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+    }
+    Camera::framing(lo, hi)
+}
+
+/// Options of `weft render`.
+pub struct VideoPlan<'a> {
+    /// Frames to simulate.
+    pub frames: u64,
+    /// Render every K-th frame.
+    pub every: u64,
+    /// Output directory.
+    pub out: &'a Path,
+    /// Image size (px).
+    pub size: UVec2,
+    /// Layers to draw.
+    pub options: RenderOptions,
+    /// Show a progress bar (on a terminal only).
+    pub progress: bool,
+}
+
+/// Writes frames of one simulation: PNGs as they come, the GIF streamed to a temporary
+/// name and renamed when [`finish`](Self::finish)ed, then the MP4.
+pub struct VideoRecorder<'g> {
+    gpu: &'g Gpu,
+    renderer: Renderer,
+    target: Offscreen,
+    camera: Camera,
+    options: RenderOptions,
+    dir: PathBuf,
+    name: String,
+    every: u64,
+    images: u64,
+    gif: Option<GifEncoder<BufWriter<Arc<File>>>>,
+    gif_file: Arc<File>,
+    gif_partial: PathBuf,
+    gif_stride: u64,
+    gif_delay_ms: u32,
+    fps: f64,
+}
+
+impl<'g> VideoRecorder<'g> {
+    /// Opens `dir` (created if missing) and the GIF, and sets the camera from `sim` now.
+    pub fn new(
+        gpu: &'g Gpu,
+        sim: &Simulation,
+        dir: &Path,
+        size: UVec2,
+        every: u64,
+        options: RenderOptions,
+    ) -> anyhow::Result<Self> {
+        if every == 0 {
+            bail!("--every must be at least 1");
+        }
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let name = file_stem(&sim.scene.name);
+        let gif_partial = dir.join(format!(".{name}.gif.partial"));
+        let gif_file = Arc::new(
+            File::create(&gif_partial)
+                .with_context(|| format!("cannot write {}", gif_partial.display()))?,
+        );
+        let mut gif = GifEncoder::new_with_speed(BufWriter::new(Arc::clone(&gif_file)), GIF_SPEED);
+        gif.set_repeat(Repeat::Infinite)
+            .context("writing the GIF header")?;
+        // Frame period of the images, and the GIF's: at least 20 ms, whole images apart.
+        let period_ms = 1e3 * sim.scene.settings.dt * every as f64;
+        let gif_stride = (GIF_MIN_DELAY_MS / period_ms).ceil().max(1.0) as u64;
+        let gif_delay_ms = (period_ms * gif_stride as f64).round().max(1.0) as u32;
+
+        let view = scene_meshes(sim);
+        let mut renderer = Renderer::new(&gpu.device, OFFSCREEN_FORMAT, &view.meshes);
+        if let Some(y) = view.ground {
+            renderer.set_ground_height(y);
+        } else {
+            // No ground collider: put the floor just under everything so nothing sinks in it.
+            let lowest = (0..sim.scene.cloths.len())
+                .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
+                .fold(0.0f32, f32::min);
+            renderer.set_ground_height(lowest.min(0.0) - 0.01 * (lowest < 0.0) as u8 as f32);
+        }
+        let camera = framing_camera(sim, &view);
+        Ok(Self {
+            gpu,
+            renderer,
+            target: Offscreen::new(&gpu.device, size),
+            camera,
+            options,
+            dir: dir.to_owned(),
+            name,
+            every,
+            images: 0,
+            gif: Some(gif),
+            gif_file,
+            gif_partial,
+            gif_stride,
+            gif_delay_ms,
+            fps: 1.0 / (sim.scene.settings.dt * every as f64),
+        })
+    }
+
+    /// Images written so far.
+    pub fn images(&self) -> u64 {
+        self.images
+    }
+
+    /// Renders the simulation's current state if its frame is a multiple of `every`.
+    pub fn frame(&mut self, sim: &Simulation) -> anyhow::Result<()> {
+        if sim.frame() % self.every != 0 {
+            return Ok(());
+        }
+        let image = self.draw(sim)?;
+        let png = self.dir.join(format!("frame_{:05}.png", self.images));
+        image
+            .save(&png)
+            .with_context(|| format!("cannot write {}", png.display()))?;
+        if self.images % self.gif_stride == 0
+            && let Some(gif) = self.gif.as_mut()
+        {
+            let delay = Delay::from_numer_denom_ms(self.gif_delay_ms, 1);
+            gif.encode_frame(Frame::from_parts(image, 0, 0, delay))
+                .with_context(|| format!("cannot write {}", self.gif_partial.display()))?;
+        }
+        self.images += 1;
+        Ok(())
+    }
+
+    /// Draws the current state offscreen and reads it back.
+    pub fn draw(&mut self, sim: &Simulation) -> anyhow::Result<image::RgbaImage> {
+        let cloths: Vec<&[weft_solver::glam::DVec3]> = (0..sim.scene.cloths.len())
+            .map(|i| sim.cloth_positions(i))
+            .collect();
+        let poses = frame_poses(sim);
+        self.renderer.update(
+            &self.gpu.queue,
+            &FrameData {
+                cloths: &cloths,
+                collider_poses: &poses,
+                highlight: None,
+                drag_target: None,
+            },
+        );
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("weft render frame"),
+            });
+        self.renderer.render(
+            &self.gpu.device,
+            &mut encoder,
+            self.target.view(),
+            self.target.size(),
+            &self.camera,
+            &self.options,
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        Ok(self.target.read(self.gpu)?)
+    }
+
+    /// Completes the GIF (renamed from its temporary name) and the MP4; returns the files.
+    pub fn finish(mut self) -> anyhow::Result<Vec<PathBuf>> {
+        let mut written = Vec::new();
+        let gif_path = self.dir.join(format!("{}.gif", self.name));
+        if let Some(gif) = self.gif.take() {
+            // Dropping the encoder writes the trailer and flushes, but cannot report a failed
+            // write: check the file ends with the GIF trailer byte (0x3B) instead.
+            drop(gif);
+            let complete = self.gif_file.sync_all().is_ok() && ends_with_trailer(&self.gif_partial);
+            if !complete {
+                let _ = std::fs::remove_file(&self.gif_partial);
+                bail!("cannot write {} (incomplete)", self.gif_partial.display());
+            }
+            if self.images == 0 {
+                let _ = std::fs::remove_file(&self.gif_partial);
+                bail!("no frames were rendered");
+            }
+            std::fs::rename(&self.gif_partial, &gif_path)
+                .with_context(|| format!("cannot write {}", gif_path.display()))?;
+            written.push(gif_path);
+        }
+        if let Some(mp4) = self.mp4()? {
+            written.push(mp4);
+        }
+        Ok(written)
+    }
+
+    /// Encodes the PNGs as H.264 with ffmpeg when it is on PATH; logs and skips otherwise.
+    fn mp4(&self) -> anyhow::Result<Option<PathBuf>> {
+        let path = self.dir.join(format!("{}.mp4", self.name));
+        let partial = self.dir.join(format!(".{}.partial.mp4", self.name));
+        let status = Command::new("ffmpeg")
+            .args(["-y", "-loglevel", "error", "-framerate"])
+            .arg(format!("{:.6}", self.fps))
+            .arg("-i")
+            .arg(self.dir.join("frame_%05d.png"))
+            .args([
+                "-c:v",
+                "libx264",
+                "-pix_fmt",
+                "yuv420p",
+                "-vf",
+                "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+            ])
+            .arg(&partial)
+            .status();
+        match status {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                eprintln!("weft: ffmpeg is not on PATH: skipping {}", path.display());
+                Ok(None)
+            }
+            Err(e) => Err(e).context("cannot run ffmpeg"),
+            Ok(s) if !s.success() => {
+                let _ = std::fs::remove_file(&partial);
+                bail!("ffmpeg failed ({s}) encoding {}", path.display())
+            }
+            Ok(_) => {
+                std::fs::rename(&partial, &path)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                Ok(Some(path))
+            }
+        }
+    }
+}
+
+impl Drop for VideoRecorder<'_> {
+    fn drop(&mut self) {
+        // Unfinished (error or early return): never leave a partial GIF behind.
+        if self.gif.take().is_some() {
+            let _ = std::fs::remove_file(&self.gif_partial);
+        }
+    }
+}
+
+/// Whether the file at `path` ends with the GIF trailer byte.
+fn ends_with_trailer(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut last = [0u8; 1];
+    File::open(path)
+        .and_then(|mut f| {
+            f.seek(SeekFrom::End(-1))?;
+            f.read_exact(&mut last)
+        })
+        .is_ok()
+        && last[0] == 0x3B
+}
+
+/// A file name from the scene's name (a path: its stem), of letters, digits, `-` and `_`.
+fn file_stem(name: &str) -> String {
+    let stem = Path::new(name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let s: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() { "scene".into() } else { s }
+}
+
+/// Runs `weft render`.
+pub fn render(scene: Scene, plan: &VideoPlan<'_>, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
+    if plan.every == 0 || plan.frames / plan.every == 0 {
+        bail!(
+            "nothing to render: --frames {} with --every {} gives no image",
+            plan.frames,
+            plan.every
+        );
+    }
+    // The output directory first, so an unwritable one fails before any GPU work.
+    std::fs::create_dir_all(plan.out)
+        .with_context(|| format!("cannot create output directory {}", plan.out.display()))?;
+    let gpu = Gpu::headless().context("cannot render")?;
+    let mut sim = Simulation::new(scene)?;
+    let mut rec = VideoRecorder::new(&gpu, &sim, plan.out, plan.size, plan.every, plan.options)?;
+    eprintln!(
+        "weft: rendering {} on {} at {}x{}, every {} frame(s) of {}",
+        sim.scene.name,
+        gpu.describe(),
+        plan.size.x,
+        plan.size.y,
+        plan.every,
+        plan.frames
+    );
+    let bar = if plan.progress && std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(Some(plan.frames), ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} frames  eta {eta}") {
+            bar.set_style(style);
+        }
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut code = ExitCode::SUCCESS;
+    for _ in 0..plan.frames {
+        if stop.load(Ordering::SeqCst) {
+            eprintln!("weft: interrupted after {} frames", sim.frame());
+            code = ExitCode::from(EXIT_INTERRUPTED);
+            break;
+        }
+        if let Err(e) = sim.step() {
+            bar.finish_and_clear();
+            eprintln!("weft: error: {e}");
+            eprintln!(
+                "weft: {} image(s) of the frames before it are in {}; no GIF written",
+                rec.images(),
+                plan.out.display()
+            );
+            return Ok(ExitCode::from(EXIT_DIVERGED));
+        }
+        rec.frame(&sim)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let images = rec.images();
+    let written = rec.finish()?;
+    println!(
+        "wrote {images} PNG frame(s) to {}/frame_*.png",
+        plan.out.display()
+    );
+    for w in written {
+        let size = std::fs::metadata(&w).map(|m| m.len()).unwrap_or(0);
+        println!("wrote {} ({size} bytes)", w.display());
+    }
+    Ok(code)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_and_bad_ones_are_named() {
+        assert_eq!(parse_size("800x600"), Ok(UVec2::new(800, 600)));
+        assert_eq!(parse_size("16X9"), Ok(UVec2::new(16, 9)));
+        for bad in ["800", "0x10", "axb", "10x99999", "-1x5"] {
+            let e = parse_size(bad).expect_err(bad);
+            assert!(e.contains(bad), "{e}");
+        }
+    }
+
+    #[test]
+    fn file_stems_are_safe() {
+        assert_eq!(file_stem("assets/scenes/sphere_drop.toml"), "sphere_drop");
+        assert_eq!(file_stem("my scene (2).toml"), "my_scene__2_");
+        assert_eq!(file_stem(""), "scene");
+    }
+}

@@ -1,0 +1,120 @@
+//! `weft render` through the binary: PNG frames, an animated GIF with the right frame count,
+//! and clear errors. Needs a graphics adapter (CI: Mesa lavapipe or llvmpipe); without one
+//! these tests fail rather than skip.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use image::AnimationDecoder;
+use image::codecs::gif::GifDecoder;
+
+fn files(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .expect("output dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn render_writes_pngs_and_a_playable_gif() {
+    let dir = temp_dir("render-sphere");
+    let out_dir = dir.join("out");
+    // 6 frames at dt = 1/60, every 2nd: 3 images 33 ms apart, each one a GIF frame.
+    let out = run(&[
+        "render",
+        "assets/scenes/sphere_drop.toml",
+        "--frames",
+        "6",
+        "--every",
+        "2",
+        "--size",
+        "160x120",
+        "--out",
+        &out_dir.to_string_lossy(),
+        "-q",
+    ]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "stdout: {o}\nstderr: {e}");
+    let names = files(&out_dir);
+    let pngs: Vec<&String> = names.iter().filter(|n| n.ends_with(".png")).collect();
+    assert_eq!(
+        pngs,
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"],
+        "{names:?}"
+    );
+    assert!(
+        !names.iter().any(|n| n.contains("partial")),
+        "no temporary file left: {names:?}"
+    );
+    let first = image::open(out_dir.join("frame_00000.png"))
+        .expect("PNG decodes")
+        .to_rgba8();
+    let last = image::open(out_dir.join("frame_00002.png"))
+        .expect("PNG decodes")
+        .to_rgba8();
+    assert_eq!(first.dimensions(), (160, 120));
+    let distinct: std::collections::HashSet<[u8; 4]> = first.pixels().map(|p| p.0).collect();
+    assert!(distinct.len() > 50, "not blank: {} colours", distinct.len());
+    assert_ne!(first, last, "the cloth falls between the frames");
+
+    let gif_name = names
+        .iter()
+        .find(|n| n.ends_with(".gif"))
+        .unwrap_or_else(|| panic!("a GIF in {names:?}"));
+    assert_eq!(gif_name, "sphere_drop.gif");
+    let file = std::fs::File::open(out_dir.join(gif_name)).expect("GIF opens");
+    let frames = GifDecoder::new(std::io::BufReader::new(file))
+        .expect("GIF header decodes")
+        .into_frames()
+        .collect_frames()
+        .expect("every GIF frame decodes");
+    assert_eq!(frames.len(), 3);
+    for f in &frames {
+        assert_eq!(f.buffer().dimensions(), (160, 120));
+        let (num, den) = f.delay().numer_denom_ms();
+        let ms = f64::from(num) / f64::from(den);
+        // 33.3 ms, stored in whole centiseconds.
+        assert!((30.0..=40.0).contains(&ms), "delay {ms} ms");
+    }
+    if o.contains(".mp4") {
+        assert!(out_dir.join("sphere_drop.mp4").is_file());
+    } else {
+        assert!(e.contains("ffmpeg"), "the MP4 skip is logged: {e}");
+    }
+}
+
+#[test]
+fn unwritable_output_fails_with_a_message() {
+    let dir = temp_dir("render-unwritable");
+    // A directory cannot be made under a regular file, even as root.
+    let blocker = write(&dir, "file", "not a directory");
+    let target = format!("{blocker}/frames");
+    let out = run(&[
+        "render", "--frames", "2", "--size", "32x24", "--out", &target, "-q",
+    ]);
+    let (_, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("cannot create output directory"), "{e}");
+    assert!(e.contains(&target), "names the path: {e}");
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn bad_render_arguments_are_named() {
+    let dir = temp_dir("render-bad-args");
+    let out_dir = dir.join("out").to_string_lossy().into_owned();
+    let out = run(&["render", "--size", "100by20", "--out", &out_dir]);
+    let (_, e) = texts(&out);
+    assert!(!out.status.success());
+    assert!(e.contains("100by20") && e.contains("--size"), "{e}");
+
+    let out = run(&["render", "--frames", "3", "--every", "5", "--out", &out_dir]);
+    let (_, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("nothing to render"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+}
