@@ -8,7 +8,7 @@ scripts/install-test-deps.sh imagemagick
 out=${1:-docs/screenshot-drag.png}
 weft=${WEFT:-${CARGO_TARGET_DIR:-target}/debug/weft}
 display=:$((200 + RANDOM % 200))
-Xvfb "$display" -screen 0 1280x800x24 -nolisten tcp >/dev/null 2>&1 &
+Xvfb "$display" -screen 0 1280x800x24 -nolisten tcp -noreset >/dev/null 2>&1 &
 xvfb=$!
 trap 'kill $xvfb 2>/dev/null || true' EXIT
 sleep 1

@@ -44,6 +44,18 @@ struct Guard(Child);
 
 impl Drop for Guard {
     fn drop(&mut self) {
+        if self.0.try_wait().ok().flatten().is_some() {
+            return;
+        }
+        // SIGTERM first, so that Xvfb removes its lock file and socket.
+        let _ = Command::new("kill").arg(self.0.id().to_string()).status();
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(5) {
+            if self.0.try_wait().ok().flatten().is_some() {
+                return;
+            }
+            sleep(Duration::from_millis(50));
+        }
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
@@ -61,9 +73,10 @@ fn require(tool: &str, package: &str) {
     );
 }
 
-/// Starts Xvfb on a free display number; returns the display name and its guard.
-fn start_xvfb() -> (String, Guard) {
-    let base = 100 + std::process::id() % 400;
+/// Starts Xvfb on a free display number (searched from `offset`, so that the tests of this
+/// file start apart); returns the display name and its guard.
+fn start_xvfb(offset: u32) -> (String, Guard) {
+    let base = 100 + (std::process::id() % 200) * 4 + offset * 100;
     for n in base..base + 50 {
         if Path::new(&format!("/tmp/.X{n}-lock")).exists()
             || Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
@@ -78,6 +91,9 @@ fn start_xvfb() -> (String, Guard) {
                 "1280x1024x24".into(),
                 "-nolisten".into(),
                 "tcp".into(),
+                // No server reset when the last client leaves (the readiness check below is
+                // one): a viewer connecting during a reset would be refused.
+                "-noreset".into(),
             ])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
@@ -87,8 +103,21 @@ fn start_xvfb() -> (String, Guard) {
         let socket = format!("/tmp/.X11-unix/X{n}");
         let start = Instant::now();
         while start.elapsed() < Duration::from_secs(10) {
-            if Path::new(&socket).exists() {
-                return (format!(":{n}"), guard);
+            // Ready once a client can talk to it; another server may own the socket, so
+            // ours must also still be running.
+            let display = format!(":{n}");
+            if Path::new(&socket).exists()
+                && Command::new("xdotool")
+                    .arg("getdisplaygeometry")
+                    .env("DISPLAY", &display)
+                    .output()
+                    .is_ok_and(|o| o.status.success())
+            {
+                sleep(Duration::from_millis(300));
+                if guard.0.try_wait().ok().flatten().is_none() {
+                    return (display, guard);
+                }
+                break;
             }
             if guard.0.try_wait().ok().flatten().is_some() {
                 break; // lost a race for this number: try the next
@@ -161,8 +190,8 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     let log = dir.join("session.mcap");
 
     // The viewer opens with Camera::framing of the bounding box of the cloths and bounded
-    // colliders (app/meshes.rs, src/video.rs); this scene has no collider, so
-    // frame it the same way and find the pixel of the particle nearest the cloth's centre.
+    // colliders (app/meshes.rs, src/video.rs). This scene has no collider: frame the cloth
+    // the same way and find the pixel of the particle nearest its centre.
     let scene = weft_scene::load(Path::new(&scene_path), &[]).expect("scene loads");
     let groups = scene.build().expect("solvers");
     let x: Vec<Vec3> = groups[0]
@@ -191,42 +220,8 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
         );
     }
 
-    let (display, _xvfb) = start_xvfb();
-    let viewer = weft()
-        .args(["view", &scene_path, "--record"])
-        .arg(&log)
-        .args([
-            "--size",
-            &format!("{W}x{H}"),
-            "--exit-after-frames",
-            "100000",
-        ])
-        .env("DISPLAY", &display)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("weft view starts");
-    let mut viewer = Guard(viewer);
-
-    // Wait for the window, then for a few frames to be drawn.
-    let start = Instant::now();
-    let window = loop {
-        let found = xdotool(&display, &["search", "--name", "Weft"]);
-        if let Some(id) = found.split_whitespace().next() {
-            break id.to_owned();
-        }
-        if let Some(status) = viewer.0.try_wait().expect("wait") {
-            let out = viewer.0.wait_with_output_now();
-            panic!("the viewer exited before opening its window ({status}): {out}");
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no viewer window after 120 s"
-        );
-        sleep(Duration::from_millis(200));
-    };
-    sleep(Duration::from_secs(3));
+    let (display, _xvfb) = start_xvfb(0);
+    let (mut viewer, window) = open_viewer(&display, &scene_path, &log);
     // No window manager gives it the keyboard: focus it for the final `q`.
     xdotool(&display, &["windowfocus", "--sync", &window]);
 
@@ -249,18 +244,7 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     xdotool(&display, &["key", "q"]);
 
     // It quits on q and leaves a finished log.
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = viewer.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the viewer did not quit on q"
-        );
-        sleep(Duration::from_millis(100));
-    };
-    let out = viewer.0.wait_with_output_now();
+    let (status, out) = wait_exit(&mut viewer, "q");
     assert!(status.success(), "viewer failed ({status}): {out}");
 
     let (inter, positions) = read(&log, i);
@@ -310,6 +294,99 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
         "moved only {} m",
         (at - x[i]).length()
     );
+}
+
+/// Starts `weft view SCENE --record LOG` on `display` and waits for its window and a few
+/// frames; returns the process and the window id.
+fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
+    let viewer = weft()
+        .args(["view", scene, "--record"])
+        .arg(log)
+        .args([
+            "--size",
+            &format!("{W}x{H}"),
+            "--exit-after-frames",
+            "100000",
+        ])
+        .env("DISPLAY", display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft view starts");
+    let mut viewer = Guard(viewer);
+    let start = Instant::now();
+    let window = loop {
+        let pid = viewer.0.id().to_string();
+        let found = xdotool(display, &["search", "--pid", &pid, "--name", "Weft"]);
+        if let Some(id) = found.split_whitespace().next() {
+            break id.to_owned();
+        }
+        if let Some(status) = viewer.0.try_wait().expect("wait") {
+            let out = viewer.0.wait_with_output_now();
+            panic!("the viewer exited before opening its window on {display} ({status}): {out}");
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no viewer window after 120 s"
+        );
+        sleep(Duration::from_millis(200));
+    };
+    sleep(Duration::from_secs(3));
+    (viewer, window)
+}
+
+/// Waits for the viewer to exit (at most 60 s); returns its status and output.
+fn wait_exit(viewer: &mut Guard, what: &str) -> (std::process::ExitStatus, String) {
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = viewer.0.try_wait().expect("wait") {
+            break s;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the viewer did not quit on {what}"
+        );
+        sleep(Duration::from_millis(100));
+    };
+    (status, viewer.0.wait_with_output_now())
+}
+
+#[test]
+fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
+    require("Xvfb", "xvfb");
+    require("xdotool", "xdotool");
+    let dir = temp_dir("e2e-interrupt");
+    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let log = dir.join("session.mcap");
+    let (display, _xvfb) = start_xvfb(1);
+    let (mut viewer, _) = open_viewer(&display, &scene_path, &log);
+    let kill = Command::new("kill")
+        .args(["-INT", &viewer.0.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(kill.success());
+    let (status, out) = wait_exit(&mut viewer, "SIGINT");
+    assert_eq!(status.code(), Some(130), "{out}");
+    let bytes = std::fs::read(&log).expect("log exists");
+    let summary = mcap::Summary::read(&bytes)
+        .expect("summary readable")
+        .expect("the log was finished (it has a summary)");
+    let status = summary
+        .metadata_indexes
+        .iter()
+        .map(|i| mcap::read::metadata(&bytes, i).expect("metadata"))
+        .find(|m| m.name == "weft.status")
+        .expect("weft.status written");
+    assert_eq!(status.metadata["status"], "interrupted", "{out}");
+    let frames: u64 = status.metadata["frames"].parse().expect("a number");
+    let logged = mcap::MessageStream::new(&bytes)
+        .expect("readable")
+        .map(|m| m.expect("message"))
+        .filter(|m| m.channel.topic == "/interaction")
+        .count() as u64;
+    assert!(frames > 0, "{out}");
+    assert_eq!(logged, frames + 1, "frame 0 and every simulated frame");
 }
 
 /// Output of a finished child, for messages.

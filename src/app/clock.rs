@@ -88,10 +88,12 @@ impl<T: TimeSource> FixedClock<T> {
         let mut dropped = 0;
         if due > f64::from(self.max_steps) {
             // Keep only the fraction of a frame: the rest is time the simulation gives up.
-            let surplus = (self.accumulator / dt).floor();
-            dropped = surplus.min(f64::from(u32::MAX)) as u32;
-            self.accumulator -= surplus * dt;
+            dropped = (due - f64::from(self.max_steps)).min(f64::from(u32::MAX)) as u32;
+            self.accumulator = self.accumulator.rem_euclid(dt);
             self.dropped_total += u64::from(dropped);
+        }
+        if !self.accumulator.is_finite() {
+            self.accumulator = 0.0;
         }
         Tick { steps, dropped }
     }
@@ -213,6 +215,17 @@ mod tests {
         assert_eq!(c.tick(DT), Tick::default());
         assert_eq!(c.tick(DT).steps, 1);
         assert_eq!(c.dropped_total(), 0);
+    }
+
+    #[test]
+    fn an_absurdly_small_time_step_keeps_stepping_the_maximum() {
+        let mut c = clock(&[0.0, 1.0, 2.0], 4);
+        for _ in 0..2 {
+            let t = c.tick(1e-300);
+            assert_eq!(t.steps, 4);
+            assert_eq!(t.dropped, u32::MAX);
+            assert!(c.accumulator().is_finite());
+        }
     }
 
     #[test]
