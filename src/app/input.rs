@@ -27,7 +27,7 @@ pub enum Action {
 /// Every shortcut as (keys, what it does), in the order the help overlay lists them.
 pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Space", "pause / resume"),
-    ("S or →", "single step (pauses)"),
+    ("S or Right", "single step (pauses)"),
     ("R", "reset the scene"),
     ("W", "wireframe on / off"),
     ("P", "particles on / off"),

@@ -215,3 +215,78 @@ impl Session {
         log.finish(&status)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn session() -> Session {
+        let scene = SceneSource::Default.load(&[]).expect("default scene");
+        Session::new(
+            Simulation::new(scene).expect("solvers"),
+            SceneSource::Default,
+            4,
+        )
+    }
+
+    #[test]
+    fn reset_puts_the_cloth_back_and_clears_a_divergence() {
+        let mut s = session();
+        let start = s.sim.cloth_positions(0).to_vec();
+        for _ in 0..5 {
+            s.step_once().expect("steps");
+        }
+        assert_eq!(s.frames, 5);
+        assert_ne!(s.sim.cloth_positions(0), &start[..]);
+        s.diverged = Some("test".into());
+        s.reset().expect("resets");
+        assert_eq!(s.sim.cloth_positions(0), &start[..]);
+        assert_eq!(s.diverged, None);
+        assert_eq!(s.sim.frame(), 0);
+        // The session's own count goes on (it numbers the log's frames).
+        assert_eq!(s.frames, 5);
+    }
+
+    #[test]
+    fn the_method_switches_in_every_solver_and_bad_values_are_refused() {
+        let mut s = session();
+        s.set_method(Method::MassSpring).expect("valid");
+        assert!(
+            s.sim
+                .groups
+                .iter()
+                .all(|g| g.solver.settings().method == Method::MassSpring)
+        );
+        s.step_once().expect("steps with the new method");
+        let solver = &mut s.sim.groups[0].solver;
+        let bad = weft_solver::Settings {
+            substeps: 0,
+            ..*solver.settings()
+        };
+        assert!(solver.set_settings(bad).is_err());
+        assert_eq!(solver.settings().substeps, 10, "the old value is kept");
+    }
+
+    #[test]
+    fn switching_scene_loads_it_but_not_while_recording() {
+        let mut s = session();
+        let file = SceneSource::File(PathBuf::from("assets/scenes/sphere_drop.toml"));
+        s.switch_scene(file.clone()).expect("switches");
+        assert_eq!(s.source, file);
+        assert_eq!(s.sim.scene.name, "assets/scenes/sphere_drop.toml");
+        let missing = SceneSource::File(PathBuf::from("no/such.toml"));
+        let e = s.switch_scene(missing).expect_err("missing file");
+        assert!(format!("{e:#}").contains("no/such.toml"), "{e:#}");
+        assert_eq!(s.source, file, "a failed switch keeps the scene");
+        // Recording: the log holds one scene, so switching is refused.
+        let path = std::env::temp_dir().join(format!("weft-session-{}.mcap", std::process::id()));
+        let f = std::fs::File::create(&path).expect("temp file");
+        s.log = Some(SessionLog::new(f, &s.sim, 0, 0).expect("log"));
+        let e = s.switch_scene(SceneSource::Default).expect_err("refused");
+        assert!(format!("{e}").contains("recorded"), "{e}");
+        assert_eq!(s.source, file);
+        s.finish(false).expect("finishes");
+        assert!(s.log.is_none());
+        let _ = std::fs::remove_file(path);
+    }
+}
