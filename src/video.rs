@@ -99,7 +99,19 @@ pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
     colliders(sim).iter().map(|c| c.world_matrix()).collect()
 }
 
-/// A camera that frames the cloths and bounded colliders of `sim` as they are now.
+/// Height of the floor drawn under `sim`: its upward half-space if it has one, else y = 0,
+/// lowered under any cloth that starts below it.
+pub fn floor_height(sim: &Simulation, view: &SceneView) -> f32 {
+    view.ground.unwrap_or_else(|| {
+        let lowest = (0..sim.scene.cloths.len())
+            .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
+            .fold(0.0f32, f32::min);
+        if lowest < 0.0 { lowest - 0.01 } else { 0.0 }
+    })
+}
+
+/// A camera that frames the cloths and bounded colliders of `sim` as they are now, and the
+/// floor under them when it is near (so shadows and the drop are in view).
 pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for i in 0..sim.scene.cloths.len() {
@@ -119,6 +131,23 @@ pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
         if (b - a).length() < 20.0 {
             lo = lo.min(a);
             hi = hi.max(b);
+        }
+    }
+    let floor = floor_height(sim, view);
+    if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length() {
+        // Take in the floor and the shadow of the box's underside on it (its corners carried
+        // down along the sunlight), so hanging things show where their shadow falls.
+        let sun = weft_render::sun_direction();
+        let (a, b) = (lo, hi);
+        for i in 0..4 {
+            let c = Vec3::new(
+                if i & 1 == 0 { a.x } else { b.x },
+                a.y,
+                if i & 2 == 0 { a.z } else { b.z },
+            );
+            let shadow = c - sun * ((c.y - floor) / sun.y.max(0.1));
+            lo = lo.min(shadow);
+            hi = hi.max(shadow);
         }
     }
     Camera::framing(lo, hi)
@@ -191,15 +220,7 @@ impl<'g> VideoRecorder<'g> {
 
         let view = scene_meshes(sim);
         let mut renderer = Renderer::new(&gpu.device, OFFSCREEN_FORMAT, &view.meshes);
-        if let Some(y) = view.ground {
-            renderer.set_ground_height(y);
-        } else {
-            // No ground collider: put the floor just under everything so nothing sinks in it.
-            let lowest = (0..sim.scene.cloths.len())
-                .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
-                .fold(0.0f32, f32::min);
-            renderer.set_ground_height(lowest.min(0.0) - 0.01 * (lowest < 0.0) as u8 as f32);
-        }
+        renderer.set_ground_height(floor_height(sim, &view));
         let camera = framing_camera(sim, &view);
         Ok(Self {
             gpu,
@@ -232,9 +253,7 @@ impl<'g> VideoRecorder<'g> {
         }
         let image = self.draw(sim)?;
         let png = self.dir.join(format!("frame_{:05}.png", self.images));
-        image
-            .save(&png)
-            .with_context(|| format!("cannot write {}", png.display()))?;
+        save_png(&image, &png).with_context(|| format!("cannot write {}", png.display()))?;
         if self.images % self.gif_stride == 0
             && let Some(gif) = self.gif.as_mut()
         {
@@ -351,6 +370,22 @@ impl Drop for VideoRecorder<'_> {
             let _ = std::fs::remove_file(&self.gif_partial);
         }
     }
+}
+
+/// Writes `image` as a PNG with the strongest compression (about half the default's size).
+fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
+    use image::ImageEncoder;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let mut out = BufWriter::new(File::create(path)?);
+    PngEncoder::new_with_quality(&mut out, CompressionType::Best, FilterType::Adaptive)
+        .write_image(
+            image.as_raw(),
+            image.width(),
+            image.height(),
+            image::ExtendedColorType::Rgba8,
+        )?;
+    std::io::Write::flush(&mut out)?;
+    Ok(())
 }
 
 /// Whether the file at `path` ends with the GIF trailer byte.

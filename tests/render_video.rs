@@ -118,3 +118,47 @@ fn bad_render_arguments_are_named() {
     assert!(e.contains("nothing to render"), "{e}");
     assert!(!e.contains("panicked"), "{e}");
 }
+
+#[test]
+fn experiments_render_each_run_into_its_directory() {
+    let dir = temp_dir("render-experiments");
+    write(&dir, "small.toml", SMALL);
+    let exp = write(
+        &dir,
+        "exp.toml",
+        "scene = \"small.toml\"\nframes = 12\nmetrics = [\"sag\"]\n[[series]]\nname = \"x\"\nvary = { \"sim.substeps\" = [2, 4] }\n",
+    );
+    let out_dir = dir.join("out");
+    let out = run(&[
+        "experiments",
+        &exp,
+        "--out",
+        &out_dir.to_string_lossy(),
+        "--no-mcap",
+        "--render",
+        "--jobs",
+        "2",
+    ]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    let mut run_dirs: Vec<_> = std::fs::read_dir(out_dir.join("runs"))
+        .expect("runs")
+        .map(|d| d.expect("entry").path())
+        .filter(|p| p.is_dir())
+        .collect();
+    run_dirs.sort();
+    assert_eq!(run_dirs.len(), 2, "{run_dirs:?}");
+    for d in &run_dirs {
+        // 12 frames at 1/60 s, rendered every 2nd for ~30 images/s: 6 PNGs and 6 GIF frames.
+        let names = files(d);
+        let pngs = names.iter().filter(|n| n.ends_with(".png")).count();
+        assert_eq!(pngs, 6, "{}: {names:?}", d.display());
+        let file = std::fs::File::open(d.join("small.gif")).expect("GIF in the run directory");
+        let frames = GifDecoder::new(std::io::BufReader::new(file))
+            .expect("GIF decodes")
+            .into_frames()
+            .collect_frames()
+            .expect("frames decode");
+        assert_eq!(frames.len(), 6);
+    }
+}

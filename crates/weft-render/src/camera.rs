@@ -98,9 +98,25 @@ impl Camera {
             near: 0.01,
             far: 100.0,
         };
-        // A sphere of radius r fits in a cone of half-angle a at distance r / sin a; the
-        // vertical half-angle is the narrower one for landscape targets.
-        c.distance = 1.1 * radius / (0.5 * c.fov_y).sin();
+        // The nearest distance at which every corner of the box is inside the view cone of
+        // half-angle fov/2, both vertically and horizontally (for targets at least as wide as
+        // tall), with a 6% margin: a corner at (x, y, z) in view axes around the target needs
+        // D ≥ z + max(|x|, |y|) / tan(fov/2).
+        let (right, up) = c.right_up();
+        let back = c.back();
+        let t = (0.5 * c.fov_y).tan();
+        let half = 0.5 * (max - min);
+        let mut distance = radius;
+        for i in 0..8 {
+            let corner = Vec3::new(
+                if i & 1 == 0 { -half.x } else { half.x },
+                if i & 2 == 0 { -half.y } else { half.y },
+                if i & 4 == 0 { -half.z } else { half.z },
+            );
+            let (x, y, z) = (corner.dot(right), corner.dot(up), corner.dot(back));
+            distance = distance.max(z + x.abs().max(y.abs()) / (0.94 * t));
+        }
+        c.distance = distance;
         c.fit_clip_planes(radius);
         c
     }

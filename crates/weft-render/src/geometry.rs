@@ -33,6 +33,35 @@ pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]], out: &mut Vec<
     }
 }
 
+/// Planar texture coordinates: positions projected on the two axes along which they extend
+/// most, scaled so the longer side spans 0..1 (a grid cloth at rest gets its grid's UVs).
+pub fn planar_uvs(positions: &[Vec3]) -> Vec<[f32; 2]> {
+    let mut b = Bounds::default();
+    positions.iter().for_each(|&p| b.add(p));
+    if b.is_empty() {
+        return vec![[0.0, 0.0]; positions.len()];
+    }
+    let size = b.max - b.min;
+    // The two largest extents, in axis order.
+    let drop = if size.x <= size.y && size.x <= size.z {
+        0
+    } else if size.y <= size.z {
+        1
+    } else {
+        2
+    };
+    let (a, c) = match drop {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    let scale = 1.0 / size[a].max(size[c]).max(1e-6);
+    positions
+        .iter()
+        .map(|p| [(p[a] - b.min[a]) * scale, (p[c] - b.min[c]) * scale])
+        .collect()
+}
+
 /// f64 solver positions as f32 render positions.
 pub fn to_f32(src: &[DVec3], out: &mut Vec<Vec3>) {
     out.clear();
@@ -255,6 +284,21 @@ mod tests {
         for n in &s.normals {
             assert!((n.abs().max_element() - 1.0).abs() < 1e-6, "{n:?}");
         }
+    }
+
+    #[test]
+    fn planar_uvs_of_a_vertical_rectangle() {
+        // 2 m wide (x), 1 m tall (y), at z = 3: u along x, v along y, longer side 0..1.
+        let p = [
+            Vec3::new(-1.0, 0.0, 3.0),
+            Vec3::new(1.0, 0.0, 3.0),
+            Vec3::new(1.0, 1.0, 3.0),
+            Vec3::new(0.0, 0.5, 3.0),
+        ];
+        assert_eq!(
+            planar_uvs(&p),
+            vec![[0.0, 0.0], [1.0, 0.0], [1.0, 0.5], [0.5, 0.25]]
+        );
     }
 
     #[test]

@@ -21,6 +21,7 @@ pub use gpu::Gpu;
 pub use offscreen::{OFFSCREEN_FORMAT, Offscreen};
 pub use renderer::Renderer;
 pub use scene::{ClothTopology, FrameData, RenderOptions, SceneMeshes, TriMesh};
+pub use uniforms::sun_direction;
 
 /// Re-export of wgpu, so users name the same types.
 pub use wgpu;

@@ -15,6 +15,8 @@ pub struct LitVertex {
     pub normal: [f32; 3],
     /// Palette index.
     pub material: u32,
+    /// Texture coordinates of the cloth's checker (negative: untextured).
+    pub uv: [f32; 2],
 }
 
 /// A vertex of a line.
@@ -63,8 +65,8 @@ pub struct Pipelines {
     pub overlay_points: wgpu::RenderPipeline,
 }
 
-const LIT_ATTRS: [wgpu::VertexAttribute; 3] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+const LIT_ATTRS: [wgpu::VertexAttribute; 4] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32, 3 => Float32x2];
 const LINE_ATTRS: [wgpu::VertexAttribute; 2] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x4];
 const POINT_ATTRS: [wgpu::VertexAttribute; 3] =

@@ -25,6 +25,8 @@ const DRAG_LINE: [f32; 4] = [1.0, 0.78, 0.05, 0.9];
 /// One cloth's place in the shared buffers.
 struct ClothSlot {
     topology: ClothTopology,
+    /// Checker coordinates, from the first positions seen unless set.
+    uvs: Option<Vec<[f32; 2]>>,
     first_vertex: usize,
     edges: Vec<[u32; 2]>,
     material: u32,
@@ -138,6 +140,7 @@ impl Renderer {
                         .map(|&v| count(next + v as usize)),
                 );
                 let slot = ClothSlot {
+                    uvs: None,
                     edges: geometry::unique_edges(&triangles),
                     topology: ClothTopology {
                         particle_count: n,
@@ -309,6 +312,17 @@ impl Renderer {
         }
     }
 
+    /// Sets cloth `cloth`'s checker coordinates (one per particle; 1 = the cloth's longer
+    /// side). By default they are the planar projection of the first positions it is given.
+    /// Ignored when the count does not match.
+    pub fn set_cloth_uvs(&mut self, cloth: usize, uvs: &[glam::Vec2]) {
+        if let Some(slot) = self.cloths.get_mut(cloth)
+            && uvs.len() == slot.topology.particle_count
+        {
+            slot.uvs = Some(uvs.iter().map(|v| v.to_array()).collect());
+        }
+    }
+
     /// Bounds of the cloths and (bounded) colliders at the last update.
     pub fn scene_bounds(&self) -> Option<(Vec3, Vec3)> {
         (!self.focus.is_empty()).then_some((self.focus.min, self.focus.max))
@@ -320,7 +334,7 @@ impl Renderer {
         let mut cloth_bounds = Bounds::default();
         self.line_data.clear();
         self.point_data.clear();
-        for (i, slot) in self.cloths.iter().enumerate() {
+        for (i, slot) in self.cloths.iter_mut().enumerate() {
             let Some(src) = frame.cloths.get(i) else {
                 continue;
             };
@@ -328,21 +342,26 @@ impl Renderer {
                 continue;
             }
             geometry::to_f32(src, &mut self.scratch_pos);
+            let uvs = slot
+                .uvs
+                .get_or_insert_with(|| geometry::planar_uvs(&self.scratch_pos));
             geometry::vertex_normals(
                 &self.scratch_pos,
                 &slot.topology.triangles,
                 &mut self.scratch_normal,
             );
             let out = &mut self.staging[slot.first_vertex..slot.first_vertex + src.len()];
-            for ((v, p), n) in out
+            for (((v, p), n), uv) in out
                 .iter_mut()
                 .zip(&self.scratch_pos)
                 .zip(&self.scratch_normal)
+                .zip(uvs.iter())
             {
                 *v = LitVertex {
                     pos: p.to_array(),
                     normal: n.to_array(),
                     material: slot.material,
+                    uv: *uv,
                 };
                 cloth_bounds.add(*p);
             }
@@ -393,6 +412,7 @@ impl Renderer {
                         .normalize_or_zero()
                         .to_array(),
                     material: COLLIDER_MATERIAL,
+                    uv: [-1.0, -1.0],
                 };
             }
             if let Some(b) = slot.bounds {

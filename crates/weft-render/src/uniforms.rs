@@ -23,8 +23,13 @@ const CLOTH_COLOURS: [([f32; 3], [f32; 3]); CLOTH_MATERIALS as usize] = [
 /// Linear colour of colliders: a cool steel grey.
 const COLLIDER_COLOUR: [f32; 3] = [0.42, 0.45, 0.50];
 
-/// Direction towards the sun (normalised on use): high, from the front left.
-pub const SUN_DIR: Vec3 = Vec3::new(-0.45, 1.0, 0.55);
+/// Direction towards the sun (normalised on use): 46° up, from the front left.
+const SUN_DIR: Vec3 = Vec3::new(-0.55, 0.85, 0.6);
+
+/// The unit direction towards the sun (the key light that casts shadows).
+pub fn sun_direction() -> Vec3 {
+    SUN_DIR.normalize()
+}
 
 /// Shadow-map side (texels).
 pub const SHADOW_SIZE: u32 = 2048;

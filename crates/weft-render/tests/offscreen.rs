@@ -307,3 +307,81 @@ fn resizing_the_target_recreates_depth_and_keeps_the_picture() {
         assert!(is_front(img.get_pixel(size.x / 2, size.y / 2)));
     }
 }
+
+/// Mean luminance-ish (sum of channels) of the 5×5 pixels around `p`.
+fn brightness(img: &RgbaImage, p: Vec2) -> f64 {
+    let mut sum = 0.0;
+    for dy in -2..=2 {
+        for dx in -2..=2 {
+            let px = img.get_pixel((p.x as i32 + dx) as u32, (p.y as i32 + dy) as u32);
+            sum += f64::from(px.0[0]) + f64::from(px.0[1]) + f64::from(px.0[2]);
+        }
+    }
+    sum / 25.0
+}
+
+#[test]
+fn the_shadow_falls_on_the_ground_along_the_sunlight() {
+    let gpu = gpu();
+    // A horizontal 1 m square at y = 1 over the ground at y = 0, seen from high above.
+    let (topology, mut positions) = square();
+    for p in &mut positions {
+        *p = DVec3::new(p.x, 1.0, p.y - 1.0);
+    }
+    let scene = SceneMeshes {
+        cloths: vec![topology],
+        colliders: vec![],
+    };
+    let camera = Camera::looking_at(Vec3::new(0.0, 7.0, 0.5), Vec3::ZERO);
+    let shot = |shadows: bool| {
+        let target = Offscreen::new(&gpu.device, SIZE);
+        let mut r = Renderer::new(&gpu.device, target.format(), &scene);
+        let cloths = [&positions[..]];
+        r.update(
+            &gpu.queue,
+            &FrameData {
+                cloths: &cloths,
+                ..FrameData::default()
+            },
+        );
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        let options = RenderOptions {
+            grid: false,
+            shadows,
+            ..RenderOptions::default()
+        };
+        r.render(
+            &gpu.device,
+            &mut encoder,
+            target.view(),
+            SIZE,
+            &camera,
+            &options,
+        );
+        gpu.queue.submit([encoder.finish()]);
+        target.read(&gpu).expect("readback")
+    };
+    let (lit, unlit) = (shot(true), shot(false));
+    // The square's centre carried down along the sunlight, and the mirror point towards the
+    // sun, where the ground stays lit.
+    let sun = weft_render::sun_direction();
+    let offset = -sun / sun.y; // from height 1 to the ground
+    let shadow = camera
+        .project(Vec3::new(0.0, 1.0, 0.0) + offset, SIZE)
+        .expect("visible");
+    let sunny = camera
+        .project(Vec3::new(-offset.x, 0.0, -offset.z), SIZE)
+        .expect("visible");
+    let (s_on, s_off) = (brightness(&lit, shadow), brightness(&unlit, shadow));
+    let (l_on, l_off) = (brightness(&lit, sunny), brightness(&unlit, sunny));
+    assert!(
+        s_on < 0.8 * s_off,
+        "shadowed ground {s_on:.0} vs {s_off:.0} without shadows"
+    );
+    assert!(
+        (l_on - l_off).abs() < 6.0,
+        "sunny ground {l_on:.0} vs {l_off:.0}"
+    );
+}

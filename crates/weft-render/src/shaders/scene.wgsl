@@ -24,7 +24,7 @@ struct Globals {
 
 const SKY_TOP: vec3<f32> = vec3<f32>(0.20, 0.30, 0.46);
 const HORIZON: vec3<f32> = vec3<f32>(0.62, 0.66, 0.71);
-const GROUND: vec3<f32> = vec3<f32>(0.50, 0.51, 0.53);
+const GROUND: vec3<f32> = vec3<f32>(0.40, 0.41, 0.43);
 const SUN: vec3<f32> = vec3<f32>(1.05, 1.0, 0.92);
 
 // ACES filmic curve, Narkowicz 2015 ("ACES Filmic Tone Mapping Curve").
@@ -153,6 +153,7 @@ struct LitIn {
     @location(0) pos: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) material: u32,
+    @location(3) uv: vec2<f32>,
 };
 
 struct LitOut {
@@ -160,7 +161,19 @@ struct LitOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) material: u32,
+    @location(3) uv: vec2<f32>,
 };
+
+// Cells of the cloth checker across the cloth's longer side.
+const CHECKER_CELLS: f32 = 16.0;
+
+// A box-filtered checker (0 or 1, blended where a pixel covers several cells), after
+// Quílez, "Filterable procedurals: checkerboard" (iquilezles.org, 2013).
+fn checker(p: vec2<f32>) -> f32 {
+    let w = max(fwidth(p), vec2<f32>(1e-4));
+    let i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
+    return 0.5 - 0.5 * i.x * i.y;
+}
 
 @vertex
 fn vs_lit(in: LitIn) -> LitOut {
@@ -169,11 +182,13 @@ fn vs_lit(in: LitIn) -> LitOut {
     out.world = in.pos;
     out.normal = in.normal;
     out.material = in.material;
+    out.uv = in.uv;
     return out;
 }
 
 @fragment
 fn fs_lit(in: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let cell = checker(in.uv * CHECKER_CELLS);
     let m = min(in.material, 7u);
     let front_col = g.palette[m * 2u];
     let back_col = g.palette[m * 2u + 1u];
@@ -186,6 +201,10 @@ fn fs_lit(in: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     } else if (!front) {
         n = -n;
         albedo = back_col.rgb;
+    }
+    if (in.uv.x > -0.5) {
+        // A subtle woven checker: stretch and folds read on flat-coloured cloth.
+        albedo = albedo * (1.0 - 0.12 * cell);
     }
     let l = g.light_dir.xyz;
     let sun = sunlight(in.world, n);
