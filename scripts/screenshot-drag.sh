@@ -13,17 +13,18 @@ xvfb=$!
 trap 'kill $xvfb 2>/dev/null || true' EXIT
 sleep 1
 export DISPLAY=$display WGPU_BACKEND=${WGPU_BACKEND:-vulkan}
-"$weft" view --size 1280x800 &
+"$weft" view --size 1280x800 --eye 1.0,1.7,2.7 --target 0.1,1.25,0 &
 app=$!
 for _ in $(seq 100); do xdotool search --name Weft >/dev/null 2>&1 && break; sleep 0.2; done
 sleep 4
 win=$(xdotool search --name Weft | head -1)
 xdotool windowfocus --sync "$win"
-# The lower part of the cloth (default camera, 1280x800), pulled down and to the left.
-xdotool mousemove --sync 660 560
+# The middle of the cloth's lower edge (in the camera above, 1280x800), pulled down, left
+# and toward the viewer.
+xdotool mousemove --sync 615 470
 sleep 0.5
 xdotool mousedown 1
-for i in $(seq 10); do xdotool mousemove $((660 - 15 * i)) $((560 + 8 * i)); sleep 0.15; done
+for i in $(seq 10); do xdotool mousemove $((615 - 16 * i)) $((470 + 13 * i)); sleep 0.15; done
 sleep 2.5
 import -window root -crop 1280x800+0+0 "$out"
 xdotool mouseup 1

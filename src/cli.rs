@@ -115,6 +115,22 @@ pub struct ViewArgs {
     /// Start paused (Space resumes).
     #[arg(long)]
     pub paused: bool,
+    /// Camera position `X,Y,Z` (m) instead of the automatic framing (with --target).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "target",
+        allow_hyphen_values = true
+    )]
+    pub eye: Option<Point>,
+    /// Point the camera looks at, `X,Y,Z` (m) (with --eye).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "eye",
+        allow_hyphen_values = true
+    )]
+    pub target: Option<Point>,
     /// At most this many simulation frames per displayed frame; real time beyond is dropped.
     #[arg(long, default_value_t = 4, value_name = "K")]
     pub max_steps_per_frame: u32,
@@ -124,6 +140,26 @@ impl ViewArgs {
     /// The overrides, `--method` first.
     pub fn overrides(&self) -> Vec<Override> {
         overrides(self.method, &self.set)
+    }
+}
+
+/// A point `X,Y,Z` in metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point(pub [f32; 3]);
+
+impl std::str::FromStr for Point {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let v: Vec<f32> = s
+            .split(',')
+            .map(|c| c.trim().parse::<f32>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("expected X,Y,Z in metres, got {s:?}: {e}"))?;
+        match v[..] {
+            [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Self([x, y, z])),
+            _ => Err(format!("expected three finite numbers X,Y,Z, got {s:?}")),
+        }
     }
 }
 

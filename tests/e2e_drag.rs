@@ -23,6 +23,11 @@ const W: u32 = 960;
 const H: u32 = 640;
 const PANEL: f32 = 300.0;
 
+/// The camera the viewer is opened with: in front of the cloth, a little to the right and
+/// above.
+const EYE: Vec3 = Vec3::new(0.8, 1.9, 2.6);
+const TARGET: Vec3 = Vec3::new(0.0, 1.5, 0.0);
+
 /// A 16 × 16 vertical cloth pinned along its top edge: it hangs straight, so the particle
 /// under the cursor is where it started when the test clicks.
 const SCENE: &str = r#"[sim]
@@ -189,9 +194,8 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     let scene_path = write(&dir, "sheet.toml", SCENE);
     let log = dir.join("session.mcap");
 
-    // The viewer opens with Camera::framing of the bounding box of the cloths and bounded
-    // colliders (app/meshes.rs, src/video.rs). This scene has no collider: frame the cloth
-    // the same way and find the pixel of the particle nearest its centre.
+    // The viewer is opened with this camera (--eye, --target), so the test knows which
+    // pixel shows which particle: the one nearest the cloth's centre.
     let scene = weft_scene::load(Path::new(&scene_path), &[]).expect("scene loads");
     let groups = scene.build().expect("solvers");
     let x: Vec<Vec3> = groups[0]
@@ -205,7 +209,7 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(a, b), p| (a.min(*p), b.max(*p)),
     );
-    let camera = Camera::framing(min, max);
+    let camera = Camera::looking_at(EYE, TARGET);
     let size = UVec2::new(W, H);
     let centre = 0.5 * (min + max);
     let i = (0..x.len())
@@ -251,7 +255,7 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     let grabbed: Vec<&Interaction> = inter.iter().filter(|m| m.particle.is_some()).collect();
     assert!(
         grabbed.len() >= 10,
-        "only {} of {} logged frames show a grab: {out}",
+        "only {} of {} logged frames show a grab (drag {from} -> {to}): {out}",
         grabbed.len(),
         inter.len()
     );
@@ -296,6 +300,10 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     );
 }
 
+fn xyz(v: Vec3) -> String {
+    format!("{},{},{}", v.x, v.y, v.z)
+}
+
 /// Starts `weft view SCENE --record LOG` on `display` and waits for its window and a few
 /// frames; returns the process and the window id.
 fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
@@ -308,6 +316,7 @@ fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
             "--exit-after-frames",
             "100000",
         ])
+        .args(["--eye", &xyz(EYE), "--target", &xyz(TARGET)])
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::piped())

@@ -160,7 +160,7 @@ fn scene_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out
         );
     }
     if session.log.is_some() {
-        ui.label("● recording");
+        ui.label("recording to MCAP");
     }
 }
 

@@ -31,6 +31,8 @@ pub struct WindowConfig {
     pub exit_after_frames: Option<u64>,
     /// Start paused.
     pub paused: bool,
+    /// A fixed initial camera `(eye, target)` instead of the automatic framing.
+    pub camera: Option<(glam::Vec3, glam::Vec3)>,
 }
 
 /// Everything that exists only while the window does.
@@ -74,7 +76,10 @@ impl App {
         stop: Arc<AtomicBool>,
         panel: PanelState,
     ) -> Self {
-        let camera = meshes::initial_camera(&session.sim);
+        let camera = match config.camera {
+            Some((eye, target)) => Camera::looking_at(eye, target),
+            None => meshes::initial_camera(&session.sim),
+        };
         Self {
             session,
             config,
@@ -146,8 +151,11 @@ impl App {
         config.format = format;
         config.present_mode = wgpu::PresentMode::AutoVsync;
         surface.configure(&gpu.device, &config);
-        let (renderer, camera) = meshes::renderer_for(&gpu.device, format, &self.session.sim);
-        self.camera = camera;
+        let (renderer, framing) = meshes::renderer_for(&gpu.device, format, &self.session.sim);
+        self.camera = match self.config.camera {
+            Some((eye, target)) => Camera::looking_at(eye, target),
+            None => framing,
+        };
         let egui_state = egui_winit::State::new(
             self.egui.clone(),
             egui::ViewportId::ROOT,
