@@ -8,16 +8,17 @@ use weft_solver::Method;
 
 /// Real-time cloth simulation with XPBD, PBD and mass-spring.
 ///
-/// With no command, runs the built-in default scene (assets/scenes/hanging.toml) headless.
+/// With no command, opens the interactive viewer on the built-in default scene
+/// (assets/scenes/hanging.toml); `weft run` runs scenes headless.
 #[derive(Debug, Parser)]
 #[command(version, about, args_conflicts_with_subcommands = true)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// Options for the default run.
+    /// Options of the viewer (the default command).
     #[command(flatten)]
-    pub run: RunArgs,
+    pub view: ViewArgs,
 }
 
 /// Subcommands.
@@ -31,6 +32,8 @@ pub enum Command {
     Replay(ReplayArgs),
     /// Run an experiments file: a queue of runs, a summary table and plots.
     Experiments(ExperimentArgs),
+    /// Open a scene in the interactive viewer (the default command).
+    View(ViewArgs),
     /// Render a scene offscreen: PNG frames, an animated GIF and (with ffmpeg) an MP4.
     Render(RenderArgs),
 }
@@ -69,16 +72,122 @@ pub struct RunArgs {
 impl RunArgs {
     /// The overrides, `--method` first.
     pub fn overrides(&self) -> Vec<Override> {
-        let mut v: Vec<Override> = self
-            .method
-            .map(|m| Override {
-                key: "sim.method".into(),
-                value: format!("\"{}\"", m.name()),
-            })
-            .into_iter()
-            .collect();
-        v.extend(self.set.iter().cloned());
-        v
+        overrides(self.method, &self.set)
+    }
+}
+
+/// `--method` as an override, followed by the `--set` ones.
+fn overrides(method: Option<Method>, set: &[Override]) -> Vec<Override> {
+    let mut v: Vec<Override> = method
+        .map(|m| Override {
+            key: "sim.method".into(),
+            value: format!("\"{}\"", m.name()),
+        })
+        .into_iter()
+        .collect();
+    v.extend(set.iter().cloned());
+    v
+}
+
+/// `weft view` (and `weft` with no command).
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// Scene file (default: the built-in hanging cloth).
+    pub scene: Option<PathBuf>,
+    /// Override a scene key: `--set sim.substeps=20` (repeatable; values are TOML, else strings).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<Override>,
+    /// Shorthand for `--set sim.method=…` (xpbd, pbd or mass-spring).
+    #[arg(long)]
+    pub method: Option<Method>,
+    /// Log the session to this MCAP file (as `weft run --out`, plus an `/interaction` channel).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// Log the cloth surface every N frames when recording (0: never).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub mesh_every: u64,
+    /// Window size in pixels.
+    #[arg(long, default_value = "1280x800", value_name = "WxH")]
+    pub size: WindowSize,
+    /// Quit cleanly after this many simulated frames (for tests and scripts).
+    #[arg(long, value_name = "N")]
+    pub exit_after_frames: Option<u64>,
+    /// Start paused (Space resumes).
+    #[arg(long)]
+    pub paused: bool,
+    /// Camera position `X,Y,Z` (m) instead of the automatic framing (with --target).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "target",
+        allow_hyphen_values = true
+    )]
+    pub eye: Option<Point>,
+    /// Point the camera looks at, `X,Y,Z` (m) (with --eye).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "eye",
+        allow_hyphen_values = true
+    )]
+    pub target: Option<Point>,
+    /// At most this many simulation frames per displayed frame; real time beyond is dropped.
+    #[arg(long, default_value_t = 4, value_name = "K")]
+    pub max_steps_per_frame: u32,
+}
+
+impl ViewArgs {
+    /// The overrides, `--method` first.
+    pub fn overrides(&self) -> Vec<Override> {
+        overrides(self.method, &self.set)
+    }
+}
+
+/// A point `X,Y,Z` in metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point(pub [f32; 3]);
+
+impl std::str::FromStr for Point {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let v: Vec<f32> = s
+            .split(',')
+            .map(|c| c.trim().parse::<f32>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("expected X,Y,Z in metres, got {s:?}: {e}"))?;
+        match v[..] {
+            [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Self([x, y, z])),
+            _ => Err(format!("expected three finite numbers X,Y,Z, got {s:?}")),
+        }
+    }
+}
+
+/// A window size `WxH` in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WindowSize {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+}
+
+impl std::str::FromStr for WindowSize {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("expected WIDTHxHEIGHT in pixels (e.g. 1280x800), got {s:?}");
+        let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+        let parse = |v: &str| {
+            v.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|&n| (64..=16384).contains(&n))
+        };
+        match (parse(w), parse(h)) {
+            (Some(width), Some(height)) => Ok(Self { width, height }),
+            _ => Err(format!("{}; each side in 64..=16384", bad())),
+        }
     }
 }
 

@@ -1,6 +1,7 @@
-//! The `weft` binary: runs scenes headless, logs them to MCAP, checks scene files, replays
-//! logs and runs experiment queues.
+//! The `weft` binary: the interactive viewer; runs scenes headless, logs them to MCAP, checks
+//! scene files, replays logs and runs experiment queues.
 
+mod app;
 mod cli;
 mod default_scene;
 mod experiments;
@@ -30,7 +31,8 @@ fn main() -> ExitCode {
         eprintln!("weft: warning: cannot catch SIGINT/SIGTERM: {e}");
     }
     let result = match cli.command {
-        None => run_command(&cli.run, &stop),
+        None => app::view(&cli.view, Arc::clone(&stop)),
+        Some(Command::View(args)) => app::view(&args, Arc::clone(&stop)),
         Some(Command::Run(args)) => run_command(&args, &stop),
         Some(Command::Check(args)) => check(&args),
         Some(Command::Replay(args)) => replay::replay(&args, &stop),

@@ -82,7 +82,7 @@ fn the_default_scene_is_hanging_toml() {
     let dir = temp_dir("default");
     let a = dir.join("a.json");
     let b = dir.join("b.json");
-    let out = run(&["--frames", "3", "--dump-final", &a.to_string_lossy()]);
+    let out = run(&["run", "--frames", "3", "--dump-final", &a.to_string_lossy()]);
     assert!(out.status.success(), "{:?}", texts(&out));
     let out = run(&[
         "run",

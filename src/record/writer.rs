@@ -232,6 +232,32 @@ impl Recorder {
         self.raw(self.stats, time)
     }
 
+    /// Adds a JSON channel (described by a JSON schema) for messages written with
+    /// [`Recorder::json`], e.g. the viewer's `/interaction`.
+    pub fn add_json_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema: &str,
+    ) -> anyhow::Result<u16> {
+        let id = self
+            .w
+            .add_schema(schema_name, "jsonschema", schema.as_bytes())?;
+        Ok(self.w.add_channel(id, topic, "json", &BTreeMap::new())?)
+    }
+
+    /// Writes one JSON message at simulated time `time` (s) on a channel from
+    /// [`Recorder::add_json_channel`].
+    pub fn json(
+        &mut self,
+        channel: u16,
+        time: f64,
+        value: &serde_json::Value,
+    ) -> anyhow::Result<()> {
+        self.buf = serde_json::to_vec(value)?;
+        self.raw(channel, time)
+    }
+
     /// Writes the status record, the summary section and the footer, and syncs the file.
     pub fn finish(mut self, status: &Status, frames_simulated: u64) -> anyhow::Result<()> {
         let message = match status {

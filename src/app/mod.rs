@@ -1,0 +1,132 @@
+//! `weft view` (and `weft` with no command): the interactive viewer.
+//!
+//! | file | holds |
+//! |---|---|
+//! | `window.rs` | winit event loop, wgpu surface, renderer + egui drawing, input wiring |
+//! | `session.rs` | the simulation side: solvers, clock, grab, live changes, log |
+//! | `clock.rs` | fixed simulation step decoupled from the display rate |
+//! | `picking.rs`, `grab.rs` | ray–cloth picking; grabbing and dragging through the solver |
+//! | `input.rs` | key and mouse-button bindings |
+//! | `panel.rs` | the egui side panel |
+//! | `meshes.rs` | scene meshes for the renderer, the initial camera |
+//! | `recording.rs` | `--record`: the MCAP log and its `/interaction` channel |
+
+pub mod clock;
+pub mod grab;
+pub mod input;
+pub mod meshes;
+pub mod panel;
+pub mod picking;
+pub mod recording;
+pub mod session;
+pub mod window;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use anyhow::Context;
+use winit::event_loop::EventLoop;
+
+use crate::cli::ViewArgs;
+use crate::run::{EXIT_INTERRUPTED, create_output};
+use crate::sim::Simulation;
+use recording::SessionLog;
+use session::{SceneSource, Session};
+use window::{App, WindowConfig};
+
+/// Opens the viewer as `args` say; returns when the window closes.
+pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
+    let source = args
+        .scene
+        .clone()
+        .map_or(SceneSource::Default, SceneSource::File);
+    let overrides = args.overrides();
+    let scene = match source.load(&overrides) {
+        Ok(s) => s,
+        Err(errors) => {
+            for e in &errors.0 {
+                eprintln!("error: {e}");
+            }
+            return Ok(ExitCode::FAILURE);
+        }
+    };
+    // An unwritable log fails before any window opens.
+    let file = args.record.as_deref().map(create_output).transpose()?;
+    let sim = Simulation::new(scene)?;
+    let log = file
+        .map(|f| {
+            SessionLog::new(
+                f,
+                &sim,
+                args.mesh_every,
+                args.exit_after_frames.unwrap_or(0),
+            )
+        })
+        .transpose()?;
+    let event_loop = match EventLoop::new() {
+        Ok(l) => l,
+        Err(e) => {
+            drop(log);
+            if let Some(p) = &args.record {
+                let _ = std::fs::remove_file(p);
+            }
+            anyhow::bail!(
+                "cannot open a window: {e}\n  \
+                 The viewer needs a display (DISPLAY or WAYLAND_DISPLAY); none is usable here.\n  \
+                 Use `weft run [SCENE]` to simulate headless (with --out FILE.mcap to log it), \
+                 or `weft render` to draw a scene to image files."
+            );
+        }
+    };
+    let mut panel = panel::PanelState {
+        scenes: panel::list_scenes(&scenes_dir(args.scene.as_deref())),
+        ..Default::default()
+    };
+    if !panel.scenes.contains(&source) {
+        panel.scenes.push(source.clone());
+    }
+    let mut session = Session::new(sim, source, args.max_steps_per_frame);
+    session.log = log;
+    let config = WindowConfig {
+        size: (args.size.width, args.size.height),
+        exit_after_frames: args.exit_after_frames,
+        paused: args.paused,
+        camera: args
+            .eye
+            .zip(args.target)
+            .map(|(e, t)| (glam::Vec3::from(e.0), glam::Vec3::from(t.0))),
+    };
+    let mut app = App::new(session, config, stop, panel);
+    let ran = event_loop.run_app(&mut app);
+    // Finish the log on every way out (window closed, q, Ctrl-C, an error).
+    let interrupted = app.interrupted;
+    let error = app.error.take();
+    let session = app.session_mut();
+    let frames = session.frames;
+    let finished = session.finish(interrupted);
+    ran.context("the window's event loop failed")?;
+    if let Some(e) = error {
+        return Err(e);
+    }
+    finished.context("finishing the MCAP file")?;
+    println!("{frames} frames simulated");
+    if let Some(p) = &args.record {
+        let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+        println!("wrote {} ({size} bytes)", p.display());
+    }
+    Ok(if interrupted {
+        ExitCode::from(EXIT_INTERRUPTED)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Where the panel looks for scenes: beside the opened scene file, else `assets/scenes`.
+fn scenes_dir(scene: Option<&Path>) -> PathBuf {
+    scene
+        .and_then(Path::parent)
+        .filter(|p| !p.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("assets/scenes"), Path::to_path_buf)
+}

@@ -1,0 +1,373 @@
+//! The egui side panel: scene and method, live parameters, statistics.
+//!
+//! Every widget edits a copy read from the solver this frame; a change goes through the
+//! solver's validating setter, and a refused value is shown as an error (the solver keeps its
+//! old value).
+
+use std::path::{Path, PathBuf};
+
+use egui::{ComboBox, DragValue, RichText, Ui};
+use weft_render::RenderOptions;
+use weft_solver::glam::DVec3;
+use weft_solver::{Family, Method};
+
+use crate::app::session::{SceneSource, Session};
+
+/// The panel's own state.
+#[derive(Debug, Default)]
+pub struct PanelState {
+    /// The cloth whose parameters are shown.
+    pub cloth: usize,
+    /// The last refused value or failed action.
+    pub error: Option<String>,
+    /// The scenes offered.
+    pub scenes: Vec<SceneSource>,
+}
+
+/// What the window must do after the panel ran.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Outcome {
+    /// The scene (and its meshes) changed: rebuild the renderer and re-frame the camera.
+    pub scene_changed: bool,
+    /// The pause button was pressed.
+    pub toggle_pause: bool,
+    /// The step button was pressed.
+    pub step: bool,
+    /// The reset button was pressed.
+    pub reset: bool,
+}
+
+/// The built-in scene, then every `*.toml` in `dir` (sorted).
+pub fn list_scenes(dir: &Path) -> Vec<SceneSource> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    std::iter::once(SceneSource::Default)
+        .chain(files.into_iter().map(SceneSource::File))
+        .collect()
+}
+
+fn note(state: &mut PanelState, r: Result<(), impl std::fmt::Display>) {
+    if let Err(e) = r {
+        state.error = Some(e.to_string());
+    }
+}
+
+/// Draws the panel's contents.
+pub fn show(
+    ui: &mut Ui,
+    session: &mut Session,
+    state: &mut PanelState,
+    options: &mut RenderOptions,
+) -> Outcome {
+    let mut out = Outcome::default();
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        ui.heading("Weft");
+        scene_section(ui, session, state, &mut out);
+        ui.separator();
+        stats_section(ui, session);
+        ui.separator();
+        solver_section(ui, session, state);
+        ui.separator();
+        cloth_section(ui, session, state);
+        ui.separator();
+        ui.label(RichText::new("View").strong());
+        ui.horizontal_wrapped(|ui| {
+            ui.checkbox(&mut options.wireframe, "wireframe");
+            ui.checkbox(&mut options.particles, "particles");
+            ui.checkbox(&mut options.grid, "grid");
+            ui.checkbox(&mut options.shadows, "shadows");
+        });
+        if let Some(e) = &state.error {
+            ui.separator();
+            ui.colored_label(egui::Color32::from_rgb(255, 110, 110), e);
+            if ui.small_button("dismiss").clicked() {
+                state.error = None;
+            }
+        }
+    });
+    out
+}
+
+fn scene_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out: &mut Outcome) {
+    let current = session.source.label();
+    let mut chosen = None;
+    ComboBox::from_label("scene")
+        .selected_text(short(&current))
+        .width(190.0)
+        .show_ui(ui, |ui| {
+            for s in &state.scenes {
+                if ui
+                    .selectable_label(*s == session.source, short(&s.label()))
+                    .clicked()
+                {
+                    chosen = Some(s.clone());
+                }
+            }
+        });
+    if let Some(s) = chosen
+        && s != session.source
+    {
+        match session.switch_scene(s) {
+            Ok(()) => {
+                out.scene_changed = true;
+                state.cloth = 0;
+                state.error = None;
+            }
+            Err(e) => state.error = Some(format!("{e:#}")),
+        }
+    }
+    let method = session
+        .sim
+        .groups
+        .first()
+        .map_or(Method::Xpbd, |g| g.solver.settings().method);
+    let mixed = session
+        .sim
+        .groups
+        .iter()
+        .any(|g| g.solver.settings().method != method);
+    let mut chosen_method = None;
+    ComboBox::from_label("method")
+        .selected_text(if mixed { "mixed" } else { method.name() })
+        .show_ui(ui, |ui| {
+            for candidate in Method::ALL {
+                let on = !mixed && candidate == method;
+                if ui.selectable_label(on, candidate.name()).clicked() {
+                    chosen_method = Some(candidate);
+                }
+            }
+        });
+    if let Some(m) = chosen_method {
+        let r = session.set_method(m);
+        note(state, r);
+    }
+    ui.horizontal(|ui| {
+        let paused = session.clock.paused();
+        out.toggle_pause = ui.button(if paused { "run" } else { "pause" }).clicked();
+        out.step = ui.button("step").clicked();
+        out.reset = ui.button("reset").clicked();
+    });
+    if let Some(m) = &session.diverged {
+        ui.colored_label(
+            egui::Color32::from_rgb(255, 110, 110),
+            format!("diverged: {m} (R resets)"),
+        );
+    }
+    if session.log.is_some() {
+        ui.label("recording to MCAP");
+    }
+}
+
+fn short(label: &str) -> String {
+    Path::new(label)
+        .file_name()
+        .map_or_else(|| label.to_owned(), |f| f.to_string_lossy().into_owned())
+        .trim_end_matches(')')
+        .to_owned()
+}
+
+fn stats_section(ui: &mut Ui, session: &Session) {
+    let s = &session.stats;
+    let particles: usize = session
+        .sim
+        .groups
+        .iter()
+        .map(|g| g.solver.particles().len())
+        .sum();
+    let constraints: usize = session
+        .sim
+        .groups
+        .iter()
+        .map(|g| g.solver.constraints().len())
+        .sum();
+    let time: f64 = session.sim.groups.first().map_or(0.0, |g| g.solver.time());
+    egui::Grid::new("stats").num_columns(2).show(ui, |ui| {
+        let mut row = |k: &str, v: String| {
+            ui.label(k);
+            ui.label(v);
+            ui.end_row();
+        };
+        row("step", format!("{:.2} ms", s.step_ms));
+        row("frame", format!("{:.1} ms", s.frame_ms));
+        row("particles", particles.to_string());
+        row("constraints", constraints.to_string());
+        row("contacts", s.contacts.to_string());
+        row("sim time", format!("{time:.3} s"));
+        row("frames", session.frames.to_string());
+        let grabbed = session.grab.map_or_else(
+            || "nothing (left-drag the cloth)".to_owned(),
+            |g| {
+                let name = session
+                    .sim
+                    .scene
+                    .cloths
+                    .get(g.cloth)
+                    .map_or("?", |c| c.name.as_str());
+                format!("{name} particle {}", g.particle)
+            },
+        );
+        row("grabbed", grabbed);
+        let dropped = session.clock.dropped_total();
+        row(
+            "dropped",
+            if dropped > 0 {
+                format!("{dropped} frames (slower than real time)")
+            } else {
+                "0".into()
+            },
+        );
+    });
+}
+
+fn drag_f64(ui: &mut Ui, label: &str, v: &mut f64, speed: f64) -> bool {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        ui.add(DragValue::new(v).speed(speed).max_decimals(9))
+            .changed()
+    })
+    .inner
+}
+
+fn drag_vec(ui: &mut Ui, label: &str, v: &mut DVec3, speed: f64) -> bool {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        let mut changed = false;
+        for c in [&mut v.x, &mut v.y, &mut v.z] {
+            changed |= ui.add(DragValue::new(c).speed(speed)).changed();
+        }
+        changed
+    })
+    .inner
+}
+
+fn solver_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
+    let Some(first) = session.sim.groups.first() else {
+        return;
+    };
+    ui.label(RichText::new("Solver (every method)").strong());
+    let mut settings = *first.solver.settings();
+    let mut forces = *first.solver.forces();
+    let mut changed = false;
+    let mut dt_ms = settings.dt * 1e3;
+    if drag_f64(ui, "time step (ms)", &mut dt_ms, 0.1) {
+        settings.dt = dt_ms * 1e-3;
+        changed = true;
+    }
+    ui.horizontal(|ui| {
+        ui.label("substeps");
+        changed |= ui
+            .add(DragValue::new(&mut settings.substeps).speed(0.2))
+            .changed();
+        ui.label("iterations");
+        changed |= ui
+            .add(DragValue::new(&mut settings.iterations).speed(0.2))
+            .changed();
+    });
+    if changed {
+        for g in &mut session.sim.groups {
+            let s = weft_solver::Settings {
+                method: g.solver.settings().method,
+                ..settings
+            };
+            let r = g.solver.set_settings(s);
+            note(state, r);
+        }
+    }
+    let mut fchanged = drag_vec(ui, "gravity", &mut forces.gravity, 0.05);
+    fchanged |= drag_vec(ui, "wind", &mut forces.wind.velocity, 0.05);
+    fchanged |= drag_f64(ui, "wind drag (1/s)", &mut forces.wind.drag, 0.01);
+    fchanged |= drag_f64(ui, "damping (1/s)", &mut forces.damping, 0.01);
+    if fchanged {
+        for g in &mut session.sim.groups {
+            let r = g.solver.set_forces(forces);
+            note(state, r);
+        }
+    }
+}
+
+fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
+    let cloths = &session.sim.scene.cloths;
+    if cloths.is_empty() {
+        return;
+    }
+    state.cloth = state.cloth.min(cloths.len() - 1);
+    let names: Vec<String> = cloths.iter().map(|c| c.name.clone()).collect();
+    ComboBox::from_label("cloth")
+        .selected_text(names[state.cloth].clone())
+        .show_ui(ui, |ui| {
+            for (i, n) in names.iter().enumerate() {
+                ui.selectable_value(&mut state.cloth, i, n);
+            }
+        });
+    let Some((g, _)) = crate::app::grab::locate(&session.sim, state.cloth, 0) else {
+        return;
+    };
+    let Some(local) = session.sim.groups[g]
+        .cloths
+        .iter()
+        .position(|&c| c == state.cloth)
+    else {
+        return;
+    };
+    let group = &mut session.sim.groups[g];
+    let Some(mut params) = group.solver.cloth_params(local) else {
+        return;
+    };
+    let mut thickness = group.solver.cloths()[local].thickness;
+    if drag_f64(ui, "thickness (m)", &mut thickness, 0.0005) {
+        let r = group.solver.set_thickness(local, thickness);
+        if r.is_ok()
+            && let Some(w) = group.world.as_mut()
+        {
+            w.sync_thickness(&group.solver);
+        }
+        note(state, r);
+    }
+    let mut changed = false;
+    egui::Grid::new("families")
+        .num_columns(4)
+        .striped(true)
+        .show(ui, |ui| {
+            ui.label("family");
+            ui.label("XPBD α");
+            ui.label("PBD k");
+            ui.label("spring k");
+            ui.end_row();
+            for f in Family::ALL {
+                let p = params.get_mut(f);
+                if !p.enabled {
+                    continue;
+                }
+                ui.label(f.name());
+                changed |= ui
+                    .add(
+                        DragValue::new(&mut p.compliance)
+                            .speed(1e-6)
+                            .max_decimals(9),
+                    )
+                    .changed();
+                changed |= ui
+                    .add(DragValue::new(&mut p.pbd_stiffness).speed(0.01))
+                    .changed();
+                changed |= ui
+                    .add(DragValue::new(&mut p.spring_stiffness).speed(10.0))
+                    .changed();
+                ui.end_row();
+            }
+        });
+    if changed {
+        let r = group.solver.set_cloth_params(local, params);
+        note(state, r);
+    }
+    ui.label(
+        RichText::new("families off in the scene have no constraints and are not listed")
+            .small()
+            .weak(),
+    );
+}

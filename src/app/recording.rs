@@ -1,0 +1,97 @@
+//! `weft view --record`: the session logged in the layout of `weft run --out`, plus an
+//! `/interaction` channel with the grabbed particle and drag target of every frame.
+
+use std::fs::File;
+
+use crate::app::grab::Grab;
+use crate::record::{RecordOptions, Recorder, Status};
+use crate::sim::{FrameStats, Simulation};
+
+/// The JSON schema of `/interaction` messages.
+const INTERACTION_SCHEMA: &str = r#"{"title":"weft.Interaction","type":"object","properties":{"frame":{"type":"integer","description":"frame of the session (continues across resets)"},"time":{"type":"number","description":"simulated time of the session (s)"},"grabbed":{"type":"boolean"},"cloth":{"type":["string","null"],"description":"name of the grabbed cloth"},"cloth_index":{"type":["integer","null"]},"particle":{"type":["integer","null"],"description":"index within the cloth, as in /cloth/<name>/particles"},"target":{"type":["array","null"],"items":{"type":"number"},"description":"drag target (m)"}},"required":["frame","time","grabbed"]}"#;
+
+/// An open session log.
+pub struct SessionLog {
+    rec: Recorder,
+    interaction: u16,
+    frames: u64,
+    time: f64,
+}
+
+impl SessionLog {
+    /// Starts the log in `file` (already created) with the scene of `sim` as frame 0.
+    pub fn new(
+        file: File,
+        sim: &Simulation,
+        mesh_every: u64,
+        planned: u64,
+    ) -> anyhow::Result<Self> {
+        let options = RecordOptions {
+            mesh_every,
+            timing: false,
+        };
+        let mut rec = Recorder::new(file, sim, planned, options)?;
+        let interaction =
+            rec.add_json_channel("/interaction", "weft.Interaction", INTERACTION_SCHEMA)?;
+        let mut log = Self {
+            rec,
+            interaction,
+            frames: 0,
+            time: 0.0,
+        };
+        let stats = sim.stats(0.0, 0);
+        log.write(sim, stats, None)?;
+        Ok(log)
+    }
+
+    /// Logs the frame just stepped (`dt` long), numbered and timed by the session so that
+    /// log time keeps increasing across resets.
+    pub fn frame(
+        &mut self,
+        sim: &Simulation,
+        stats: FrameStats,
+        dt: f64,
+        grab: Option<&Grab>,
+    ) -> anyhow::Result<()> {
+        self.frames += 1;
+        self.time += dt;
+        self.write(sim, stats, grab)
+    }
+
+    fn write(
+        &mut self,
+        sim: &Simulation,
+        mut stats: FrameStats,
+        grab: Option<&Grab>,
+    ) -> anyhow::Result<()> {
+        stats.frame = self.frames;
+        stats.time = self.time;
+        self.rec.frame(sim, &stats)?;
+        let json = match grab {
+            Some(g) => serde_json::json!({
+                "frame": self.frames,
+                "time": self.time,
+                "grabbed": true,
+                "cloth": sim.scene.cloths.get(g.cloth).map(|c| c.name.clone()),
+                "cloth_index": g.cloth,
+                "particle": g.particle,
+                "target": g.target.to_array(),
+            }),
+            None => serde_json::json!({
+                "frame": self.frames,
+                "time": self.time,
+                "grabbed": false,
+                "cloth": null,
+                "cloth_index": null,
+                "particle": null,
+                "target": null,
+            }),
+        };
+        self.rec.json(self.interaction, self.time, &json)
+    }
+
+    /// Writes the status and the summary and closes the file.
+    pub fn finish(self, status: &Status) -> anyhow::Result<()> {
+        self.rec.finish(status, self.frames)
+    }
+}

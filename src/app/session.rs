@@ -1,0 +1,292 @@
+//! The viewer's simulation side, free of any window: the scene's solvers, the fixed-step
+//! clock, the grabbed particle, live parameter changes and the optional session log.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use weft_scene::{Override, Scene, SceneErrors};
+use weft_solver::{Method, ParamError};
+
+use crate::app::clock::{FixedClock, WallClock};
+use crate::app::grab::Grab;
+use crate::app::picking::Ray;
+use crate::app::recording::SessionLog;
+use crate::default_scene;
+use crate::record::Status;
+use crate::sim::Simulation;
+
+/// Where a scene came from (to reset it, and to list it in the panel).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SceneSource {
+    /// The compiled-in default scene.
+    Default,
+    /// A scene file.
+    File(PathBuf),
+}
+
+impl SceneSource {
+    /// Loads the scene with `overrides`.
+    pub fn load(&self, overrides: &[Override]) -> Result<Scene, SceneErrors> {
+        match self {
+            SceneSource::Default => default_scene::load(overrides),
+            SceneSource::File(p) => weft_scene::load(p, overrides),
+        }
+    }
+
+    /// A short label.
+    pub fn label(&self) -> String {
+        match self {
+            SceneSource::Default => format!("built-in ({})", default_scene::NAME),
+            SceneSource::File(p) => p.display().to_string(),
+        }
+    }
+}
+
+/// Figures the panel shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Wall-clock time of the last simulated frame (ms).
+    pub step_ms: f64,
+    /// Wall-clock time between the last two displayed frames (ms).
+    pub frame_ms: f64,
+    /// Simulation frames stepped in the last displayed frame.
+    pub steps_last: u32,
+    /// Frames of real time dropped in the last displayed frame (over the per-frame limit).
+    pub dropped_last: u32,
+    /// Contacts in the last substep.
+    pub contacts: usize,
+}
+
+/// The simulation the window shows.
+pub struct Session {
+    /// The scene's solvers.
+    pub sim: Simulation,
+    /// Where the scene came from.
+    pub source: SceneSource,
+    /// The fixed-step clock.
+    pub clock: FixedClock<WallClock>,
+    /// The particle held with the mouse.
+    pub grab: Option<Grab>,
+    /// The session log (`--record`).
+    pub log: Option<SessionLog>,
+    /// Figures for the panel.
+    pub stats: Stats,
+    /// The solver's message after a divergence (stepping stops until reset).
+    pub diverged: Option<String>,
+    /// Frames simulated in this session (across resets).
+    pub frames: u64,
+}
+
+impl Session {
+    /// A session on `sim`, stepping at most `max_steps` frames per displayed frame.
+    pub fn new(sim: Simulation, source: SceneSource, max_steps: u32) -> Self {
+        Self {
+            sim,
+            source,
+            clock: FixedClock::new(WallClock::default(), max_steps),
+            grab: None,
+            log: None,
+            stats: Stats::default(),
+            diverged: None,
+            frames: 0,
+        }
+    }
+
+    /// The frame time step in use (s).
+    pub fn dt(&self) -> f64 {
+        self.sim
+            .groups
+            .first()
+            .map_or(self.sim.scene.settings.dt, |g| g.solver.settings().dt)
+    }
+
+    /// Steps as many frames as real time asks for (at most the clock's limit), never
+    /// beyond `last_frame` frames in all.
+    pub fn advance(&mut self, last_frame: Option<u64>) -> anyhow::Result<()> {
+        let tick = self.clock.tick(self.dt());
+        self.stats.steps_last = 0;
+        self.stats.dropped_last = tick.dropped;
+        for _ in 0..tick.steps {
+            if last_frame.is_some_and(|n| self.frames >= n) {
+                break;
+            }
+            self.step_once()?;
+        }
+        Ok(())
+    }
+
+    /// Steps one frame now (unless diverged), logging it.
+    pub fn step_once(&mut self) -> anyhow::Result<()> {
+        if self.diverged.is_some() {
+            return Ok(());
+        }
+        let start = Instant::now();
+        let dt = self.dt();
+        match self.sim.step() {
+            Ok(stats) => {
+                self.stats.step_ms = start.elapsed().as_secs_f64() * 1e3;
+                self.stats.contacts = stats.contacts;
+                self.stats.steps_last += 1;
+                self.frames += 1;
+                if let Some(log) = self.log.as_mut() {
+                    log.frame(&self.sim, stats, dt, self.grab.as_ref())?;
+                }
+            }
+            Err(e) => {
+                self.diverged = Some(e.to_string());
+                self.clock.set_paused(true);
+            }
+        }
+        Ok(())
+    }
+
+    /// Grabs the cloth under `ray`, if any.
+    pub fn grab(&mut self, ray: &Ray, view_dir: weft_solver::glam::DVec3) -> bool {
+        self.release();
+        self.grab = Grab::start(&mut self.sim, ray, view_dir);
+        self.grab.is_some()
+    }
+
+    /// Drags the held particle toward where `ray` meets its drag plane.
+    pub fn drag(&mut self, ray: &Ray) {
+        if let Some(g) = self.grab.as_mut() {
+            g.drag(&mut self.sim, ray);
+        }
+    }
+
+    /// Lets the held particle go.
+    pub fn release(&mut self) {
+        if let Some(g) = self.grab.take() {
+            g.release(&mut self.sim);
+        }
+    }
+
+    /// Rebuilds the scene's solvers: initial positions, the scene's parameters, time 0.
+    pub fn reset(&mut self) -> anyhow::Result<()> {
+        self.release();
+        self.sim = Simulation::new(self.sim.scene.clone())?;
+        self.diverged = None;
+        let paused = self.clock.paused();
+        self.clock.set_paused(paused);
+        Ok(())
+    }
+
+    /// Switches to another scene (refused while recording: a log holds one scene).
+    pub fn switch_scene(&mut self, source: SceneSource) -> anyhow::Result<()> {
+        if self.log.is_some() {
+            anyhow::bail!("a recorded session keeps its scene; stop and start a new one");
+        }
+        let scene = source.load(&[]).map_err(|e| {
+            let lines: Vec<String> = e.0.iter().map(|e| e.to_string()).collect();
+            anyhow::anyhow!(lines.join("\n"))
+        })?;
+        let sim = Simulation::new(scene)?;
+        self.release();
+        self.sim = sim;
+        self.source = source;
+        self.diverged = None;
+        Ok(())
+    }
+
+    /// Switches every solver of the scene to `method` (parameters of every method are kept
+    /// per cloth, so nothing else changes).
+    pub fn set_method(&mut self, method: Method) -> Result<(), ParamError> {
+        for g in &mut self.sim.groups {
+            let s = weft_solver::Settings {
+                method,
+                ..*g.solver.settings()
+            };
+            g.solver.set_settings(s)?;
+            g.method = method;
+        }
+        Ok(())
+    }
+
+    /// Closes the log (if any) with the status of how the session ended.
+    pub fn finish(&mut self, interrupted: bool) -> anyhow::Result<()> {
+        let Some(log) = self.log.take() else {
+            return Ok(());
+        };
+        let status = match (&self.diverged, interrupted) {
+            (Some(m), _) => Status::Diverged(m.clone()),
+            (None, true) => Status::Interrupted,
+            (None, false) => Status::Complete,
+        };
+        log.finish(&status)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn session() -> Session {
+        let scene = SceneSource::Default.load(&[]).expect("default scene");
+        Session::new(
+            Simulation::new(scene).expect("solvers"),
+            SceneSource::Default,
+            4,
+        )
+    }
+
+    #[test]
+    fn reset_puts_the_cloth_back_and_clears_a_divergence() {
+        let mut s = session();
+        let start = s.sim.cloth_positions(0).to_vec();
+        for _ in 0..5 {
+            s.step_once().expect("steps");
+        }
+        assert_eq!(s.frames, 5);
+        assert_ne!(s.sim.cloth_positions(0), &start[..]);
+        s.diverged = Some("test".into());
+        s.reset().expect("resets");
+        assert_eq!(s.sim.cloth_positions(0), &start[..]);
+        assert_eq!(s.diverged, None);
+        assert_eq!(s.sim.frame(), 0);
+        // The session's own count goes on (it numbers the log's frames).
+        assert_eq!(s.frames, 5);
+    }
+
+    #[test]
+    fn the_method_switches_in_every_solver_and_bad_values_are_refused() {
+        let mut s = session();
+        s.set_method(Method::MassSpring).expect("valid");
+        assert!(
+            s.sim
+                .groups
+                .iter()
+                .all(|g| g.solver.settings().method == Method::MassSpring)
+        );
+        s.step_once().expect("steps with the new method");
+        let solver = &mut s.sim.groups[0].solver;
+        let bad = weft_solver::Settings {
+            substeps: 0,
+            ..*solver.settings()
+        };
+        assert!(solver.set_settings(bad).is_err());
+        assert_eq!(solver.settings().substeps, 10, "the old value is kept");
+    }
+
+    #[test]
+    fn switching_scene_loads_it_but_not_while_recording() {
+        let mut s = session();
+        let file = SceneSource::File(PathBuf::from("assets/scenes/sphere_drop.toml"));
+        s.switch_scene(file.clone()).expect("switches");
+        assert_eq!(s.source, file);
+        assert_eq!(s.sim.scene.name, "assets/scenes/sphere_drop.toml");
+        let missing = SceneSource::File(PathBuf::from("no/such.toml"));
+        let e = s.switch_scene(missing).expect_err("missing file");
+        assert!(format!("{e:#}").contains("no/such.toml"), "{e:#}");
+        assert_eq!(s.source, file, "a failed switch keeps the scene");
+        // Recording: the log holds one scene, so switching is refused.
+        let path = std::env::temp_dir().join(format!("weft-session-{}.mcap", std::process::id()));
+        let f = std::fs::File::create(&path).expect("temp file");
+        s.log = Some(SessionLog::new(f, &s.sim, 0, 0).expect("log"));
+        let e = s.switch_scene(SceneSource::Default).expect_err("refused");
+        assert!(format!("{e}").contains("recorded"), "{e}");
+        assert_eq!(s.source, file);
+        s.finish(false).expect("finishes");
+        assert!(s.log.is_none());
+        let _ = std::fs::remove_file(path);
+    }
+}

@@ -1,0 +1,552 @@
+//! The window: winit's event loop (ApplicationHandler), the wgpu surface, the weft renderer
+//! and the egui overlay, and the mouse and keyboard wired to the session and the camera.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use glam::{UVec2, Vec2};
+use weft_render::{Camera, FrameData, Gpu, RenderOptions, Renderer};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow};
+use winit::window::{Window, WindowId};
+
+use crate::app::input::{self, Action, DragMode};
+use crate::app::meshes;
+use crate::app::panel::{self, PanelState};
+use crate::app::picking::Ray;
+use crate::app::session::Session;
+
+/// Width of the side panel (points).
+pub const PANEL_WIDTH: f32 = 300.0;
+
+/// How the window opens and when it closes by itself.
+#[derive(Clone, Debug)]
+pub struct WindowConfig {
+    /// Inner size in pixels.
+    pub size: (u32, u32),
+    /// Quit after this many simulated frames.
+    pub exit_after_frames: Option<u64>,
+    /// Start paused.
+    pub paused: bool,
+    /// A fixed initial camera `(eye, target)` instead of the automatic framing.
+    pub camera: Option<(glam::Vec3, glam::Vec3)>,
+}
+
+/// Everything that exists only while the window does.
+struct Gfx {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    gpu: Gpu,
+    config: wgpu::SurfaceConfiguration,
+    renderer: Renderer,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+}
+
+/// The viewer.
+pub struct App {
+    session: Session,
+    config: WindowConfig,
+    stop: Arc<AtomicBool>,
+    gfx: Option<Gfx>,
+    egui: egui::Context,
+    camera: Camera,
+    options: RenderOptions,
+    panel: PanelState,
+    show_panel: bool,
+    show_help: bool,
+    cursor: Option<Vec2>,
+    drag: Option<(DragMode, MouseButton)>,
+    shift: bool,
+    last_frame: Option<Instant>,
+    /// Set when the loop must end with an error (no adapter, a failed log write).
+    pub error: Option<anyhow::Error>,
+    /// Whether SIGINT/SIGTERM ended the session.
+    pub interrupted: bool,
+}
+
+impl App {
+    /// A viewer of `session`; `stop` is raised by the signal handler.
+    pub fn new(
+        session: Session,
+        config: WindowConfig,
+        stop: Arc<AtomicBool>,
+        panel: PanelState,
+    ) -> Self {
+        let camera = match config.camera {
+            Some((eye, target)) => Camera::looking_at(eye, target),
+            None => meshes::initial_camera(&session.sim),
+        };
+        Self {
+            session,
+            config,
+            stop,
+            gfx: None,
+            egui: egui::Context::default(),
+            camera,
+            options: RenderOptions {
+                wireframe: false,
+                particles: false,
+                grid: true,
+                shadows: true,
+            },
+            panel,
+            show_panel: true,
+            show_help: false,
+            cursor: None,
+            drag: None,
+            shift: false,
+            last_frame: None,
+            error: None,
+            interrupted: false,
+        }
+    }
+
+    /// The session (to finish its log once the loop has ended).
+    pub fn session_mut(&mut self) -> &mut Session {
+        &mut self.session
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        if self.error.is_none() {
+            self.error = Some(e);
+        }
+        event_loop.exit();
+    }
+
+    fn init(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Gfx> {
+        let (w, h) = self.config.size;
+        let attrs = Window::default_attributes()
+            .with_title(format!("Weft — {}", self.session.sim.scene.name))
+            .with_inner_size(PhysicalSize::new(w, h));
+        let window = Arc::new(event_loop.create_window(attrs)?);
+        let display = event_loop.owned_display_handle();
+        let mut desc =
+            wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display));
+        if wgpu::Backends::from_env().is_none() {
+            desc.backends = wgpu::Backends::all();
+        }
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance.create_surface(Arc::clone(&window))?;
+        let gpu = Gpu::for_surface(instance, &surface).map_err(|e| {
+            anyhow::anyhow!(
+                "no graphics adapter can draw to this window ({e}); `weft run` simulates without one"
+            )
+        })?;
+        let size = window.inner_size();
+        let caps = surface.get_capabilities(&gpu.adapter);
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(wgpu::TextureFormat::is_srgb)
+            .or_else(|| caps.formats.first().copied())
+            .ok_or_else(|| anyhow::anyhow!("the window surface offers no format"))?;
+        let mut config = surface
+            .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| anyhow::anyhow!("the adapter cannot draw to this window's surface"))?;
+        config.format = format;
+        config.present_mode = wgpu::PresentMode::AutoVsync;
+        surface.configure(&gpu.device, &config);
+        let (renderer, framing) = meshes::renderer_for(&gpu.device, format, &self.session.sim);
+        self.camera = match self.config.camera {
+            Some((eye, target)) => Camera::looking_at(eye, target),
+            None => framing,
+        };
+        let egui_state = egui_winit::State::new(
+            self.egui.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(gpu.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer =
+            egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        eprintln!(
+            "weft: {}: window {}x{} on {}",
+            self.session.sim.scene.name,
+            size.width,
+            size.height,
+            gpu.describe()
+        );
+        Ok(Gfx {
+            window,
+            surface,
+            gpu,
+            config,
+            renderer,
+            egui_state,
+            egui_renderer,
+        })
+    }
+
+    fn size(&self) -> UVec2 {
+        self.gfx
+            .as_ref()
+            .map_or(UVec2::new(self.config.size.0, self.config.size.1), |g| {
+                UVec2::new(g.config.width, g.config.height)
+            })
+    }
+
+    fn ray(&self, cursor: Vec2) -> Ray {
+        let r = self.camera.ray(cursor, self.size());
+        Ray {
+            origin: r.origin.as_dvec3(),
+            dir: r.dir.as_dvec3(),
+        }
+    }
+
+    fn act(&mut self, action: Action, event_loop: &ActiveEventLoop) {
+        match action {
+            Action::TogglePause => {
+                let p = self.session.clock.paused();
+                self.session.clock.set_paused(!p);
+            }
+            Action::Step => {
+                self.session.clock.set_paused(true);
+                if let Err(e) = self.session.step_once() {
+                    self.fail(event_loop, e);
+                }
+            }
+            Action::Reset => {
+                if let Err(e) = self.session.reset() {
+                    self.panel.error = Some(format!("{e:#}"));
+                }
+            }
+            Action::ToggleWireframe => self.options.wireframe = !self.options.wireframe,
+            Action::ToggleParticles => self.options.particles = !self.options.particles,
+            Action::ToggleHelp => self.show_help = !self.show_help,
+            Action::TogglePanel => self.show_panel = !self.show_panel,
+            Action::Quit => event_loop.exit(),
+        }
+    }
+
+    fn rebuild_scene(&mut self) {
+        self.camera = meshes::initial_camera(&self.session.sim);
+        if let Some(g) = self.gfx.as_mut() {
+            let (renderer, camera) =
+                meshes::renderer_for(&g.gpu.device, g.config.format, &self.session.sim);
+            g.renderer = renderer;
+            self.camera = camera;
+            g.window
+                .set_title(&format!("Weft — {}", self.session.sim.scene.name));
+        }
+    }
+
+    fn mouse_button(&mut self, button: MouseButton, state: ElementState) {
+        match state {
+            ElementState::Pressed => {
+                if self.egui.is_pointer_over_egui() || self.drag.is_some() {
+                    return;
+                }
+                let Some(mode) = input::drag_mode(button, self.shift) else {
+                    return;
+                };
+                if mode == DragMode::Grab {
+                    let Some(c) = self.cursor else { return };
+                    let ray = self.ray(c);
+                    let forward = self.camera.forward().as_dvec3();
+                    if !self.session.grab(&ray, forward) {
+                        return;
+                    }
+                }
+                self.drag = Some((mode, button));
+            }
+            ElementState::Released => {
+                if let Some((mode, b)) = self.drag
+                    && b == button
+                {
+                    if mode == DragMode::Grab {
+                        self.session.release();
+                    }
+                    self.drag = None;
+                }
+            }
+        }
+    }
+
+    fn cursor_moved(&mut self, to: Vec2) {
+        let from = self.cursor.replace(to);
+        let d = from.map_or(Vec2::ZERO, |f| to - f);
+        match self.drag.map(|(m, _)| m) {
+            Some(DragMode::Grab) => {
+                let ray = self.ray(to);
+                self.session.drag(&ray);
+            }
+            Some(DragMode::Orbit) => self.camera.orbit(d.x, d.y),
+            Some(DragMode::Pan) => self.camera.pan(d.x, d.y, self.size()),
+            None => {}
+        }
+    }
+
+    fn frame(&mut self, event_loop: &ActiveEventLoop) {
+        let now = Instant::now();
+        if let Some(last) = self.last_frame.replace(now) {
+            self.session.stats.frame_ms = (now - last).as_secs_f64() * 1e3;
+        }
+        if let Err(e) = self.session.advance(self.config.exit_after_frames) {
+            return self.fail(event_loop, e);
+        }
+        if let Some(n) = self.config.exit_after_frames
+            && self.session.frames >= n
+        {
+            event_loop.exit();
+        }
+        if let Err(e) = self.draw() {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn draw(&mut self) -> anyhow::Result<()> {
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        // The overlay first: the panel may change the scene or the view options.
+        let raw = g.egui_state.take_egui_input(&g.window);
+        let session = &mut self.session;
+        let panel_state = &mut self.panel;
+        let options = &mut self.options;
+        let (show_panel, show_help) = (self.show_panel, self.show_help);
+        let mut outcome = panel::Outcome::default();
+        let output = self.egui.run_ui(raw, |ui| {
+            if show_panel {
+                egui::Panel::right("weft-panel")
+                    .exact_size(PANEL_WIDTH)
+                    .resizable(false)
+                    .show(ui, |ui| {
+                        outcome = panel::show(ui, session, panel_state, options);
+                    });
+            }
+            help_overlay(ui.ctx(), show_help);
+        });
+        g.egui_state
+            .handle_platform_output(&g.window, output.platform_output);
+        let jobs = self.egui.tessellate(output.shapes, output.pixels_per_point);
+        // Texture uploads first (they must happen even when no frame can be drawn), frees
+        // after painting.
+        let mut textures = output.textures_delta;
+        for (id, deltas) in textures.set.drain() {
+            for delta in deltas {
+                g.egui_renderer
+                    .update_texture(&g.gpu.device, &g.gpu.queue, id, &delta);
+            }
+        }
+        let free: Vec<egui::TextureId> = textures.free.drain().collect();
+        let result = self.paint(&jobs, output.pixels_per_point, outcome);
+        if let Some(g) = self.gfx.as_mut() {
+            for id in &free {
+                g.egui_renderer.free_texture(id);
+            }
+        }
+        result
+    }
+
+    /// Applies the panel's requests, then draws the scene and the overlay and presents.
+    fn paint(
+        &mut self,
+        jobs: &[egui::ClippedPrimitive],
+        pixels_per_point: f32,
+        outcome: panel::Outcome,
+    ) -> anyhow::Result<()> {
+        if outcome.toggle_pause {
+            let p = self.session.clock.paused();
+            self.session.clock.set_paused(!p);
+        }
+        if outcome.step {
+            self.session.clock.set_paused(true);
+            self.session.step_once()?;
+        }
+        if outcome.reset {
+            self.session.reset()?;
+        }
+        if outcome.scene_changed {
+            self.rebuild_scene();
+        }
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let sim = &self.session.sim;
+        let cloths: Vec<&[weft_solver::glam::DVec3]> = (0..sim.scene.cloths.len())
+            .map(|i| sim.cloth_positions(i))
+            .collect();
+        let poses = meshes::collider_poses(sim);
+        let grab = self.session.grab;
+        g.renderer.update(
+            &g.gpu.queue,
+            &FrameData {
+                cloths: &cloths,
+                collider_poses: &poses,
+                highlight: grab.map(|g| (g.cloth, g.particle)),
+                drag_target: grab.map(|g| g.target.as_vec3()),
+            },
+        );
+        let texture = match g.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                g.surface.configure(&g.gpu.device, &g.config);
+                return Ok(());
+            }
+            _ => return Ok(()),
+        };
+        let view = texture
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let size = UVec2::new(g.config.width, g.config.height);
+        let mut encoder = g
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("weft frame"),
+            });
+        g.renderer.render(
+            &g.gpu.device,
+            &mut encoder,
+            &view,
+            size,
+            &self.camera,
+            &self.options,
+        );
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [size.x, size.y],
+            pixels_per_point,
+        };
+        let extra = g.egui_renderer.update_buffers(
+            &g.gpu.device,
+            &g.gpu.queue,
+            &mut encoder,
+            jobs,
+            &screen,
+        );
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            g.egui_renderer
+                .render(&mut pass.forget_lifetime(), jobs, &screen);
+        }
+        g.gpu
+            .queue
+            .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
+        g.window.pre_present_notify();
+        g.gpu.queue.present(texture);
+        Ok(())
+    }
+}
+
+/// The help overlay: every shortcut and mouse binding, or a one-line hint.
+fn help_overlay(ctx: &egui::Context, open: bool) {
+    let area = egui::Area::new(egui::Id::unique("weft-help"))
+        .anchor(egui::Align2::LEFT_TOP, egui::vec2(10.0, 10.0))
+        .interactable(false);
+    area.show(ctx, |ui| {
+        egui::Frame::popup(ui.style()).show(ui, |ui| {
+            if !open {
+                ui.label("H: help");
+                return;
+            }
+            ui.label(egui::RichText::new("Keys").strong());
+            egui::Grid::new("help-keys").show(ui, |ui| {
+                for (k, what) in input::SHORTCUTS.iter().chain(input::MOUSE) {
+                    ui.label(*k);
+                    ui.label(*what);
+                    ui.end_row();
+                }
+            });
+        });
+    });
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        match self.init(event_loop) {
+            Ok(g) => {
+                self.gfx = Some(g);
+                self.session.clock.set_paused(self.config.paused);
+                self.session.clock.restart();
+                event_loop.set_control_flow(ControlFlow::Poll);
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let consumed = match self.gfx.as_mut() {
+            Some(g) => g.egui_state.on_window_event(&g.window, &event).consumed,
+            None => false,
+        };
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(s) => {
+                if let Some(g) = self.gfx.as_mut()
+                    && s.width > 0
+                    && s.height > 0
+                {
+                    g.config.width = s.width;
+                    g.config.height = s.height;
+                    g.surface.configure(&g.gpu.device, &g.config);
+                }
+            }
+            WindowEvent::RedrawRequested => self.frame(event_loop),
+            WindowEvent::ModifiersChanged(m) => self.shift = m.state().shift_key(),
+            WindowEvent::KeyboardInput { event, .. } => {
+                if event.state == ElementState::Pressed
+                    && !event.repeat
+                    && !self.egui.egui_wants_keyboard_input()
+                    && let Some(a) = input::action_for(&event.logical_key)
+                {
+                    self.act(a, event_loop);
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                self.cursor_moved(Vec2::new(position.x as f32, position.y as f32));
+            }
+            WindowEvent::CursorLeft { .. } => {}
+            // A press egui took (a click on the panel) is not a grab or a camera drag.
+            WindowEvent::MouseInput { state, button, .. }
+                if !(consumed && state == ElementState::Pressed) =>
+            {
+                self.mouse_button(button, state);
+            }
+            WindowEvent::MouseWheel { delta, .. } if !self.egui.is_pointer_over_egui() => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                self.camera.zoom(steps);
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self.stop.load(Ordering::SeqCst) {
+            self.interrupted = true;
+            event_loop.exit();
+            return;
+        }
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+}
