@@ -92,8 +92,10 @@ fn cpu_ns() -> u64 {
 fn time_frames(solver: &Solver, world: Option<&CollisionWorld>, frames: usize) -> (f64, f64) {
     let mut solver = solver.clone();
     let mut world = world.cloned();
+    let lists = |w: &Option<CollisionWorld>| w.as_ref().and_then(|w| w.self_collision_lists());
     let mut wall = Vec::with_capacity(frames);
     let mut cpu = Vec::with_capacity(frames);
+    let before = lists(&world);
     for _ in 0..frames {
         let (t, c) = (Instant::now(), cpu_ns());
         match &mut world {
@@ -102,6 +104,13 @@ fn time_frames(solver: &Solver, world: Option<&CollisionWorld>, frames: usize) -
         };
         wall.push(t.elapsed().as_secs_f64() * 1e3);
         cpu.push((cpu_ns() - c) as f64 * 1e-6);
+    }
+    if let (Some((r0, _)), Some((r1, len))) = (before, lists(&world)) {
+        println!(
+            "  self-collision lists: {} rebuilds in {frames} frames of {} substeps; {len} pairs",
+            r1 - r0,
+            solver.settings().substeps
+        );
     }
     (median(wall), median(cpu))
 }

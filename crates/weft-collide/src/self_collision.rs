@@ -3,9 +3,16 @@
 //! Each particle is a sphere of radius thickness / 2, so two particles are kept a thickness
 //! apart (Müller, "Ten Minute Physics" #11; Macklin et al. 2014, §5 for particle contacts).
 //! Pairs that share a triangle are left to the cloth's own constraints, and pairs that were
-//! closer than a thickness at rest are only kept at their rest distance. Candidate pairs come
-//! from a [`SpatialHash`] rebuilt every substep; they are solved Gauss–Seidel in a fixed order,
-//! so results do not depend on thread count or hashing order.
+//! closer than a thickness at rest are only kept at their rest distance.
+//!
+//! Candidate pairs live in a Verlet ("skin") list (Verlet 1967; Allen & Tildesley, "Computer
+//! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + search_margin) apart
+//! when the list was built, t the largest member thickness, so `search_margin` · t is the
+//! skin. The list is reused while no member has moved more than a quarter of the skin since
+//! the build, and rebuilt from a [`SpatialHash`] otherwise (see [`SelfCollision::refresh`] for
+//! why no contact can be missing). Pairs are kept sorted by (a, b) and solved Gauss–Seidel in
+//! that order, so results depend neither on thread count nor on hashing order, nor on when the
+//! list was rebuilt: a listed pair that is not touching does nothing.
 
 use glam::DVec3;
 use weft_solver::{Particles, Solver};
@@ -67,20 +74,17 @@ impl SelfCollisionParams {
     }
 }
 
-/// A candidate pair and the distance it must keep.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Pair {
-    a: u32,
-    b: u32,
-    target: f64,
-}
+/// How far (as a fraction of the skin) a member may move from where the list was built
+/// before the list is rebuilt. Two members each within skin/4 of their build positions are at
+/// most skin/2 closer than they were, so every pair closer than t + skin/2 now was closer than
+/// R = t + skin then, and is in the list: contacts (closer than t) all are, with skin/2 to spare
+/// for pairs pushed together within one sweep (the role `search_margin` had when pairs were
+/// searched every substep).
+const REBUILD_FRACTION: f64 = 0.25;
 
-/// Self-collision state: member particles, rest data, hash and this substep's pairs.
+/// What decides each pair's treatment: cloths, rest positions and triangle adjacency.
 #[derive(Clone, Debug)]
-pub(crate) struct SelfCollision {
-    params: SelfCollisionParams,
-    /// Participating particles, ascending.
-    members: Vec<u32>,
+struct Exemptions {
     /// Rest positions (global index; only members are meaningful).
     rest: Vec<DVec3>,
     /// Cloth of each particle (global index).
@@ -89,9 +93,61 @@ pub(crate) struct SelfCollision {
     /// `adjacency[offsets[i]..offsets[i + 1]]`, sorted.
     offsets: Vec<u32>,
     adjacency: Vec<u32>,
+}
+
+impl Exemptions {
+    /// Whether `a` and `b` share a triangle.
+    fn adjacent(&self, a: u32, b: u32) -> bool {
+        let (s, e) = (self.offsets[a as usize], self.offsets[a as usize + 1]);
+        self.adjacency[s as usize..e as usize]
+            .binary_search(&b)
+            .is_ok()
+    }
+
+    /// The distance pair `(a, b)` must keep, or `None` if it is exempt.
+    fn target(&self, a: u32, b: u32, thickness: &[f64]) -> Option<f64> {
+        if self.adjacent(a, b) {
+            return None;
+        }
+        let t = 0.5 * (thickness[a as usize] + thickness[b as usize]);
+        if self.cloth[a as usize] == self.cloth[b as usize] {
+            let rest = self.rest[a as usize].distance(self.rest[b as usize]);
+            Some(t.min(rest))
+        } else {
+            Some(t)
+        }
+    }
+}
+
+/// Candidate pairs as struct-of-arrays, sorted by (a, b), a < b.
+#[derive(Clone, Debug, Default)]
+struct PairList {
+    a: Vec<u32>,
+    b: Vec<u32>,
+    target: Vec<f64>,
+}
+
+/// Self-collision state: member particles, rest data, and the Verlet list of candidate pairs.
+#[derive(Clone, Debug)]
+pub(crate) struct SelfCollision {
+    params: SelfCollisionParams,
+    /// Participating particles, ascending.
+    members: Vec<u32>,
+    exempt: Exemptions,
     hash: SpatialHash,
-    pairs: Vec<Pair>,
-    scratch: Vec<u32>,
+    pairs: PairList,
+    /// Member positions (member order) when the list was built.
+    built_at: Vec<DVec3>,
+    /// Largest member thickness the list was built for; `None` when there is no list.
+    built_for: Option<f64>,
+    /// Lists built so far.
+    rebuilds: u64,
+    /// [`REBUILD_FRACTION`], or another value in tests.
+    rebuild_fraction: f64,
+    /// Build scratch: candidates as found, per-particle counts, candidates sorted by `a`.
+    found: Vec<(u32, u32, f64)>,
+    counts: Vec<u32>,
+    sorted: Vec<(u32, f64)>,
 }
 
 impl SelfCollision {
@@ -137,35 +193,137 @@ impl SelfCollision {
         Ok(Self {
             params,
             members,
-            rest: solver.particles().positions.clone(),
-            cloth,
-            offsets,
-            adjacency,
+            exempt: Exemptions {
+                rest: solver.particles().positions.clone(),
+                cloth,
+                offsets,
+                adjacency,
+            },
             hash: SpatialHash::new(1.0),
-            pairs: Vec::new(),
-            scratch: Vec::new(),
+            pairs: PairList::default(),
+            built_at: Vec::new(),
+            built_for: None,
+            rebuilds: 0,
+            rebuild_fraction: REBUILD_FRACTION,
+            found: Vec::new(),
+            counts: Vec::new(),
+            sorted: Vec::new(),
         })
-    }
-
-    /// Whether `a` and `b` share a triangle.
-    pub(crate) fn adjacent(&self, a: u32, b: u32) -> bool {
-        let (s, e) = (self.offsets[a as usize], self.offsets[a as usize + 1]);
-        self.adjacency[s as usize..e as usize]
-            .binary_search(&b)
-            .is_ok()
     }
 
     /// The distance pair `(a, b)` must keep, or `None` if it is exempt.
     pub(crate) fn target(&self, a: u32, b: u32, thickness: &[f64]) -> Option<f64> {
-        if self.adjacent(a, b) {
-            return None;
+        self.exempt.target(a, b, thickness)
+    }
+
+    /// Lists built so far.
+    pub(crate) fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+
+    /// Candidate pairs in the current list.
+    pub(crate) fn pair_count(&self) -> usize {
+        self.pairs.a.len()
+    }
+
+    /// Drops the list (thickness changed): the next [`SelfCollision::refresh`] rebuilds it.
+    pub(crate) fn invalidate(&mut self) {
+        self.built_for = None;
+    }
+
+    /// Makes sure the list holds every pair that may touch at `positions`: keeps it while every
+    /// member is within [`REBUILD_FRACTION`] · skin of where it was at the build, and rebuilds
+    /// it otherwise.
+    ///
+    /// Why nothing is missed: the list holds every non-exempt pair with |x⁰ₐ − x⁰ᵦ| ≤ R =
+    /// t + skin at the build (x⁰). Now |xₐ − x⁰ₐ| ≤ skin/4 and the same for b, so by the
+    /// triangle inequality |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + skin/2: every pair closer than
+    /// t + skin/2 now is listed, and every target is at most t (the mean of two thicknesses,
+    /// or less). The check runs before every sweep, so it also catches moves between frames
+    /// (pins, grabs, a user editing positions).
+    pub(crate) fn refresh(&mut self, positions: &[DVec3], thickness: &[f64]) {
+        if let Some(t) = self.built_for {
+            if t <= 0.0 {
+                return; // no thickness, no pairs, whatever the motion
+            }
+            let limit = self.rebuild_fraction * self.params.search_margin * t;
+            let limit2 = limit * limit;
+            let moved = self
+                .members
+                .iter()
+                .zip(&self.built_at)
+                .any(|(&i, x0)| positions[i as usize].distance_squared(*x0) > limit2);
+            if !moved {
+                return;
+            }
         }
-        let t = 0.5 * (thickness[a as usize] + thickness[b as usize]);
-        if self.cloth[a as usize] == self.cloth[b as usize] {
-            let rest = self.rest[a as usize].distance(self.rest[b as usize]);
-            Some(t.min(rest))
-        } else {
-            Some(t)
+        self.rebuild(positions, thickness);
+    }
+
+    /// Builds the list at `positions`: pairs from the hash, their targets, sorted by (a, b).
+    fn rebuild(&mut self, positions: &[DVec3], thickness: &[f64]) {
+        self.rebuilds += 1;
+        self.built_at.clear();
+        self.built_at
+            .extend(self.members.iter().map(|&i| positions[i as usize]));
+        let max_t = self
+            .members
+            .iter()
+            .map(|&i| thickness[i as usize])
+            .fold(0.0f64, f64::max);
+        self.built_for = Some(max_t);
+        let pairs = &mut self.pairs;
+        pairs.a.clear();
+        pairs.b.clear();
+        pairs.target.clear();
+        if max_t <= 0.0 {
+            return;
+        }
+        let radius = max_t * (1.0 + self.params.search_margin);
+        self.hash.set_spacing(radius);
+        self.hash.build(positions, &self.members);
+        let (found, exempt) = (&mut self.found, &self.exempt);
+        found.clear();
+        self.hash.for_each_pair(radius, |i, j, _| {
+            let (a, b) = (i.min(j), i.max(j));
+            if let Some(target) = exempt.target(a, b, thickness) {
+                found.push((a, b, target));
+            }
+        });
+        // Counting sort by a, then each a's few partners by b: a fixed order, whatever the
+        // hash did, and a sweep that walks the particles in order.
+        let counts = &mut self.counts;
+        counts.clear();
+        counts.resize(positions.len() + 1, 0);
+        for &(a, _, _) in found.iter() {
+            counts[a as usize + 1] += 1;
+        }
+        for i in 0..positions.len() {
+            counts[i + 1] += counts[i];
+        }
+        let sorted = &mut self.sorted;
+        sorted.clear();
+        sorted.resize(found.len(), (0, 0.0));
+        for &(a, b, target) in found.iter() {
+            let slot = &mut counts[a as usize];
+            sorted[*slot as usize] = (b, target);
+            *slot += 1;
+        }
+        // counts[a] is now the end of a's run, which starts where a − 1's ended.
+        let mut start = 0;
+        for &end in &counts[..positions.len()] {
+            let run = &mut sorted[start..end as usize];
+            run.sort_unstable_by_key(|&(b, _)| b);
+            start = end as usize;
+        }
+        pairs.b.extend(sorted.iter().map(|&(b, _)| b));
+        pairs.target.extend(sorted.iter().map(|&(_, t)| t));
+        let mut start = 0;
+        for (a, &end) in counts[..positions.len()].iter().enumerate() {
+            pairs
+                .a
+                .extend(std::iter::repeat_n(a as u32, end as usize - start));
+            start = end as usize;
         }
     }
 
@@ -185,56 +343,30 @@ impl SelfCollision {
         }
     }
 
-    /// Finds this substep's candidate pairs at the current positions.
-    pub(crate) fn find_pairs(&mut self, positions: &[DVec3], thickness: &[f64]) {
-        self.pairs.clear();
-        let max_t = self
-            .members
-            .iter()
-            .map(|&i| thickness[i as usize])
-            .fold(0.0f64, f64::max);
-        if max_t <= 0.0 {
-            return;
-        }
-        let radius = max_t * (1.0 + self.params.search_margin);
-        if self.hash.spacing() != radius {
-            self.hash = SpatialHash::new(radius);
-        }
-        self.hash.build(positions, &self.members);
-        let mut scratch = std::mem::take(&mut self.scratch);
-        for &a in &self.members {
-            let pa = positions[a as usize];
-            self.hash.query(pa, radius, &mut scratch);
-            for &b in scratch.iter().filter(|&&b| b > a) {
-                if pa.distance_squared(positions[b as usize]) > radius * radius {
-                    continue;
-                }
-                if let Some(target) = self.target(a, b, thickness) {
-                    self.pairs.push(Pair { a, b, target });
-                }
-            }
-        }
-        self.scratch = scratch;
-    }
-
     /// Pushes touching pairs apart to their target distance, with friction; returns the
-    /// number of contacts and the deepest overlap (m).
+    /// number of contacts and the deepest overlap (m). Call [`SelfCollision::refresh`] first.
     pub(crate) fn solve(&self, p: &mut Particles) -> (usize, f64) {
         let mut contacts = 0;
         let mut deepest = 0.0f64;
-        for pair in &self.pairs {
-            let (a, b) = (pair.a as usize, pair.b as usize);
+        let PairList { a, b, target } = &self.pairs;
+        for ((&a, &b), &target) in a.iter().zip(b).zip(target) {
+            let (a, b) = (a as usize, b as usize);
+            let delta = p.positions[a] - p.positions[b];
+            // Most listed pairs are not touching: rule them out before any square root.
+            let dist2 = delta.length_squared();
+            if dist2 >= target * target {
+                continue;
+            }
             let (wa, wb) = (p.inv_masses[a], p.inv_masses[b]);
             let w = wa + wb;
             if w == 0.0 {
                 continue;
             }
-            let delta = p.positions[a] - p.positions[b];
-            let dist = delta.length();
-            if dist >= pair.target || dist <= 1e-9 {
+            let dist = dist2.sqrt();
+            if dist >= target || dist <= 1e-9 {
                 continue;
             }
-            let depth = pair.target - dist;
+            let depth = target - dist;
             let n = delta / dist;
             // Distance constraint C = |xa − xb| − target ≥ 0, mass-weighted projection
             // (Müller et al. 2007, eq. 9–10).
@@ -251,5 +383,249 @@ impl SelfCollision {
             deepest = deepest.max(depth);
         }
         (contacts, deepest)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenarios::self_fold;
+    use weft_solver::{
+        ClothParams, Forces, GridDesc, Mass, Method, Orientation, Settings, SolverBuilder,
+        SubstepContext, SubstepHook,
+    };
+
+    /// A deterministic pseudo-random number in [−1, 1) (64-bit LCG, Knuth's MMIX constants).
+    fn rand(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    const N: usize = 24;
+    const SPACING: f64 = 0.01;
+
+    /// An N×N cloth of thickness = spacing (flat at rest), and positions accordion-folded in
+    /// layers of 4 rows 0.9 thickness apart, every particle jittered by up to 0.3 thickness:
+    /// a random folded configuration.
+    fn folded() -> (Solver, Vec<DVec3>, Vec<f64>) {
+        let mesh = GridDesc {
+            resolution: (N, N),
+            size: (SPACING * (N - 1) as f64, SPACING * (N - 1) as f64),
+            center: DVec3::ZERO,
+            orientation: Orientation::Horizontal,
+            mass: Mass::Total(0.1),
+            pins: vec![],
+        }
+        .build()
+        .expect("grid");
+        let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("builder");
+        b.add_cloth("cloth", &mesh, ClothParams::default(), SPACING)
+            .expect("cloth");
+        let solver = b.build();
+        let mut seed = 7;
+        let mut x = solver.particles().positions.clone();
+        for j in 0..N {
+            for i in 0..N {
+                let (layer, k) = (j / 4, j % 4);
+                let along = if layer % 2 == 0 { k } else { 3 - k };
+                let jitter = DVec3::new(rand(&mut seed), rand(&mut seed), rand(&mut seed));
+                x[j * N + i] = DVec3::new(
+                    i as f64 * SPACING,
+                    layer as f64 * 0.9 * SPACING,
+                    along as f64 * SPACING,
+                ) + jitter * (0.3 * SPACING / 3f64.sqrt());
+            }
+        }
+        let thickness = vec![SPACING; solver.particles().len()];
+        (solver, x, thickness)
+    }
+
+    /// Pairs listed by `sc` that touch at `x`.
+    fn listed_contacts(sc: &SelfCollision, x: &[DVec3]) -> Vec<(u32, u32)> {
+        let PairList { a, b, target } = &sc.pairs;
+        (0..a.len())
+            .filter(|&k| x[a[k] as usize].distance(x[b[k] as usize]) < target[k])
+            .map(|k| (a[k], b[k]))
+            .collect()
+    }
+
+    /// Every non-exempt pair closer than `within(target)` at `x`, by brute force over all pairs.
+    fn brute_pairs(
+        sc: &SelfCollision,
+        x: &[DVec3],
+        t: &[f64],
+        within: impl Fn(f64) -> f64,
+    ) -> Vec<(u32, u32)> {
+        let n = x.len() as u32;
+        let mut out = Vec::new();
+        for a in 0..n {
+            for b in a + 1..n {
+                if let Some(target) = sc.target(a, b, t) {
+                    if x[a as usize].distance(x[b as usize]) < within(target) {
+                        out.push((a, b));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn listed(sc: &SelfCollision) -> Vec<(u32, u32)> {
+        sc.pairs
+            .a
+            .iter()
+            .copied()
+            .zip(sc.pairs.b.iter().copied())
+            .collect()
+    }
+
+    #[test]
+    fn skin_list_holds_exactly_the_brute_force_contacts_until_a_quarter_skin_move() {
+        let (solver, mut x, t) = folded();
+        let params = SelfCollisionParams::default();
+        let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
+        sc.refresh(&x, &t);
+        assert_eq!(sc.rebuilds(), 1);
+        let list = listed(&sc);
+        assert!(
+            list.windows(2).all(|w| w[0] < w[1]),
+            "list not sorted by (a, b)"
+        );
+        let contacts = listed_contacts(&sc, &x);
+        assert_eq!(contacts, brute_pairs(&sc, &x, &t, |target| target));
+        assert!(contacts.len() > 200, "only {} contacts", contacts.len());
+        // Exactly the pairs within R at the build, no more.
+        let radius = SPACING * (1.0 + params.search_margin);
+        assert_eq!(list, brute_pairs(&sc, &x, &t, |_| radius * (1.0 + 1e-12)));
+
+        // Adversarial moves within the skin: each particle heads straight for the nearest
+        // particle the list does not pair it with, by just under a quarter of the skin.
+        let limit = REBUILD_FRACTION * params.search_margin * SPACING;
+        let x0 = x.clone();
+        for a in 0..x.len() {
+            let nearest = (0..x.len())
+                .filter(|&b| b != a && sc.target(a as u32, b as u32, &t).is_some())
+                .filter(|&b| {
+                    list.binary_search(&((a.min(b)) as u32, a.max(b) as u32))
+                        .is_err()
+                })
+                .min_by(|&b, &c| x0[a].distance(x0[b]).total_cmp(&x0[a].distance(x0[c])));
+            if let Some(b) = nearest {
+                x[a] = x0[a] + (x0[b] - x0[a]).normalize() * (0.999 * limit);
+            }
+        }
+        sc.refresh(&x, &t);
+        assert_eq!(
+            sc.rebuilds(),
+            1,
+            "rebuilt although nothing moved a quarter skin"
+        );
+        // Every pair closer than t + skin/2 is still listed, so every contact is.
+        let guaranteed = brute_pairs(&sc, &x, &t, |_| SPACING + 2.0 * limit);
+        let list = listed(&sc);
+        let missing: Vec<_> = guaranteed
+            .iter()
+            .filter(|p| list.binary_search(p).is_err())
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "pairs missing from the list: {missing:?}"
+        );
+        assert_eq!(
+            listed_contacts(&sc, &x),
+            brute_pairs(&sc, &x, &t, |target| target)
+        );
+        // The moves did bring unlisted pairs closer than R: the skin was needed.
+        let closer = brute_pairs(&sc, &x, &t, |_| radius);
+        assert!(closer.iter().any(|p| list.binary_search(p).is_err()));
+    }
+
+    #[test]
+    fn moving_one_particle_past_a_quarter_skin_rebuilds_the_list() {
+        let (solver, mut x, t) = folded();
+        let params = SelfCollisionParams::default();
+        let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
+        let limit = REBUILD_FRACTION * params.search_margin * SPACING;
+        sc.refresh(&x, &t);
+        x[100].x += 0.99 * limit;
+        sc.refresh(&x, &t);
+        assert_eq!(sc.rebuilds(), 1, "rebuilt for a move within the skin");
+        // Particle 200 jumps onto particle 300 (far away at rest): a new contact.
+        x[200] = x[300] + DVec3::new(0.0, 0.2 * SPACING, 0.0);
+        let (a, b) = (200, 300);
+        assert!(listed(&sc).binary_search(&(a, b)).is_err());
+        sc.refresh(&x, &t);
+        assert_eq!(sc.rebuilds(), 2, "no rebuild after a move past the skin");
+        assert!(listed(&sc).binary_search(&(a, b)).is_ok());
+        assert_eq!(
+            listed_contacts(&sc, &x),
+            brute_pairs(&sc, &x, &t, |target| target)
+        );
+        // A thickness change drops the list.
+        sc.invalidate();
+        sc.refresh(&x, &t);
+        assert_eq!(sc.rebuilds(), 3);
+    }
+
+    /// Self-collision alone, with the ground as a floor at one thickness.
+    struct Hook {
+        sc: SelfCollision,
+        thickness: Vec<f64>,
+        fresh: bool,
+    }
+
+    impl SubstepHook for Hook {
+        fn begin_substep(&mut self, _: &SubstepContext, _: &Particles) {
+            self.fresh = true;
+        }
+
+        fn project(&mut self, _: &SubstepContext, p: &mut Particles) -> usize {
+            if std::mem::take(&mut self.fresh) {
+                self.sc.clamp_displacements(p, &self.thickness);
+            }
+            self.sc.refresh(&p.positions, &self.thickness);
+            let (contacts, _) = self.sc.solve(p);
+            for (x, t) in p.positions.iter_mut().zip(&self.thickness) {
+                x.y = x.y.max(*t);
+            }
+            contacts
+        }
+    }
+
+    fn fold_with(rebuild_fraction: f64) -> (Vec<DVec3>, u64) {
+        let (mut solver, _) = self_fold(Method::Xpbd, 10, 30).expect("scenario");
+        let mut sc = SelfCollision::new(&solver, &[0], SelfCollisionParams::default())
+            .expect("self-collision");
+        sc.rebuild_fraction = rebuild_fraction;
+        let thickness = vec![solver.cloths()[0].thickness; solver.particles().len()];
+        let mut hook = Hook {
+            sc,
+            thickness,
+            fresh: true,
+        };
+        for _ in 0..90 {
+            solver.step_with(&mut hook).expect("step");
+        }
+        (solver.particles().positions.clone(), hook.sc.rebuilds())
+    }
+
+    #[test]
+    fn skin_list_folds_exactly_like_a_search_before_every_sweep() {
+        // Fraction 0: any motion at all rebuilds the list, i.e. a fresh search every sweep.
+        let (every, sweeps) = fold_with(0.0);
+        let (skin, rebuilds) = fold_with(REBUILD_FRACTION);
+        assert_eq!(sweeps, 90 * 10, "a fresh search every sweep");
+        assert!(
+            4 * rebuilds < 3 * sweeps,
+            "{rebuilds} rebuilds in {sweeps} sweeps"
+        );
+        let differ = every
+            .iter()
+            .zip(&skin)
+            .filter(|(a, b)| a.to_array() != b.to_array())
+            .count();
+        assert_eq!(differ, 0, "{differ} particles differ");
     }
 }
