@@ -7,7 +7,7 @@
 //! (c) no hook at all (`solver.step()`). Prints the median wall time per frame of each and
 //! (a) − (b) against (c), in wall time and in CPU time (all threads).
 //!
-//! `cargo run --release -p weft-collide --example self_collision_cost -- [--scene fold|drape]
+//! `cargo run --release -p weft-collide --example self_collision_cost -- [--scene curtain|drape|fold]
 //! [--only a|b|c] [--frames F] [--warmup W] [--n N]`; `--only` runs one variant (for
 //! `perf stat -e task-clock`). Set `RAYON_NUM_THREADS` to choose the thread count.
 #![allow(clippy::unwrap_used)]
@@ -16,7 +16,8 @@ use std::time::Instant;
 
 use weft_collide::scenarios::{self, THICKNESS};
 use weft_collide::{CollisionWorld, SelfCollisionParams};
-use weft_solver::{Method, Solver};
+use weft_solver::glam::DVec3;
+use weft_solver::{GridDesc, Mass, Method, Orientation, Solver, SolverBuilder};
 
 struct Args {
     scenes: Vec<String>,
@@ -28,7 +29,7 @@ struct Args {
 
 fn args() -> Args {
     let mut a = Args {
-        scenes: vec!["fold".into(), "drape".into()],
+        scenes: vec!["curtain".into(), "drape".into(), "fold".into()],
         only: None,
         frames: 30,
         warmup: 60,
@@ -49,10 +50,45 @@ fn args() -> Args {
     a
 }
 
-/// The scene: `fold` is the self-fold strip at n × n; `drape` an n × n sheet dropped on the
-/// sphere (it drapes and its skirt folds onto itself).
+/// A vertical square n × n sheet, 0.9 m wide, thickness = particle spacing, 5 cm above the
+/// ground, with the self-fold scenario's wavy sideways velocity: it buckles and folds onto
+/// itself like [`scenarios::self_fold`], but with square cells.
+fn curtain(n: usize) -> (Solver, CollisionWorld) {
+    let (size, bottom) = (0.9, 0.05);
+    let thickness = size / (n - 1) as f64;
+    let mesh = GridDesc {
+        resolution: (n, n),
+        size: (size, size),
+        center: DVec3::new(0.0, bottom + 0.5 * size, 0.0),
+        orientation: Orientation::Vertical,
+        mass: Mass::Total(0.2),
+        pins: vec![],
+    }
+    .build()
+    .unwrap();
+    let (settings, params) = scenarios::method_setup(Method::Xpbd);
+    let mut builder = SolverBuilder::new(settings, scenarios::scenario_forces()).unwrap();
+    builder.add_cloth("curtain", &mesh, params, thickness).unwrap();
+    let mut solver = builder.build();
+    let p = solver.particles_mut();
+    for i in 0..p.len() {
+        let y = p.positions[i].y - bottom;
+        p.velocities[i].z = 0.3 * (std::f64::consts::TAU * y / 0.3).sin();
+    }
+    let mut world = CollisionWorld::new(&solver);
+    world.add_collider(&scenarios::ground(0.0)).unwrap();
+    world
+        .enable_self_collision(&solver, &[0], SelfCollisionParams::default())
+        .unwrap();
+    (solver, world)
+}
+
+/// The scene: `fold` is the self-fold strip at n × n (0.3 m × 0.9 m, so its cells are three
+/// times wider than tall); `curtain` the same fall with square cells ([`curtain`]); `drape`
+/// an n × n sheet dropped on the sphere (thickness below the spacing: few self contacts).
 fn scene(name: &str, n: usize) -> (Solver, CollisionWorld) {
     match name {
+        "curtain" => curtain(n),
         "fold" => scenarios::self_fold(Method::Xpbd, n, n).unwrap(),
         "drape" => {
             let (solver, mut world) = scenarios::sphere_drop(Method::Xpbd, n).unwrap();
@@ -120,17 +156,20 @@ fn main() {
     let threads = rayon::current_num_threads();
     for name in &a.scenes {
         let (mut solver, mut world) = scene(name, a.n);
-        let mut contacts = 0;
         for _ in 0..a.warmup {
             solver.step_with(&mut world).unwrap();
-            contacts = world.stats().self_contacts;
         }
+        let stats = world.stats();
         let thickness = solver.cloths()[0].thickness;
         println!(
             "{name} {n}x{n} (thickness {thickness:.4} m, sphere-drop thickness {THICKNESS}), \
-             {threads} thread(s), after {w} warm-up frames: {contacts} self contacts",
+             {threads} thread(s), after {w} warm-up frames: {} self contacts, deepest {:.2e} m, \
+             KE {:.2e} J",
+            stats.self_contacts,
+            stats.max_self_depth,
+            solver.particles().kinetic_energy(),
             n = a.n,
-            w = a.warmup
+            w = a.warmup,
         );
         let mut without = world.clone();
         without.disable_self_collision();

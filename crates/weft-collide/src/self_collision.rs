@@ -144,10 +144,53 @@ pub(crate) struct SelfCollision {
     rebuilds: u64,
     /// [`REBUILD_FRACTION`], or another value in tests.
     rebuild_fraction: f64,
-    /// Build scratch: candidates as found, per-particle counts, candidates sorted by `a`.
+    /// Pairs whose treatment is not the default (keep the mean thickness): CSR over particles,
+    /// `special[special_offsets[a]..special_offsets[a + 1]]` holds (b > a, target), sorted by
+    /// b, with a negative target for exempt pairs. Built at the first list build after
+    /// creation or a thickness change; `None` until then.
+    special_offsets: Option<Vec<u32>>,
+    special: Vec<(u32, f64)>,
+    /// Build scratch: candidates as found, per-particle offsets, candidates sorted by `a`.
     found: Vec<(u32, u32, f64)>,
     counts: Vec<u32>,
     sorted: Vec<(u32, f64)>,
+}
+
+/// Marks an exempt pair in [`SelfCollision::special`].
+const EXEMPT: f64 = -1.0;
+
+/// Counting sort of `(a, b, value)` by a, then by b within each a (a fixed order whatever
+/// order the hash found them in): `out[offsets[a]..offsets[a + 1]]` is a's (b, value), and
+/// `offsets` has `n + 1` entries.
+fn sort_pairs(
+    found: &[(u32, u32, f64)],
+    n: usize,
+    offsets: &mut Vec<u32>,
+    out: &mut Vec<(u32, f64)>,
+) {
+    offsets.clear();
+    offsets.resize(n + 1, 0);
+    for &(a, _, _) in found {
+        offsets[a as usize + 1] += 1;
+    }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    out.clear();
+    out.resize(found.len(), (0, 0.0));
+    for &(a, b, value) in found {
+        let slot = &mut offsets[a as usize];
+        out[*slot as usize] = (b, value);
+        *slot += 1;
+    }
+    // offsets[a] is now a's end = a + 1's start: shift back to starts.
+    for i in (1..=n).rev() {
+        offsets[i] = offsets[i - 1];
+    }
+    offsets[0] = 0;
+    for w in offsets.windows(2) {
+        out[w[0] as usize..w[1] as usize].sort_unstable_by_key(|&(b, _)| b);
+    }
 }
 
 impl SelfCollision {
@@ -205,6 +248,8 @@ impl SelfCollision {
             built_for: None,
             rebuilds: 0,
             rebuild_fraction: REBUILD_FRACTION,
+            special_offsets: None,
+            special: Vec::new(),
             found: Vec::new(),
             counts: Vec::new(),
             sorted: Vec::new(),
@@ -229,31 +274,74 @@ impl SelfCollision {
     /// Drops the list (thickness changed): the next [`SelfCollision::refresh`] rebuilds it.
     pub(crate) fn invalidate(&mut self) {
         self.built_for = None;
+        self.special_offsets = None;
+    }
+
+    /// Finds the pairs whose treatment is not the default: those sharing a triangle (exempt)
+    /// and those closer at rest than their mean thickness (kept at their rest distance), i.e.
+    /// every pair for which [`Exemptions::target`] is not `Some(mean thickness)`.
+    fn find_special(&mut self, thickness: &[f64], max_t: f64) -> Vec<u32> {
+        let n = thickness.len();
+        let (found, exempt) = (&mut self.found, &self.exempt);
+        found.clear();
+        for &a in &self.members {
+            let (s, e) = (exempt.offsets[a as usize], exempt.offsets[a as usize + 1]);
+            for &b in &exempt.adjacency[s as usize..e as usize] {
+                if b > a {
+                    found.push((a, b, EXEMPT));
+                }
+            }
+        }
+        // Closer at rest than the mean thickness ≤ max_t.
+        self.hash.set_spacing(max_t);
+        self.hash.build(&exempt.rest, &self.members);
+        self.hash.for_each_pair(max_t, |i, j, _| {
+            let (a, b) = (i.min(j), i.max(j));
+            let mean = 0.5 * (thickness[a as usize] + thickness[b as usize]);
+            match exempt.target(a, b, thickness) {
+                Some(target) if target != mean => found.push((a, b, target)),
+                _ => {} // exempt pairs are in already; the others take the default
+            }
+        });
+        let mut offsets = Vec::new();
+        sort_pairs(found, n, &mut offsets, &mut self.special);
+        offsets
     }
 
     /// Makes sure the list holds every pair that may touch at `positions`: keeps it while every
-    /// member is within [`REBUILD_FRACTION`] · skin of where it was at the build, and rebuilds
-    /// it otherwise.
+    /// member's displacement since the build is within [`REBUILD_FRACTION`] · skin of one
+    /// common displacement c, and rebuilds it otherwise.
     ///
     /// Why nothing is missed: the list holds every non-exempt pair with |x⁰ₐ − x⁰ᵦ| ≤ R =
-    /// t + skin at the build (x⁰). Now |xₐ − x⁰ₐ| ≤ skin/4 and the same for b, so by the
-    /// triangle inequality |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + skin/2: every pair closer than
-    /// t + skin/2 now is listed, and every target is at most t (the mean of two thicknesses,
-    /// or less). The check runs before every sweep, so it also catches moves between frames
-    /// (pins, grabs, a user editing positions).
+    /// t + skin at the build (x⁰). With displacements Δᵢ = xᵢ − x⁰ᵢ and |Δᵢ − c| ≤ skin/4 for
+    /// all members, |Δₐ − Δᵦ| = |(Δₐ − c) − (Δᵦ − c)| ≤ skin/2, so by the triangle inequality
+    /// |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + skin/2: every pair closer than t + skin/2 now is listed, and
+    /// every target is at most t (the mean of two thicknesses, or less). The common part c
+    /// (the centre of the displacements' bounding box) lets a cloth that falls or is carried
+    /// as a whole keep its list. The check runs before every sweep, so it also catches moves
+    /// between frames (pins, grabs, a user editing positions).
     pub(crate) fn refresh(&mut self, positions: &[DVec3], thickness: &[f64]) {
         if let Some(t) = self.built_for {
-            if t <= 0.0 {
-                return; // no thickness, no pairs, whatever the motion
+            if t <= 0.0 || self.members.is_empty() {
+                return; // no thickness or no members: no pairs, whatever the motion
             }
             let limit = self.rebuild_fraction * self.params.search_margin * t;
             let limit2 = limit * limit;
-            let moved = self
-                .members
-                .iter()
-                .zip(&self.built_at)
-                .any(|(&i, x0)| positions[i as usize].distance_squared(*x0) > limit2);
-            if !moved {
+            let displacements = || {
+                self.members
+                    .iter()
+                    .zip(&self.built_at)
+                    .map(|(&i, x0)| positions[i as usize] - *x0)
+            };
+            let (lo, hi) = displacements().fold(
+                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+                |(lo, hi), d| (lo.min(d), hi.max(d)),
+            );
+            let c = 0.5 * (lo + hi);
+            // Every |Δᵢ − c| is at most the box's half-diagonal: often that settles it.
+            let within = (0.5 * (hi - lo)).length_squared() <= limit2
+                || displacements().all(|d| (d - c).length_squared() <= limit2);
+            if within {
                 return;
             }
         }
@@ -272,58 +360,40 @@ impl SelfCollision {
             .map(|&i| thickness[i as usize])
             .fold(0.0f64, f64::max);
         self.built_for = Some(max_t);
-        let pairs = &mut self.pairs;
-        pairs.a.clear();
-        pairs.b.clear();
-        pairs.target.clear();
+        self.pairs.a.clear();
+        self.pairs.b.clear();
+        self.pairs.target.clear();
         if max_t <= 0.0 {
             return;
+        }
+        if self.special_offsets.is_none() {
+            self.special_offsets = Some(self.find_special(thickness, max_t));
         }
         let radius = max_t * (1.0 + self.params.search_margin);
         self.hash.set_spacing(radius);
         self.hash.build(positions, &self.members);
-        let (found, exempt) = (&mut self.found, &self.exempt);
+        let (found, special) = (&mut self.found, &self.special);
+        let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
         found.clear();
         self.hash.for_each_pair(radius, |i, j, _| {
             let (a, b) = (i.min(j), i.max(j));
-            if let Some(target) = exempt.target(a, b, thickness) {
+            let (s, e) = (special_offsets[a as usize], special_offsets[a as usize + 1]);
+            let run = &special[s as usize..e as usize];
+            // Same result as Exemptions::target, without its adjacency search and rest distance.
+            let target = match run.binary_search_by_key(&b, |&(b, _)| b) {
+                Ok(k) => run[k].1,
+                Err(_) => 0.5 * (thickness[a as usize] + thickness[b as usize]),
+            };
+            if target != EXEMPT {
                 found.push((a, b, target));
             }
         });
-        // Counting sort by a, then each a's few partners by b: a fixed order, whatever the
-        // hash did, and a sweep that walks the particles in order.
-        let counts = &mut self.counts;
-        counts.clear();
-        counts.resize(positions.len() + 1, 0);
-        for &(a, _, _) in found.iter() {
-            counts[a as usize + 1] += 1;
-        }
-        for i in 0..positions.len() {
-            counts[i + 1] += counts[i];
-        }
-        let sorted = &mut self.sorted;
-        sorted.clear();
-        sorted.resize(found.len(), (0, 0.0));
-        for &(a, b, target) in found.iter() {
-            let slot = &mut counts[a as usize];
-            sorted[*slot as usize] = (b, target);
-            *slot += 1;
-        }
-        // counts[a] is now the end of a's run, which starts where a − 1's ended.
-        let mut start = 0;
-        for &end in &counts[..positions.len()] {
-            let run = &mut sorted[start..end as usize];
-            run.sort_unstable_by_key(|&(b, _)| b);
-            start = end as usize;
-        }
-        pairs.b.extend(sorted.iter().map(|&(b, _)| b));
-        pairs.target.extend(sorted.iter().map(|&(_, t)| t));
-        let mut start = 0;
-        for (a, &end) in counts[..positions.len()].iter().enumerate() {
-            pairs
-                .a
-                .extend(std::iter::repeat_n(a as u32, end as usize - start));
-            start = end as usize;
+        sort_pairs(found, positions.len(), &mut self.counts, &mut self.sorted);
+        let pairs = &mut self.pairs;
+        pairs.b.extend(self.sorted.iter().map(|&(b, _)| b));
+        pairs.target.extend(self.sorted.iter().map(|&(_, t)| t));
+        for (a, w) in self.counts.windows(2).enumerate() {
+            pairs.a.extend(std::iter::repeat_n(a as u32, (w[1] - w[0]) as usize));
         }
     }
 
