@@ -8,7 +8,7 @@
 //! (a) − (b) against (c), in wall time and in CPU time (all threads).
 //!
 //! `cargo run --release -p weft-collide --example self_collision_cost -- [--scene curtain|drape|fold]
-//! [--only a|b|c] [--frames F] [--warmup W] [--n N]`; `--only` runs one variant (for
+//! [--only a|b|c] [--frames F] [--warmup W] [--n N] [--margin M]`; `--only` runs one variant (for
 //! `perf stat -e task-clock`). Set `RAYON_NUM_THREADS` to choose the thread count.
 #![allow(clippy::unwrap_used)]
 
@@ -25,6 +25,7 @@ struct Args {
     frames: usize,
     warmup: usize,
     n: usize,
+    margin: Option<f64>,
 }
 
 fn args() -> Args {
@@ -34,6 +35,7 @@ fn args() -> Args {
         frames: 30,
         warmup: 60,
         n: 128,
+        margin: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -44,6 +46,7 @@ fn args() -> Args {
             "--frames" => a.frames = value.parse().unwrap(),
             "--warmup" => a.warmup = value.parse().unwrap(),
             "--n" => a.n = value.parse().unwrap(),
+            "--margin" => a.margin = Some(value.parse().unwrap()),
             _ => panic!("unknown flag {flag}"),
         }
     }
@@ -156,6 +159,13 @@ fn main() {
     let threads = rayon::current_num_threads();
     for name in &a.scenes {
         let (mut solver, mut world) = scene(name, a.n);
+        if let Some(search_margin) = a.margin {
+            let params = SelfCollisionParams {
+                search_margin,
+                ..SelfCollisionParams::default()
+            };
+            world.enable_self_collision(&solver, &[0], params).unwrap();
+        }
         for _ in 0..a.warmup {
             solver.step_with(&mut world).unwrap();
         }

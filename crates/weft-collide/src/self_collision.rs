@@ -9,7 +9,7 @@
 //! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + search_margin) apart
 //! when the list was built, t the largest member thickness, so `search_margin` · t is the
 //! skin. The list is reused while no member has moved more than a quarter of the skin since
-//! the build, and rebuilt from a [`SpatialHash`] otherwise (see [`SelfCollision::refresh`] for
+//! the build, and rebuilt otherwise from a [`CellGrid`] (points sorted by cell, swept once) (see [`SelfCollision::refresh`] for
 //! why no contact can be missing). Pairs are kept sorted by (a, b) and solved Gauss–Seidel in
 //! that order, so results depend neither on thread count nor on hashing order, nor on when the
 //! list was rebuilt: a listed pair that is not touching does nothing.
@@ -19,7 +19,7 @@ use weft_solver::{Particles, Solver};
 
 use crate::error::CollideError;
 use crate::friction::Friction;
-use crate::spatial_hash::SpatialHash;
+use crate::spatial_hash::CellGrid;
 
 /// Self-collision settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -134,7 +134,7 @@ pub(crate) struct SelfCollision {
     /// Participating particles, ascending.
     members: Vec<u32>,
     exempt: Exemptions,
-    hash: SpatialHash,
+    grid: CellGrid,
     pairs: PairList,
     /// Member positions (member order) when the list was built.
     built_at: Vec<DVec3>,
@@ -150,23 +150,23 @@ pub(crate) struct SelfCollision {
     /// creation or a thickness change; `None` until then.
     special_offsets: Option<Vec<u32>>,
     special: Vec<(u32, f64)>,
-    /// Build scratch: candidates as found, per-particle offsets, candidates sorted by `a`.
-    found: Vec<(u32, u32, f64)>,
+    /// Build scratch: pairs as found, per-particle offsets, partners sorted by `a`.
+    found: Vec<(u32, u32, ())>,
     counts: Vec<u32>,
-    sorted: Vec<(u32, f64)>,
+    sorted: Vec<(u32, ())>,
 }
 
 /// Marks an exempt pair in [`SelfCollision::special`].
 const EXEMPT: f64 = -1.0;
 
 /// Counting sort of `(a, b, value)` by a, then by b within each a (a fixed order whatever
-/// order the hash found them in): `out[offsets[a]..offsets[a + 1]]` is a's (b, value), and
+/// order the grid found them in): `out[offsets[a]..offsets[a + 1]]` is a's (b, value), and
 /// `offsets` has `n + 1` entries.
-fn sort_pairs(
-    found: &[(u32, u32, f64)],
+fn sort_pairs<T: Copy + Default>(
+    found: &[(u32, u32, T)],
     n: usize,
     offsets: &mut Vec<u32>,
-    out: &mut Vec<(u32, f64)>,
+    out: &mut Vec<(u32, T)>,
 ) {
     offsets.clear();
     offsets.resize(n + 1, 0);
@@ -177,7 +177,7 @@ fn sort_pairs(
         offsets[i + 1] += offsets[i];
     }
     out.clear();
-    out.resize(found.len(), (0, 0.0));
+    out.resize(found.len(), (0, T::default()));
     for &(a, b, value) in found {
         let slot = &mut offsets[a as usize];
         out[*slot as usize] = (b, value);
@@ -242,7 +242,7 @@ impl SelfCollision {
                 offsets,
                 adjacency,
             },
-            hash: SpatialHash::new(1.0),
+            grid: CellGrid::new(),
             pairs: PairList::default(),
             built_at: Vec::new(),
             built_for: None,
@@ -282,8 +282,8 @@ impl SelfCollision {
     /// every pair for which [`Exemptions::target`] is not `Some(mean thickness)`.
     fn find_special(&mut self, thickness: &[f64], max_t: f64) -> Vec<u32> {
         let n = thickness.len();
-        let (found, exempt) = (&mut self.found, &self.exempt);
-        found.clear();
+        let exempt = &self.exempt;
+        let mut found = Vec::new();
         for &a in &self.members {
             let (s, e) = (exempt.offsets[a as usize], exempt.offsets[a as usize + 1]);
             for &b in &exempt.adjacency[s as usize..e as usize] {
@@ -293,9 +293,8 @@ impl SelfCollision {
             }
         }
         // Closer at rest than the mean thickness ≤ max_t.
-        self.hash.set_spacing(max_t);
-        self.hash.build(&exempt.rest, &self.members);
-        self.hash.for_each_pair(max_t, |i, j, _| {
+        self.grid.build(&exempt.rest, &self.members, max_t);
+        self.grid.for_each_pair(max_t, |i, j| {
             let (a, b) = (i.min(j), i.max(j));
             let mean = 0.5 * (thickness[a as usize] + thickness[b as usize]);
             match exempt.target(a, b, thickness) {
@@ -304,7 +303,7 @@ impl SelfCollision {
             }
         });
         let mut offsets = Vec::new();
-        sort_pairs(found, n, &mut offsets, &mut self.special);
+        sort_pairs(&found, n, &mut offsets, &mut self.special);
         offsets
     }
 
@@ -370,30 +369,39 @@ impl SelfCollision {
             self.special_offsets = Some(self.find_special(thickness, max_t));
         }
         let radius = max_t * (1.0 + self.params.search_margin);
-        self.hash.set_spacing(radius);
-        self.hash.build(positions, &self.members);
-        let (found, special) = (&mut self.found, &self.special);
-        let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
+        self.grid.build(positions, &self.members, radius);
+        let found = &mut self.found;
         found.clear();
-        self.hash.for_each_pair(radius, |i, j, _| {
-            let (a, b) = (i.min(j), i.max(j));
-            let (s, e) = (special_offsets[a as usize], special_offsets[a as usize + 1]);
-            let run = &special[s as usize..e as usize];
-            // Same result as Exemptions::target, without its adjacency search and rest distance.
-            let target = match run.binary_search_by_key(&b, |&(b, _)| b) {
-                Ok(k) => run[k].1,
-                Err(_) => 0.5 * (thickness[a as usize] + thickness[b as usize]),
-            };
-            if target != EXEMPT {
-                found.push((a, b, target));
-            }
-        });
-        sort_pairs(found, positions.len(), &mut self.counts, &mut self.sorted);
+        self.grid
+            .for_each_pair(radius, |i, j| found.push((i.min(j), i.max(j), ())));
+        let n = positions.len();
+        sort_pairs(found, n, &mut self.counts, &mut self.sorted);
+        // Each a's partners and its special pairs are both sorted by b: merge them. The
+        // result is what Exemptions::target gives, without its searches and square roots.
+        let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
         let pairs = &mut self.pairs;
-        pairs.b.extend(self.sorted.iter().map(|&(b, _)| b));
-        pairs.target.extend(self.sorted.iter().map(|&(_, t)| t));
-        for (a, w) in self.counts.windows(2).enumerate() {
-            pairs.a.extend(std::iter::repeat_n(a as u32, (w[1] - w[0]) as usize));
+        for a in 0..n {
+            let (s, e) = (self.counts[a] as usize, self.counts[a + 1] as usize);
+            if s == e {
+                continue;
+            }
+            let (ss, se) = (special_offsets[a] as usize, special_offsets[a + 1] as usize);
+            let special = &self.special[ss..se];
+            let mut k = 0;
+            for &(b, ()) in &self.sorted[s..e] {
+                while k < special.len() && special[k].0 < b {
+                    k += 1;
+                }
+                let target = match special.get(k) {
+                    Some(&(sb, target)) if sb == b => target,
+                    _ => 0.5 * (thickness[a] + thickness[b as usize]),
+                };
+                if target != EXEMPT {
+                    pairs.a.push(a as u32);
+                    pairs.b.push(b);
+                    pairs.target.push(target);
+                }
+            }
         }
     }
 

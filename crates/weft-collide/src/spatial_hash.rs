@@ -1,8 +1,13 @@
-//! Dense spatial hashing of points, after Müller's "Ten Minute Physics" #11 (self-collision):
-//! cells of a fixed spacing hashed into a power-of-two table of at least 2N buckets, stored as
-//! counting-sorted `cell_start` / `cell_entries` arrays: no allocation per cell (nor per
-//! rebuild once the arrays have grown), and no `HashMap` whose iteration order could leak into
-//! results.
+//! Grids of points for neighbour searches.
+//!
+//! [`SpatialHash`]: dense spatial hashing, after Müller's "Ten Minute Physics" #11
+//! (self-collision): cells of a fixed spacing hashed into a power-of-two table of at least 2N
+//! buckets, stored as counting-sorted `cell_start` / `cell_entries` arrays: no allocation per
+//! cell, and no `HashMap` whose iteration order could leak into results.
+//!
+//! [`CellGrid`]: points sorted by cell, for finding every close pair in one sequential sweep
+//! (the sorted cell list of Green, "Particle Simulation using CUDA", NVIDIA 2010, walked on
+//! the CPU with one forward-only cursor per neighbour column instead of hashed look-ups).
 
 use glam::DVec3;
 
@@ -14,30 +19,7 @@ pub struct SpatialHash {
     mask: usize,
     cell_start: Vec<u32>,
     cell_entries: Vec<u32>,
-    /// Cell and position of each entry of `cell_entries`, in the same order.
-    entry_cells: Vec<[i32; 3]>,
-    entry_positions: Vec<DVec3>,
-    /// Bucket of each item, in `items` order (build scratch).
-    item_buckets: Vec<u32>,
 }
-
-/// The 13 neighbour-cell offsets that are lexicographically positive: with the cell itself
-/// they visit every pair of neighbouring cells exactly once.
-const HALF_NEIGHBOURS: [[i32; 3]; 13] = [
-    [0, 0, 1],
-    [0, 1, -1],
-    [0, 1, 0],
-    [0, 1, 1],
-    [1, -1, -1],
-    [1, -1, 0],
-    [1, -1, 1],
-    [1, 0, -1],
-    [1, 0, 0],
-    [1, 0, 1],
-    [1, 1, -1],
-    [1, 1, 0],
-    [1, 1, 1],
-];
 
 impl SpatialHash {
     /// An empty hash with cell size `spacing` (m).
@@ -53,11 +35,6 @@ impl SpatialHash {
         self.spacing
     }
 
-    /// Sets the cell size (m); takes effect at the next [`SpatialHash::build`].
-    pub fn set_spacing(&mut self, spacing: f64) {
-        self.spacing = spacing;
-    }
-
     fn cell(&self, p: DVec3) -> [i32; 3] {
         (p / self.spacing).floor().as_ivec3().to_array()
     }
@@ -70,105 +47,28 @@ impl SpatialHash {
         h as u32 as usize & self.mask
     }
 
-    /// Rebuilds the table over `items` (indices into `positions`). Within a bucket, entries are
-    /// ordered by cell, then by their order in `items`.
+    /// Rebuilds the table over `items` (indices into `positions`), keeping their order per bucket.
     pub fn build(&mut self, positions: &[DVec3], items: &[u32]) {
         let table = (2 * items.len()).max(2).next_power_of_two();
         self.mask = table - 1;
         self.cell_start.clear();
         self.cell_start.resize(table + 1, 0);
-        self.item_buckets.clear();
+        self.cell_entries.clear();
+        self.cell_entries.resize(items.len(), 0);
         for &i in items {
             let b = self.bucket(self.cell(positions[i as usize]));
-            self.item_buckets.push(b as u32);
             self.cell_start[b] += 1;
         }
-        // Inclusive prefix sums give each bucket's end; filling backwards then leaves the start.
+        // Exclusive prefix sums give each bucket's end; filling backwards then leaves the start.
         let mut sum = 0;
         for s in &mut self.cell_start {
             sum += *s;
             *s = sum;
         }
-        self.cell_entries.clear();
-        self.cell_entries.resize(items.len(), 0);
-        for (&i, &b) in items.iter().zip(&self.item_buckets).rev() {
-            self.cell_start[b as usize] -= 1;
-            self.cell_entries[self.cell_start[b as usize] as usize] = i;
-        }
-        self.entry_cells.clear();
-        self.entry_positions.clear();
-        for &i in &self.cell_entries {
-            let p = positions[i as usize];
-            self.entry_cells.push(self.cell(p));
-            self.entry_positions.push(p);
-        }
-        // Group each bucket's entries by cell (buckets hold a handful of entries: insertion
-        // sort, stable, so items keep their order within a cell).
-        for b in 0..table {
-            let (s, e) = (self.cell_start[b] as usize, self.cell_start[b + 1] as usize);
-            for k in s + 1..e {
-                let mut j = k;
-                while j > s && self.entry_cells[j - 1] > self.entry_cells[j] {
-                    self.entry_cells.swap(j - 1, j);
-                    self.entry_positions.swap(j - 1, j);
-                    self.cell_entries.swap(j - 1, j);
-                    j -= 1;
-                }
-            }
-        }
-    }
-
-    /// Calls `f(i, j, distance²)` once for every unordered pair {i, j} of built items at most
-    /// `radius` apart (`radius` must not exceed the spacing). Which of the two comes first,
-    /// and the order of the calls, depend on the positions and the table alone.
-    ///
-    /// Cell by cell: a cell is paired with itself and with its 13 lexicographically positive
-    /// neighbours, so each pair of neighbouring cells is visited once; with `radius` ≤ spacing
-    /// any two points within `radius` lie in the same or neighbouring cells.
-    pub fn for_each_pair(&self, radius: f64, mut f: impl FnMut(u32, u32, f64)) {
-        assert!(
-            radius <= self.spacing,
-            "pair radius {radius} exceeds the cell size {}",
-            self.spacing
-        );
-        let r2 = radius * radius;
-        let (cells, pos, ids) = (&self.entry_cells, &self.entry_positions, &self.cell_entries);
-        let mut s = 0;
-        while s < ids.len() {
-            // The run s..e of entries in one cell (one bucket holds its whole cell).
-            let c = cells[s];
-            let mut e = s + 1;
-            while e < ids.len() && cells[e] == c {
-                e += 1;
-            }
-            for x in s..e {
-                for y in x + 1..e {
-                    let d2 = pos[x].distance_squared(pos[y]);
-                    if d2 <= r2 {
-                        f(ids[x], ids[y], d2);
-                    }
-                }
-            }
-            for off in HALF_NEIGHBOURS {
-                let nc = [c[0] + off[0], c[1] + off[1], c[2] + off[2]];
-                let b = self.bucket(nc);
-                let (bs, be) = (self.cell_start[b] as usize, self.cell_start[b + 1] as usize);
-                // Cells are grouped within a bucket: find nc's run, if any.
-                let Some(first) = (bs..be).find(|&y| cells[y] == nc) else {
-                    continue;
-                };
-                let last = (first..be).find(|&y| cells[y] != nc).unwrap_or(be);
-                for x in s..e {
-                    let px = pos[x];
-                    for y in first..last {
-                        let d2 = px.distance_squared(pos[y]);
-                        if d2 <= r2 {
-                            f(ids[x], ids[y], d2);
-                        }
-                    }
-                }
-            }
-            s = e;
+        for &i in items.iter().rev() {
+            let b = self.bucket(self.cell(positions[i as usize]));
+            self.cell_start[b] -= 1;
+            self.cell_entries[self.cell_start[b] as usize] = i;
         }
     }
 
@@ -210,6 +110,116 @@ impl SpatialHash {
     }
 }
 
+/// Points sorted by grid cell (x, then y, then z) for [`CellGrid::for_each_pair`].
+///
+/// The order is kept from one build to the next: points move little between builds, so the
+/// sort starts from nearly sorted input (Rust's stable sort merges the runs it finds).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct CellGrid {
+    spacing: f64,
+    /// The items of the last build, to know whether the kept order is still a permutation.
+    items: Vec<u32>,
+    /// (cell, item) in cell order.
+    sorted: Vec<([i32; 3], u32)>,
+    /// Positions in cell order.
+    positions: Vec<DVec3>,
+}
+
+/// Neighbour columns (dx, dy) after a cell's own in the sort order, each visited over
+/// dz ∈ −1..=1: with the cell itself and the cell above it (0, 0, +1) they are the 13
+/// lexicographically positive neighbours, so each pair of neighbouring cells is visited once.
+const COLUMNS: [[i32; 2]; 4] = [[0, 1], [1, -1], [1, 0], [1, 1]];
+
+impl CellGrid {
+    /// An empty grid.
+    pub(crate) fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sorts `items` (indices into `positions`) by their cell of size `spacing` (m), then by
+    /// index.
+    pub(crate) fn build(&mut self, positions: &[DVec3], items: &[u32], spacing: f64) {
+        self.spacing = spacing;
+        if self.items != items {
+            self.items.clear();
+            self.items.extend_from_slice(items);
+            self.sorted.clear();
+            self.sorted.extend(items.iter().map(|&i| ([0; 3], i)));
+        }
+        let inv = 1.0 / spacing;
+        for (cell, i) in &mut self.sorted {
+            *cell = (positions[*i as usize] * inv).floor().as_ivec3().to_array();
+        }
+        self.sorted.sort();
+        self.positions.clear();
+        self.positions
+            .extend(self.sorted.iter().map(|&(_, i)| positions[i as usize]));
+    }
+
+    /// Calls `f(i, j)` once for every unordered pair {i, j} of built items at most `radius`
+    /// apart (`radius` must not exceed the spacing); which comes first, and the order of the
+    /// calls, depend on the positions alone.
+    ///
+    /// With `radius` ≤ spacing two such points lie in the same or neighbouring cells. Walking
+    /// the cells in sorted order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
+    /// form one contiguous run whose start only moves forward, so one cursor per column finds
+    /// it without any search.
+    pub(crate) fn for_each_pair(&self, radius: f64, mut f: impl FnMut(u32, u32)) {
+        assert!(
+            radius <= self.spacing,
+            "pair radius {radius} exceeds the cell size {}",
+            self.spacing
+        );
+        let r2 = radius * radius;
+        let (cells, pos) = (&self.sorted, &self.positions);
+        let n = cells.len();
+        let mut cursors = [0usize; COLUMNS.len()];
+        let mut test = |x: usize, y: usize| {
+            if pos[x].distance_squared(pos[y]) <= r2 {
+                f(cells[x].1, cells[y].1);
+            }
+        };
+        let mut s = 0;
+        while s < n {
+            let c = cells[s].0;
+            let mut e = s + 1;
+            while e < n && cells[e].0 == c {
+                e += 1;
+            }
+            for x in s..e {
+                for y in x + 1..e {
+                    test(x, y);
+                }
+            }
+            // The cell above, if occupied, is the next run.
+            let up = [c[0], c[1], c[2].saturating_add(1)];
+            let mut y = e;
+            while y < n && cells[y].0 == up {
+                for x in s..e {
+                    test(x, y);
+                }
+                y += 1;
+            }
+            for (cursor, [dx, dy]) in cursors.iter_mut().zip(COLUMNS) {
+                let (cx, cy) = (c[0].saturating_add(dx), c[1].saturating_add(dy));
+                let lo = [cx, cy, c[2].saturating_sub(1)];
+                let hi = [cx, cy, c[2].saturating_add(1)];
+                while *cursor < n && cells[*cursor].0 < lo {
+                    *cursor += 1;
+                }
+                let mut y = *cursor;
+                while y < n && cells[y].0 <= hi {
+                    for x in s..e {
+                        test(x, y);
+                    }
+                    y += 1;
+                }
+            }
+            s = e;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -241,43 +251,41 @@ mod tests {
     }
 
     #[test]
-    fn pairs_are_exactly_the_brute_force_pairs_each_once() {
-        // A folded, clustered cloud: many points per cell and many bucket collisions.
+    fn grid_pairs_are_exactly_the_brute_force_pairs_each_once() {
+        // A folded, clustered cloud: many points per cell, negative and positive cells.
         let positions: Vec<DVec3> = (0..800)
             .map(|i| {
                 let f = i as f64;
                 DVec3::new((f * 0.37).sin(), 0.1 * (f * 0.71).cos(), (f * 0.13).sin()) * 0.3
             })
             .collect();
-        // Every other point only, so that items are not simply 0..n.
         let items: Vec<u32> = (0..800).filter(|i| i % 3 != 1).collect();
         let radius = 0.04;
-        let mut hash = SpatialHash::new(radius);
-        hash.build(&positions, &items);
-        let mut found = Vec::new();
-        hash.for_each_pair(radius, |i, j, d2| {
-            let d = positions[i as usize].distance_squared(positions[j as usize]);
-            assert_eq!(d, d2, "distance² of {i}-{j}");
-            found.push((i.min(j), i.max(j)));
-        });
-        let count = found.len();
-        found.sort_unstable();
-        found.dedup();
-        assert_eq!(found.len(), count, "a pair was reported twice");
-        let mut brute = Vec::new();
-        for (k, &i) in items.iter().enumerate() {
-            for &j in &items[k + 1..] {
-                if positions[i as usize].distance_squared(positions[j as usize]) <= radius * radius
-                {
-                    brute.push((i, j));
+        let mut grid = CellGrid::new();
+        let mut moved = positions.clone();
+        // Twice: the second build starts from the first one's order.
+        for round in 0..2 {
+            grid.build(&moved, &items, radius);
+            let mut found = Vec::new();
+            grid.for_each_pair(radius, |i, j| found.push((i.min(j), i.max(j))));
+            let count = found.len();
+            found.sort_unstable();
+            found.dedup();
+            assert_eq!(found.len(), count, "round {round}: a pair was reported twice");
+            let mut brute = Vec::new();
+            for (k, &i) in items.iter().enumerate() {
+                for &j in &items[k + 1..] {
+                    let d2 = moved[i as usize].distance_squared(moved[j as usize]);
+                    if d2 <= radius * radius {
+                        brute.push((i, j));
+                    }
                 }
             }
+            assert!(brute.len() > 1000, "too sparse a test: {} pairs", brute.len());
+            assert_eq!(found, brute, "round {round}");
+            for (k, x) in moved.iter_mut().enumerate() {
+                x.x += 0.01 * (k as f64 * 0.9).sin();
+            }
         }
-        assert!(
-            brute.len() > 1000,
-            "too sparse a test: {} pairs",
-            brute.len()
-        );
-        assert_eq!(found, brute);
     }
 }
