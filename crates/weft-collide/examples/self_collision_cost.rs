@@ -71,7 +71,9 @@ fn curtain(n: usize) -> (Solver, CollisionWorld) {
     .unwrap();
     let (settings, params) = scenarios::method_setup(Method::Xpbd);
     let mut builder = SolverBuilder::new(settings, scenarios::scenario_forces()).unwrap();
-    builder.add_cloth("curtain", &mesh, params, thickness).unwrap();
+    builder
+        .add_cloth("curtain", &mesh, params, thickness)
+        .unwrap();
     let mut solver = builder.build();
     let p = solver.particles_mut();
     for i in 0..p.len() {
@@ -144,10 +146,12 @@ fn time_frames(solver: &Solver, world: Option<&CollisionWorld>, frames: usize) -
         wall.push(t.elapsed().as_secs_f64() * 1e3);
         cpu.push((cpu_ns() - c) as f64 * 1e-6);
     }
-    if let (Some((r0, _)), Some((r1, len))) = (before, lists(&world)) {
+    if let (Some((r0, u0, _)), Some((r1, u1, len))) = (before, lists(&world)) {
         println!(
-            "  self-collision lists: {} rebuilds in {frames} frames of {} substeps; {len} pairs",
+            "  self-collision lists: {} rebuilds and {} partial updates in {frames} frames of \
+             {} substeps; {len} pairs",
             r1 - r0,
+            u1 - u0,
             solver.settings().substeps
         );
     }

@@ -127,6 +127,52 @@ struct PairList {
     target: Vec<f64>,
 }
 
+impl PairList {
+    fn clear(&mut self) {
+        self.a.clear();
+        self.b.clear();
+        self.target.clear();
+    }
+
+    fn push(&mut self, a: u32, b: u32, target: f64) {
+        self.a.push(a);
+        self.b.push(b);
+        self.target.push(target);
+    }
+
+    /// Index of (a, b), or where it would go.
+    fn position(&self, a: u32, b: u32) -> Result<usize, usize> {
+        let (mut lo, mut hi) = (0, self.a.len());
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            match (self.a[mid], self.b[mid]).cmp(&(a, b)) {
+                std::cmp::Ordering::Less => lo = mid + 1,
+                std::cmp::Ordering::Greater => hi = mid,
+                std::cmp::Ordering::Equal => return Ok(mid),
+            }
+        }
+        Err(lo)
+    }
+
+    /// Both lists in one, sorted (they share no pair).
+    fn merged(&self, other: &PairList) -> PairList {
+        let mut out = PairList::default();
+        let (mut i, mut j) = (0, 0);
+        while i < self.a.len() || j < other.a.len() {
+            let take_self = j == other.a.len()
+                || (i < self.a.len() && (self.a[i], self.b[i]) < (other.a[j], other.b[j]));
+            if take_self {
+                out.push(self.a[i], self.b[i], self.target[i]);
+                i += 1;
+            } else {
+                out.push(other.a[j], other.b[j], other.target[j]);
+                j += 1;
+            }
+        }
+        out
+    }
+}
+
 /// Self-collision state: member particles, rest data, and the Verlet list of candidate pairs.
 #[derive(Clone, Debug)]
 pub(crate) struct SelfCollision {
@@ -136,8 +182,22 @@ pub(crate) struct SelfCollision {
     exempt: Exemptions,
     grid: CellGrid,
     pairs: PairList,
-    /// Member positions (member order) when the list was built.
+    /// Each member's anchor x⁰ (member order): its position at the last full build, or, for
+    /// a member re-anchored since, its position then less the common displacement.
     built_at: Vec<DVec3>,
+    /// Members (slots) re-anchored since the last full build, and a flag per slot: their
+    /// positions in `grid` are stale.
+    reanchored: Vec<u32>,
+    is_reanchored: Vec<bool>,
+    /// Member slot of each particle (`u32::MAX` for non-members).
+    slot_of: Vec<u32>,
+    /// Pairs added for re-anchored members since the last full build (not in `pairs`), sorted.
+    extra: PairList,
+    /// Partial updates (re-anchoring a few members) so far.
+    updates: u64,
+    /// Scratch: members that moved past the limit; pairs found for them.
+    movers: Vec<u32>,
+    new_pairs: Vec<(u32, u32)>,
     /// Largest member thickness the list was built for; `None` when there is no list.
     built_for: Option<f64>,
     /// Lists built so far.
@@ -223,6 +283,10 @@ impl SelfCollision {
         }
         members.sort_unstable();
         members.dedup();
+        let mut slot_of = vec![u32::MAX; n];
+        for (slot, &i) in members.iter().enumerate() {
+            slot_of[i as usize] = slot as u32;
+        }
         neighbours.sort_unstable();
         neighbours.dedup();
         let mut offsets = vec![0u32; n + 1];
@@ -245,6 +309,13 @@ impl SelfCollision {
             grid: CellGrid::new(),
             pairs: PairList::default(),
             built_at: Vec::new(),
+            reanchored: Vec::new(),
+            is_reanchored: Vec::new(),
+            slot_of,
+            extra: PairList::default(),
+            updates: 0,
+            movers: Vec::new(),
+            new_pairs: Vec::new(),
             built_for: None,
             rebuilds: 0,
             rebuild_fraction: REBUILD_FRACTION,
@@ -266,9 +337,14 @@ impl SelfCollision {
         self.rebuilds
     }
 
+    /// Partial updates (a few members re-anchored) so far.
+    pub(crate) fn updates(&self) -> u64 {
+        self.updates
+    }
+
     /// Candidate pairs in the current list.
     pub(crate) fn pair_count(&self) -> usize {
-        self.pairs.a.len()
+        self.pairs.a.len() + self.extra.a.len()
     }
 
     /// Drops the list (thickness changed): the next [`SelfCollision::refresh`] rebuilds it.
@@ -307,49 +383,132 @@ impl SelfCollision {
         offsets
     }
 
-    /// Makes sure the list holds every pair that may touch at `positions`: keeps it while every
-    /// member's displacement since the build is within [`REBUILD_FRACTION`] · skin of one
-    /// common displacement c, and rebuilds it otherwise.
+    /// Makes sure the list holds every pair that may touch at `positions`.
     ///
-    /// Why nothing is missed: the list holds every non-exempt pair with |x⁰ₐ − x⁰ᵦ| ≤ R =
-    /// t + skin at the build (x⁰). With displacements Δᵢ = xᵢ − x⁰ᵢ and |Δᵢ − c| ≤ skin/4 for
-    /// all members, |Δₐ − Δᵦ| = |(Δₐ − c) − (Δᵦ − c)| ≤ skin/2, so by the triangle inequality
-    /// |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + skin/2: every pair closer than t + skin/2 now is listed, and
-    /// every target is at most t (the mean of two thicknesses, or less). The common part c
-    /// (the centre of the displacements' bounding box) lets a cloth that falls or is carried
-    /// as a whole keep its list. The check runs before every sweep, so it also catches moves
-    /// between frames (pins, grabs, a user editing positions).
+    /// Invariant: the list (`pairs` and `extra`) holds every non-exempt pair whose anchors are
+    /// at most R = t + skin apart, |x⁰ₐ − x⁰ᵦ| ≤ R. With displacements Δᵢ = xᵢ − x⁰ᵢ and a
+    /// common displacement c (their mean), a member is a mover if |Δᵢ − c| > skin/4. Movers
+    /// are re-anchored at x⁰ᵢ = xᵢ − c (so Δᵢ − c = 0) and their pairs within R of the new
+    /// anchor added, which keeps the invariant; when there are many, the list is rebuilt.
+    /// Then |Δᵢ − c| ≤ skin/4 for every member, so |Δₐ − Δᵦ| ≤ skin/2 and, by the triangle
+    /// inequality, |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + skin/2: every pair closer than t + skin/2 now is
+    /// listed, and every target is at most t (the mean of two thicknesses, or less). So no
+    /// contact is missing, with skin/2 to spare for pairs pushed together within a sweep.
+    /// c lets a cloth that falls or is carried as a whole keep its list. The check runs
+    /// before every sweep, so it also catches moves between frames (pins, grabs, edits).
     pub(crate) fn refresh(&mut self, positions: &[DVec3], thickness: &[f64]) {
-        if let Some(t) = self.built_for {
-            if t <= 0.0 || self.members.is_empty() {
-                return; // no thickness or no members: no pairs, whatever the motion
-            }
-            let limit = self.rebuild_fraction * self.params.search_margin * t;
-            let limit2 = limit * limit;
-            let displacements = || {
-                self.members
-                    .iter()
-                    .zip(&self.built_at)
-                    .map(|(&i, x0)| positions[i as usize] - *x0)
-            };
-            let (lo, hi) = displacements().fold(
-                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-                |(lo, hi), d| (lo.min(d), hi.max(d)),
-            );
-            let c = 0.5 * (lo + hi);
-            // Every |Δᵢ − c| is at most the box's half-diagonal: often that settles it.
-            let within = (0.5 * (hi - lo)).length_squared() <= limit2
-                || displacements().all(|d| (d - c).length_squared() <= limit2);
-            if within {
-                return;
+        let Some(t) = self.built_for else {
+            return self.rebuild(positions, thickness);
+        };
+        if t <= 0.0 || self.members.is_empty() {
+            return; // no thickness or no members: no pairs, whatever the motion
+        }
+        let limit = self.rebuild_fraction * self.params.search_margin * t;
+        let limit2 = limit * limit;
+        let displacements = || {
+            self.members
+                .iter()
+                .zip(&self.built_at)
+                .map(|(&i, x0)| positions[i as usize] - *x0)
+        };
+        let (lo, hi, sum) = displacements().fold(
+            (
+                DVec3::splat(f64::INFINITY),
+                DVec3::splat(f64::NEG_INFINITY),
+                DVec3::ZERO,
+            ),
+            |(lo, hi, sum), d| (lo.min(d), hi.max(d), sum + d),
+        );
+        // Every |Δᵢ − box centre| is at most the box's half-diagonal: often that settles it.
+        if (0.5 * (hi - lo)).length_squared() <= limit2 {
+            return;
+        }
+        let c = sum / self.members.len() as f64;
+        let cap = (self.members.len() / 64).max(64);
+        self.movers.clear();
+        for (slot, d) in displacements().enumerate() {
+            if (d - c).length_squared() > limit2 {
+                if self.movers.len() == cap {
+                    return self.rebuild(positions, thickness);
+                }
+                self.movers.push(slot as u32);
             }
         }
-        self.rebuild(positions, thickness);
+        if !self.movers.is_empty() {
+            self.reanchor(positions, thickness, c, t);
+        }
+    }
+
+    /// Re-anchors `movers` at xᵢ − c and lists their pairs within R of the new anchors (see
+    /// [`SelfCollision::refresh`]); rebuilds instead once many members have been re-anchored.
+    fn reanchor(&mut self, positions: &[DVec3], thickness: &[f64], c: DVec3, t: f64) {
+        for &m in &self.movers {
+            let m = m as usize;
+            self.built_at[m] = positions[self.members[m] as usize] - c;
+            if !self.is_reanchored[m] {
+                self.is_reanchored[m] = true;
+                self.reanchored.push(m as u32);
+            }
+        }
+        if self.reanchored.len() > (self.members.len() / 32).max(64) {
+            return self.rebuild(positions, thickness);
+        }
+        self.updates += 1;
+        let radius = t * (1.0 + self.params.search_margin);
+        let r2 = radius * radius;
+        let new_pairs = &mut self.new_pairs;
+        new_pairs.clear();
+        for &m in &self.movers {
+            let (x0, id) = (self.built_at[m as usize], self.members[m as usize]);
+            let pair = |j: u32| (id.min(j), id.max(j));
+            // Members never re-anchored sit in the grid at their anchors.
+            self.grid.for_each_near(x0, radius, |j| {
+                if j != id && !self.is_reanchored[self.slot_of[j as usize] as usize] {
+                    new_pairs.push(pair(j));
+                }
+            });
+            for &r in &self.reanchored {
+                if r != m && self.built_at[r as usize].distance_squared(x0) <= r2 {
+                    new_pairs.push(pair(self.members[r as usize]));
+                }
+            }
+        }
+        new_pairs.sort_unstable();
+        new_pairs.dedup();
+        let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
+        let mut added = PairList::default();
+        for &(a, b) in new_pairs.iter() {
+            if self.pairs.position(a, b).is_ok() || self.extra.position(a, b).is_ok() {
+                continue;
+            }
+            let (s, e) = (
+                special_offsets[a as usize] as usize,
+                special_offsets[a as usize + 1] as usize,
+            );
+            let special = &self.special[s..e];
+            let target = match special.binary_search_by_key(&b, |&(sb, _)| sb) {
+                Ok(k) => special[k].1,
+                Err(_) => 0.5 * (thickness[a as usize] + thickness[b as usize]),
+            };
+            if target != EXEMPT {
+                added.push(a, b, target);
+            }
+        }
+        if !added.a.is_empty() {
+            let old = std::mem::take(&mut self.extra);
+            self.extra = old.merged(&added);
+        }
     }
 
     /// Builds the list at `positions`: pairs from the hash, their targets, sorted by (a, b).
     fn rebuild(&mut self, positions: &[DVec3], thickness: &[f64]) {
         self.rebuilds += 1;
+        for &r in &self.reanchored {
+            self.is_reanchored[r as usize] = false;
+        }
+        self.reanchored.clear();
+        self.is_reanchored.resize(self.members.len(), false);
+        self.extra.clear();
         self.built_at.clear();
         self.built_at
             .extend(self.members.iter().map(|&i| positions[i as usize]));
@@ -359,9 +518,7 @@ impl SelfCollision {
             .map(|&i| thickness[i as usize])
             .fold(0.0f64, f64::max);
         self.built_for = Some(max_t);
-        self.pairs.a.clear();
-        self.pairs.b.clear();
-        self.pairs.target.clear();
+        self.pairs.clear();
         if max_t <= 0.0 {
             return;
         }
@@ -424,9 +581,33 @@ impl SelfCollision {
     /// Pushes touching pairs apart to their target distance, with friction; returns the
     /// number of contacts and the deepest overlap (m). Call [`SelfCollision::refresh`] first.
     pub(crate) fn solve(&self, p: &mut Particles) -> (usize, f64) {
-        let mut contacts = 0;
-        let mut deepest = 0.0f64;
-        let PairList { a, b, target } = &self.pairs;
+        let mut acc = (0, 0.0f64);
+        // `pairs` and `extra` in one (a, b) order: the order a full rebuild would give.
+        let mut k = 0;
+        for e in 0..self.extra.a.len() {
+            let (a, b) = (self.extra.a[e], self.extra.b[e]);
+            let end = self.pairs.position(a, b).unwrap_or_else(|i| i);
+            self.solve_range(p, &self.pairs, k..end, &mut acc);
+            self.solve_range(p, &self.extra, e..e + 1, &mut acc);
+            k = end;
+        }
+        self.solve_range(p, &self.pairs, k..self.pairs.a.len(), &mut acc);
+        acc
+    }
+
+    /// Solves `list[range]`, adding to (contacts, deepest).
+    fn solve_range(
+        &self,
+        p: &mut Particles,
+        list: &PairList,
+        range: std::ops::Range<usize>,
+        (contacts, deepest): &mut (usize, f64),
+    ) {
+        let (a, b, target) = (
+            &list.a[range.clone()],
+            &list.b[range.clone()],
+            &list.target[range],
+        );
         for ((&a, &b), &target) in a.iter().zip(b).zip(target) {
             let (a, b) = (a as usize, b as usize);
             let delta = p.positions[a] - p.positions[b];
@@ -457,10 +638,9 @@ impl SelfCollision {
             let corr = self.params.friction.correction(tangential, depth);
             p.positions[a] -= corr * (wa / w);
             p.positions[b] += corr * (wb / w);
-            contacts += 1;
-            deepest = deepest.max(depth);
+            *contacts += 1;
+            *deepest = deepest.max(depth);
         }
-        (contacts, deepest)
     }
 }
 
@@ -520,9 +700,14 @@ mod tests {
         (solver, x, thickness)
     }
 
+    /// The whole list (`pairs` and `extra`), in solve order.
+    fn whole(sc: &SelfCollision) -> PairList {
+        sc.pairs.merged(&sc.extra)
+    }
+
     /// Pairs listed by `sc` that touch at `x`.
     fn listed_contacts(sc: &SelfCollision, x: &[DVec3]) -> Vec<(u32, u32)> {
-        let PairList { a, b, target } = &sc.pairs;
+        let PairList { a, b, target } = whole(sc);
         (0..a.len())
             .filter(|&k| x[a[k] as usize].distance(x[b[k] as usize]) < target[k])
             .map(|k| (a[k], b[k]))
@@ -551,12 +736,25 @@ mod tests {
     }
 
     fn listed(sc: &SelfCollision) -> Vec<(u32, u32)> {
-        sc.pairs
-            .a
-            .iter()
-            .copied()
-            .zip(sc.pairs.b.iter().copied())
-            .collect()
+        let w = whole(sc);
+        w.a.iter().copied().zip(w.b.iter().copied()).collect()
+    }
+
+    /// Asserts every non-exempt pair closer than t + skin/2 at `x` is listed, and that the
+    /// touching pairs are exactly the brute-force ones.
+    fn assert_complete(sc: &SelfCollision, x: &[DVec3], t: &[f64], limit: f64, when: &str) {
+        let list = listed(sc);
+        assert!(list.windows(2).all(|w| w[0] < w[1]), "{when}: not sorted");
+        let missing: Vec<_> = brute_pairs(sc, x, t, |_| SPACING + 2.0 * limit)
+            .into_iter()
+            .filter(|p| list.binary_search(p).is_err())
+            .collect();
+        assert!(missing.is_empty(), "{when}: pairs missing: {missing:?}");
+        assert_eq!(
+            listed_contacts(sc, x),
+            brute_pairs(sc, x, t, |target| target),
+            "{when}: contacts"
+        );
     }
 
     #[test]
@@ -566,81 +764,90 @@ mod tests {
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
         sc.refresh(&x, &t);
         assert_eq!(sc.rebuilds(), 1);
-        let list = listed(&sc);
-        assert!(
-            list.windows(2).all(|w| w[0] < w[1]),
-            "list not sorted by (a, b)"
-        );
         let contacts = listed_contacts(&sc, &x);
-        assert_eq!(contacts, brute_pairs(&sc, &x, &t, |target| target));
         assert!(contacts.len() > 200, "only {} contacts", contacts.len());
+        let limit = REBUILD_FRACTION * params.search_margin * SPACING;
+        assert_complete(&sc, &x, &t, limit, "built");
         // Exactly the pairs within R at the build, no more.
+        let list = listed(&sc);
         let radius = SPACING * (1.0 + params.search_margin);
         assert_eq!(list, brute_pairs(&sc, &x, &t, |_| radius * (1.0 + 1e-12)));
 
-        // Adversarial moves within the skin: each particle heads straight for the nearest
-        // particle the list does not pair it with, by just under a quarter of the skin.
-        let limit = REBUILD_FRACTION * params.search_margin * SPACING;
+        // Adversarial moves within the skin: each particle heads for the nearest particle the
+        // list does not pair it with; less their mean, scaled to just under a quarter skin.
         let x0 = x.clone();
-        for a in 0..x.len() {
-            let nearest = (0..x.len())
-                .filter(|&b| b != a && sc.target(a as u32, b as u32, &t).is_some())
-                .filter(|&b| {
-                    list.binary_search(&((a.min(b)) as u32, a.max(b) as u32))
-                        .is_err()
-                })
-                .min_by(|&b, &c| x0[a].distance(x0[b]).total_cmp(&x0[a].distance(x0[c])));
-            if let Some(b) = nearest {
-                x[a] = x0[a] + (x0[b] - x0[a]).normalize() * (0.999 * limit);
-            }
+        let mut moves: Vec<DVec3> = (0..x.len())
+            .map(|a| {
+                (0..x.len())
+                    .filter(|&b| b != a && sc.target(a as u32, b as u32, &t).is_some())
+                    .filter(|&b| {
+                        list.binary_search(&(a.min(b) as u32, a.max(b) as u32))
+                            .is_err()
+                    })
+                    .min_by(|&b, &c| x0[a].distance(x0[b]).total_cmp(&x0[a].distance(x0[c])))
+                    .map_or(DVec3::ZERO, |b| (x0[b] - x0[a]).normalize())
+            })
+            .collect();
+        let mean = moves.iter().sum::<DVec3>() / moves.len() as f64;
+        let longest = moves
+            .iter()
+            .map(|m| (*m - mean).length())
+            .fold(0.0, f64::max);
+        for m in &mut moves {
+            *m = (*m - mean) * (0.999 * limit / longest);
+        }
+        for (xi, (x0i, m)) in x.iter_mut().zip(x0.iter().zip(&moves)) {
+            *xi = *x0i + *m;
         }
         sc.refresh(&x, &t);
         assert_eq!(
-            sc.rebuilds(),
-            1,
-            "rebuilt although nothing moved a quarter skin"
+            (sc.rebuilds(), sc.updates()),
+            (1, 0),
+            "list changed although nothing moved a quarter skin"
         );
-        // Every pair closer than t + skin/2 is still listed, so every contact is.
-        let guaranteed = brute_pairs(&sc, &x, &t, |_| SPACING + 2.0 * limit);
-        let list = listed(&sc);
-        let missing: Vec<_> = guaranteed
-            .iter()
-            .filter(|p| list.binary_search(p).is_err())
-            .collect();
-        assert!(
-            missing.is_empty(),
-            "pairs missing from the list: {missing:?}"
-        );
-        assert_eq!(
-            listed_contacts(&sc, &x),
-            brute_pairs(&sc, &x, &t, |target| target)
-        );
+        assert_complete(&sc, &x, &t, limit, "after the moves");
         // The moves did bring unlisted pairs closer than R: the skin was needed.
         let closer = brute_pairs(&sc, &x, &t, |_| radius);
         assert!(closer.iter().any(|p| list.binary_search(p).is_err()));
     }
 
     #[test]
-    fn moving_one_particle_past_a_quarter_skin_rebuilds_the_list() {
+    fn movers_are_reanchored_the_whole_cloth_may_move_and_many_movers_rebuild() {
         let (solver, mut x, t) = folded();
         let params = SelfCollisionParams::default();
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
         let limit = REBUILD_FRACTION * params.search_margin * SPACING;
         sc.refresh(&x, &t);
+        // The whole cloth carried 10 quarter-skins away: its list still holds.
+        for xi in &mut x {
+            *xi += DVec3::new(10.0 * limit, -3.0 * limit, 0.0);
+        }
+        sc.refresh(&x, &t);
+        assert_eq!((sc.rebuilds(), sc.updates()), (1, 0), "carried");
         x[100].x += 0.99 * limit;
         sc.refresh(&x, &t);
-        assert_eq!(sc.rebuilds(), 1, "rebuilt for a move within the skin");
-        // Particle 200 jumps onto particle 300 (far away at rest): a new contact.
-        x[200] = x[300] + DVec3::new(0.0, 0.2 * SPACING, 0.0);
-        let (a, b) = (200, 300);
-        assert!(listed(&sc).binary_search(&(a, b)).is_err());
-        sc.refresh(&x, &t);
-        assert_eq!(sc.rebuilds(), 2, "no rebuild after a move past the skin");
-        assert!(listed(&sc).binary_search(&(a, b)).is_ok());
         assert_eq!(
-            listed_contacts(&sc, &x),
-            brute_pairs(&sc, &x, &t, |target| target)
+            (sc.rebuilds(), sc.updates()),
+            (1, 0),
+            "moved within the skin"
         );
+        // Particles 200 and 201 jump onto particle 300 (far away at rest): new contacts.
+        x[200] = x[300] + DVec3::new(0.0, 0.2 * SPACING, 0.0);
+        x[201] = x[300] + DVec3::new(0.2 * SPACING, 0.0, 0.0);
+        assert!(listed(&sc).binary_search(&(200, 300)).is_err());
+        sc.refresh(&x, &t);
+        assert_eq!((sc.rebuilds(), sc.updates()), (1, 1), "two movers");
+        assert!(listed(&sc).binary_search(&(200, 300)).is_ok());
+        assert!(listed(&sc).binary_search(&(201, 300)).is_ok());
+        assert_complete(&sc, &x, &t, limit, "after re-anchoring");
+        // Everything shaken by half a skin: a full rebuild.
+        let mut seed = 3;
+        for xi in &mut x {
+            *xi += DVec3::new(rand(&mut seed), rand(&mut seed), rand(&mut seed)) * (2.0 * limit);
+        }
+        sc.refresh(&x, &t);
+        assert_eq!((sc.rebuilds(), sc.updates()), (2, 1), "shaken");
+        assert_complete(&sc, &x, &t, limit, "after the rebuild");
         // A thickness change drops the list.
         sc.invalidate();
         sc.refresh(&x, &t);
@@ -672,7 +879,7 @@ mod tests {
         }
     }
 
-    fn fold_with(rebuild_fraction: f64) -> (Vec<DVec3>, u64) {
+    fn fold_with(rebuild_fraction: f64) -> (Vec<DVec3>, u64, u64) {
         let (mut solver, _) = self_fold(Method::Xpbd, 10, 30).expect("scenario");
         let mut sc = SelfCollision::new(&solver, &[0], SelfCollisionParams::default())
             .expect("self-collision");
@@ -686,14 +893,19 @@ mod tests {
         for _ in 0..90 {
             solver.step_with(&mut hook).expect("step");
         }
-        (solver.particles().positions.clone(), hook.sc.rebuilds())
+        (
+            solver.particles().positions.clone(),
+            hook.sc.rebuilds(),
+            hook.sc.updates(),
+        )
     }
 
     #[test]
     fn skin_list_folds_exactly_like_a_search_before_every_sweep() {
         // Fraction 0: any motion at all rebuilds the list, i.e. a fresh search every sweep.
-        let (every, sweeps) = fold_with(0.0);
-        let (skin, rebuilds) = fold_with(REBUILD_FRACTION);
+        let (every, sweeps, _) = fold_with(0.0);
+        let (skin, rebuilds, updates) = fold_with(REBUILD_FRACTION);
+        assert!(updates > 0, "no partial update was exercised");
         assert_eq!(sweeps, 90 * 10, "a fresh search every sweep");
         assert!(
             4 * rebuilds < 3 * sweeps,

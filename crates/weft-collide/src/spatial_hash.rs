@@ -156,6 +156,31 @@ impl CellGrid {
             .extend(self.sorted.iter().map(|&(_, i)| positions[i as usize]));
     }
 
+    /// Calls `f(i)` for every built item at most `radius` (≤ spacing) from `p`, in cell order.
+    pub(crate) fn for_each_near(&self, p: DVec3, radius: f64, mut f: impl FnMut(u32)) {
+        assert!(
+            radius <= self.spacing,
+            "query radius {radius} exceeds the cell size {}",
+            self.spacing
+        );
+        let r2 = radius * radius;
+        let c = (p / self.spacing).floor().as_ivec3().to_array();
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                let (cx, cy) = (c[0].saturating_add(dx), c[1].saturating_add(dy));
+                let lo = [cx, cy, c[2].saturating_sub(1)];
+                let hi = [cx, cy, c[2].saturating_add(1)];
+                let start = self.sorted.partition_point(|&(cell, _)| cell < lo);
+                let end = self.sorted.partition_point(|&(cell, _)| cell <= hi);
+                for k in start..end {
+                    if self.positions[k].distance_squared(p) <= r2 {
+                        f(self.sorted[k].1);
+                    }
+                }
+            }
+        }
+    }
+
     /// Calls `f(i, j)` once for every unordered pair {i, j} of built items at most `radius`
     /// apart (`radius` must not exceed the spacing); which comes first, and the order of the
     /// calls, depend on the positions alone.
@@ -271,7 +296,11 @@ mod tests {
             let count = found.len();
             found.sort_unstable();
             found.dedup();
-            assert_eq!(found.len(), count, "round {round}: a pair was reported twice");
+            assert_eq!(
+                found.len(),
+                count,
+                "round {round}: a pair was reported twice"
+            );
             let mut brute = Vec::new();
             for (k, &i) in items.iter().enumerate() {
                 for &j in &items[k + 1..] {
@@ -281,7 +310,11 @@ mod tests {
                     }
                 }
             }
-            assert!(brute.len() > 1000, "too sparse a test: {} pairs", brute.len());
+            assert!(
+                brute.len() > 1000,
+                "too sparse a test: {} pairs",
+                brute.len()
+            );
             assert_eq!(found, brute, "round {round}");
             for (k, x) in moved.iter_mut().enumerate() {
                 x.x += 0.01 * (k as f64 * 0.9).sin();

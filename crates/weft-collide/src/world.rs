@@ -107,12 +107,12 @@ impl CollisionWorld {
             .map(|s| s.target(a, b, &self.thickness))
     }
 
-    /// Self-collision candidate lists built so far and the current list's length, or `None`
-    /// when self-collision is off.
-    pub fn self_collision_lists(&self) -> Option<(u64, usize)> {
+    /// Self-collision candidate lists: full builds and partial updates so far and the current
+    /// list's length, or `None` when self-collision is off.
+    pub fn self_collision_lists(&self) -> Option<(u64, u64, usize)> {
         self.self_collision
             .as_ref()
-            .map(|s| (s.rebuilds(), s.pair_count()))
+            .map(|s| (s.rebuilds(), s.updates(), s.pair_count()))
     }
 
     /// Per-particle thickness (m).
