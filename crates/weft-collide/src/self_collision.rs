@@ -8,11 +8,13 @@
 //! Candidate pairs live in a Verlet ("skin") list (Verlet 1967; Allen & Tildesley, "Computer
 //! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + search_margin) apart
 //! when the list was built, t the largest member thickness, so `search_margin` · t is the
-//! skin. The list is reused while no member has moved more than a quarter of the skin since
-//! the build, and rebuilt otherwise from a [`CellGrid`] (points sorted by cell, swept once) (see [`SelfCollision::refresh`] for
-//! why no contact can be missing). Pairs are kept sorted by (a, b) and solved Gauss–Seidel in
-//! that order, so results depend neither on thread count nor on hashing order, nor on when the
-//! list was rebuilt: a listed pair that is not touching does nothing.
+//! skin. The list is reused while every member stays within a quarter of the skin of its
+//! anchor (up to a displacement common to all); the few members that stray are re-anchored
+//! and their new pairs added, and the list is rebuilt from a [`CellGrid`] (points sorted by
+//! cell, swept once) when many do. [`SelfCollision::refresh`] says why no contact can be
+//! missing. Pairs are solved Gauss–Seidel in (a, b) order, so results depend neither on
+//! thread count nor on grid order, nor on when the list was rebuilt: a listed pair that is not
+//! touching does nothing.
 
 use glam::DVec3;
 use weft_solver::{Particles, Solver};
@@ -74,12 +76,12 @@ impl SelfCollisionParams {
     }
 }
 
-/// How far (as a fraction of the skin) a member may move from where the list was built
-/// before the list is rebuilt. Two members each within skin/4 of their build positions are at
-/// most skin/2 closer than they were, so every pair closer than t + skin/2 now was closer than
-/// R = t + skin then, and is in the list: contacts (closer than t) all are, with skin/2 to spare
-/// for pairs pushed together within one sweep (the role `search_margin` had when pairs were
-/// searched every substep).
+/// How far (as a fraction of the skin) a member may move from its anchor, beyond the common
+/// displacement, before it is re-anchored. Two members each within skin/4 of their anchors
+/// are at most skin/2 closer than their anchors, so every pair closer than t + skin/2 now has
+/// anchors closer than R = t + skin, and is in the list: contacts (closer than t) all are, with
+/// skin/2 to spare for pairs pushed together within one sweep (the role `search_margin` had
+/// when pairs were searched every substep).
 const REBUILD_FRACTION: f64 = 0.25;
 
 /// What decides each pair's treatment: cloths, rest positions and triangle adjacency.
@@ -500,7 +502,7 @@ impl SelfCollision {
         }
     }
 
-    /// Builds the list at `positions`: pairs from the hash, their targets, sorted by (a, b).
+    /// Builds the list at `positions`: pairs from the grid, their targets, sorted by (a, b).
     fn rebuild(&mut self, positions: &[DVec3], thickness: &[f64]) {
         self.rebuilds += 1;
         for &r in &self.reanchored {

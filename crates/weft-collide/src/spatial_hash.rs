@@ -119,16 +119,37 @@ pub(crate) struct CellGrid {
     spacing: f64,
     /// The items of the last build, to know whether the kept order is still a permutation.
     items: Vec<u32>,
-    /// (cell, item) in cell order.
-    sorted: Vec<([i32; 3], u32)>,
-    /// Positions in cell order.
+    /// (cell key, item) in key order.
+    sorted: Vec<(u64, u32)>,
+    /// Positions in key order.
     positions: Vec<DVec3>,
 }
 
-/// Neighbour columns (dx, dy) after a cell's own in the sort order, each visited over
+/// Bits per cell coordinate in a cell key.
+const BITS: u32 = 21;
+/// Key steps of one cell along y and along x (z is 1).
+const Y: u64 = 1 << BITS;
+const X: u64 = 1 << (2 * BITS);
+
+/// The key of the cell holding `p`: its coordinates, offset to be positive and clamped to
+/// 1..2²¹ − 2, packed x, y, z from the high bits, so that key order is lexicographic cell
+/// order and a neighbour's key is the key ± 1, ± Y, ± X. Clamping is 1-Lipschitz: cells that
+/// are neighbours stay neighbours (or merge), so no close pair is lost; only points more than
+/// 2²⁰ cells from the origin share border cells.
+fn cell_key(p: DVec3, inv_spacing: f64) -> u64 {
+    let c = (p * inv_spacing).floor();
+    let half = f64::from(1u32 << (BITS - 1));
+    let max = f64::from((1u32 << BITS) - 2);
+    // NaN clamps to NaN and `as` turns it into 0: such points gather in one cell.
+    let k = |v: f64| (v + half).clamp(1.0, max) as u64;
+    (k(c.x) << (2 * BITS)) | (k(c.y) << BITS) | k(c.z)
+}
+
+/// Neighbour columns (dx, dy) after a cell's own in key order, each visited over
 /// dz ∈ −1..=1: with the cell itself and the cell above it (0, 0, +1) they are the 13
 /// lexicographically positive neighbours, so each pair of neighbouring cells is visited once.
-const COLUMNS: [[i32; 2]; 4] = [[0, 1], [1, -1], [1, 0], [1, 1]];
+/// As key offsets from (x, y, z) to (x + dx, y + dy, z − 1).
+const COLUMNS: [u64; 4] = [Y - 1, X - Y - 1, X - 1, X + Y - 1];
 
 impl CellGrid {
     /// An empty grid.
@@ -144,11 +165,11 @@ impl CellGrid {
             self.items.clear();
             self.items.extend_from_slice(items);
             self.sorted.clear();
-            self.sorted.extend(items.iter().map(|&i| ([0; 3], i)));
+            self.sorted.extend(items.iter().map(|&i| (0, i)));
         }
         let inv = 1.0 / spacing;
-        for (cell, i) in &mut self.sorted {
-            *cell = (positions[*i as usize] * inv).floor().as_ivec3().to_array();
+        for (key, i) in &mut self.sorted {
+            *key = cell_key(positions[*i as usize], inv);
         }
         self.sorted.sort();
         self.positions.clear();
@@ -156,7 +177,7 @@ impl CellGrid {
             .extend(self.sorted.iter().map(|&(_, i)| positions[i as usize]));
     }
 
-    /// Calls `f(i)` for every built item at most `radius` (≤ spacing) from `p`, in cell order.
+    /// Calls `f(i)` for every built item at most `radius` (≤ spacing) from `p`, in key order.
     pub(crate) fn for_each_near(&self, p: DVec3, radius: f64, mut f: impl FnMut(u32)) {
         assert!(
             radius <= self.spacing,
@@ -164,18 +185,17 @@ impl CellGrid {
             self.spacing
         );
         let r2 = radius * radius;
-        let c = (p / self.spacing).floor().as_ivec3().to_array();
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                let (cx, cy) = (c[0].saturating_add(dx), c[1].saturating_add(dy));
-                let lo = [cx, cy, c[2].saturating_sub(1)];
-                let hi = [cx, cy, c[2].saturating_add(1)];
-                let start = self.sorted.partition_point(|&(cell, _)| cell < lo);
-                let end = self.sorted.partition_point(|&(cell, _)| cell <= hi);
-                for k in start..end {
-                    if self.positions[k].distance_squared(p) <= r2 {
-                        f(self.sorted[k].1);
-                    }
+        let key = cell_key(p, 1.0 / self.spacing);
+        for column in [key - X - Y, key - X, key - X + Y, key - Y, key, key + Y]
+            .into_iter()
+            .chain([key + X - Y, key + X, key + X + Y])
+        {
+            let (lo, hi) = (column - 1, column + 1);
+            let start = self.sorted.partition_point(|&(k, _)| k < lo);
+            let end = self.sorted.partition_point(|&(k, _)| k <= hi);
+            for k in start..end {
+                if self.positions[k].distance_squared(p) <= r2 {
+                    f(self.sorted[k].1);
                 }
             }
         }
@@ -186,7 +206,7 @@ impl CellGrid {
     /// calls, depend on the positions alone.
     ///
     /// With `radius` ≤ spacing two such points lie in the same or neighbouring cells. Walking
-    /// the cells in sorted order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
+    /// the cells in key order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
     /// form one contiguous run whose start only moves forward, so one cursor per column finds
     /// it without any search.
     pub(crate) fn for_each_pair(&self, radius: f64, mut f: impl FnMut(u32, u32)) {
@@ -199,11 +219,6 @@ impl CellGrid {
         let (cells, pos) = (&self.sorted, &self.positions);
         let n = cells.len();
         let mut cursors = [0usize; COLUMNS.len()];
-        let mut test = |x: usize, y: usize| {
-            if pos[x].distance_squared(pos[y]) <= r2 {
-                f(cells[x].1, cells[y].1);
-            }
-        };
         let mut s = 0;
         while s < n {
             let c = cells[s].0;
@@ -211,33 +226,36 @@ impl CellGrid {
             while e < n && cells[e].0 == c {
                 e += 1;
             }
-            for x in s..e {
-                for y in x + 1..e {
-                    test(x, y);
-                }
-            }
-            // The cell above, if occupied, is the next run.
-            let up = [c[0], c[1], c[2].saturating_add(1)];
+            // The cell itself, the cell above (the next run, if occupied), then the columns.
             let mut y = e;
-            while y < n && cells[y].0 == up {
-                for x in s..e {
-                    test(x, y);
-                }
+            while y < n && cells[y].0 == c + 1 {
                 y += 1;
             }
-            for (cursor, [dx, dy]) in cursors.iter_mut().zip(COLUMNS) {
-                let (cx, cy) = (c[0].saturating_add(dx), c[1].saturating_add(dy));
-                let lo = [cx, cy, c[2].saturating_sub(1)];
-                let hi = [cx, cy, c[2].saturating_add(1)];
+            let mut runs = [(e, y); 1 + COLUMNS.len()];
+            for (k, (cursor, offset)) in cursors.iter_mut().zip(COLUMNS).enumerate() {
+                let lo = c + offset;
                 while *cursor < n && cells[*cursor].0 < lo {
                     *cursor += 1;
                 }
-                let mut y = *cursor;
-                while y < n && cells[y].0 <= hi {
-                    for x in s..e {
-                        test(x, y);
+                let mut end = *cursor;
+                while end < n && cells[end].0 <= lo + 2 {
+                    end += 1;
+                }
+                runs[k + 1] = (*cursor, end);
+            }
+            for x in s..e {
+                let px = pos[x];
+                for y in x + 1..e {
+                    if px.distance_squared(pos[y]) <= r2 {
+                        f(cells[x].1, cells[y].1);
                     }
-                    y += 1;
+                }
+                for &(from, to) in &runs {
+                    for y in from..to {
+                        if px.distance_squared(pos[y]) <= r2 {
+                            f(cells[x].1, cells[y].1);
+                        }
+                    }
                 }
             }
             s = e;
