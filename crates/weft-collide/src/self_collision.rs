@@ -6,10 +6,11 @@
 //! closer than a thickness at rest are only kept at their rest distance.
 //!
 //! Candidate pairs live in a Verlet ("skin") list (Verlet 1967; Allen & Tildesley, "Computer
-//! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + search_margin) apart
-//! when the list was built, t the largest member thickness, so `search_margin` · t is the
-//! skin. The list is reused while every member stays within a quarter of the skin of its
-//! anchor (up to a displacement common to all); the few members that stray are re-anchored
+//! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + search_margin) + s
+//! apart when the list was built, t the largest member thickness and s the skin. The list is
+//! reused while every member stays within s/2 of its anchor (up to a displacement common to
+//! all), so that every pair within t (1 + search_margin) is always listed, as when pairs were
+//! searched every substep; the few members that stray are re-anchored
 //! and their new pairs added, and the list is rebuilt from a [`CellGrid`] (points sorted by
 //! cell, swept once) when many do. [`SelfCollision::refresh`] says why no contact can be
 //! missing. Pairs are solved Gauss–Seidel in (a, b) order, so results depend neither on
@@ -76,13 +77,14 @@ impl SelfCollisionParams {
     }
 }
 
-/// How far (as a fraction of the skin) a member may move from its anchor, beyond the common
-/// displacement, before it is re-anchored. Two members each within skin/4 of their anchors
-/// are at most skin/2 closer than their anchors, so every pair closer than t + skin/2 now has
-/// anchors closer than R = t + skin, and is in the list: contacts (closer than t) all are, with
-/// skin/2 to spare for pairs pushed together within one sweep (the role `search_margin` had
-/// when pairs were searched every substep).
-const REBUILD_FRACTION: f64 = 0.25;
+/// The skin s of the list, as a fraction of the thickness. The list holds the pairs within
+/// R = t (1 + search_margin) + s, and a member may stray s/2 from its anchor (beyond the common
+/// displacement) before it is re-anchored: two members within s/2 of their anchors are at
+/// most s closer than their anchors, so every pair within t (1 + search_margin) now has anchors
+/// within R and is listed. A larger skin means fewer re-anchorings and rebuilds but a longer
+/// list to sweep; of 0.25, 0.5 and 1, 0.5 cost least overall in the 128² cost example
+/// (`examples/self_collision_cost.rs`).
+const SKIN: f64 = 0.5;
 
 /// What decides each pair's treatment: cloths, rest positions and triangle adjacency.
 #[derive(Clone, Debug)]
@@ -204,8 +206,8 @@ pub(crate) struct SelfCollision {
     built_for: Option<f64>,
     /// Lists built so far.
     rebuilds: u64,
-    /// [`REBUILD_FRACTION`], or another value in tests.
-    rebuild_fraction: f64,
+    /// [`SKIN`], or another value in tests.
+    skin: f64,
     /// Pairs whose treatment is not the default (keep the mean thickness): CSR over particles,
     /// `special[special_offsets[a]..special_offsets[a + 1]]` holds (b > a, target), sorted by
     /// b, with a negative target for exempt pairs. Built at the first list build after
@@ -320,7 +322,7 @@ impl SelfCollision {
             new_pairs: Vec::new(),
             built_for: None,
             rebuilds: 0,
-            rebuild_fraction: REBUILD_FRACTION,
+            skin: SKIN,
             special_offsets: None,
             special: Vec::new(),
             found: Vec::new(),
@@ -385,19 +387,30 @@ impl SelfCollision {
         offsets
     }
 
+    /// The list radius R for largest thickness `t` (m).
+    fn radius(&self, t: f64) -> f64 {
+        t * (1.0 + self.params.search_margin + self.skin)
+    }
+
+    /// How far a member may stray from its anchor for thickness `t` (m): half the skin.
+    fn limit(&self, t: f64) -> f64 {
+        0.5 * self.skin * t
+    }
+
     /// Makes sure the list holds every pair that may touch at `positions`.
     ///
     /// Invariant: the list (`pairs` and `extra`) holds every non-exempt pair whose anchors are
-    /// at most R = t + skin apart, |x⁰ₐ − x⁰ᵦ| ≤ R. With displacements Δᵢ = xᵢ − x⁰ᵢ and a
-    /// common displacement c (their mean), a member is a mover if |Δᵢ − c| > skin/4. Movers
-    /// are re-anchored at x⁰ᵢ = xᵢ − c (so Δᵢ − c = 0) and their pairs within R of the new
-    /// anchor added, which keeps the invariant; when there are many, the list is rebuilt.
-    /// Then |Δᵢ − c| ≤ skin/4 for every member, so |Δₐ − Δᵦ| ≤ skin/2 and, by the triangle
-    /// inequality, |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + skin/2: every pair closer than t + skin/2 now is
-    /// listed, and every target is at most t (the mean of two thicknesses, or less). So no
-    /// contact is missing, with skin/2 to spare for pairs pushed together within a sweep.
-    /// c lets a cloth that falls or is carried as a whole keep its list. The check runs
-    /// before every sweep, so it also catches moves between frames (pins, grabs, edits).
+    /// at most R = t (1 + m) + s apart (m the search margin, s the skin), |x⁰ₐ − x⁰ᵦ| ≤ R. With
+    /// displacements Δᵢ = xᵢ − x⁰ᵢ and a common displacement c (their mean), a member is a
+    /// mover if |Δᵢ − c| > s/2. Movers are re-anchored at x⁰ᵢ = xᵢ − c (so Δᵢ − c = 0) and
+    /// their pairs within R of the new anchor added, which keeps the invariant; when there are
+    /// many, the list is rebuilt. Then |Δᵢ − c| ≤ s/2 for every member, so |Δₐ − Δᵦ| ≤ s and,
+    /// by the triangle inequality, |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + s: every pair within t (1 + m) now
+    /// is listed. Every target is at most t (the mean of two thicknesses, or less), so no
+    /// contact is missing, with m t to spare for pairs pushed together within a sweep — the
+    /// guarantee of a fresh search every sweep. c lets a cloth that falls or is carried as a
+    /// whole keep its list. The check runs before every sweep, so it also catches moves
+    /// between frames (pins, grabs, edits).
     pub(crate) fn refresh(&mut self, positions: &[DVec3], thickness: &[f64]) {
         let Some(t) = self.built_for else {
             return self.rebuild(positions, thickness);
@@ -405,7 +418,7 @@ impl SelfCollision {
         if t <= 0.0 || self.members.is_empty() {
             return; // no thickness or no members: no pairs, whatever the motion
         }
-        let limit = self.rebuild_fraction * self.params.search_margin * t;
+        let limit = self.limit(t);
         let limit2 = limit * limit;
         let displacements = || {
             self.members
@@ -456,7 +469,7 @@ impl SelfCollision {
             return self.rebuild(positions, thickness);
         }
         self.updates += 1;
-        let radius = t * (1.0 + self.params.search_margin);
+        let radius = self.radius(t);
         let r2 = radius * radius;
         let new_pairs = &mut self.new_pairs;
         new_pairs.clear();
@@ -527,7 +540,7 @@ impl SelfCollision {
         if self.special_offsets.is_none() {
             self.special_offsets = Some(self.find_special(thickness, max_t));
         }
-        let radius = max_t * (1.0 + self.params.search_margin);
+        let radius = self.radius(max_t);
         self.grid.build(positions, &self.members, radius);
         let found = &mut self.found;
         found.clear();
@@ -742,12 +755,13 @@ mod tests {
         w.a.iter().copied().zip(w.b.iter().copied()).collect()
     }
 
-    /// Asserts every non-exempt pair closer than t + skin/2 at `x` is listed, and that the
+    /// Asserts every non-exempt pair within t (1 + search margin) at `x` is listed, and that the
     /// touching pairs are exactly the brute-force ones.
-    fn assert_complete(sc: &SelfCollision, x: &[DVec3], t: &[f64], limit: f64, when: &str) {
+    fn assert_complete(sc: &SelfCollision, x: &[DVec3], t: &[f64], when: &str) {
         let list = listed(sc);
         assert!(list.windows(2).all(|w| w[0] < w[1]), "{when}: not sorted");
-        let missing: Vec<_> = brute_pairs(sc, x, t, |_| SPACING + 2.0 * limit)
+        let guaranteed = SPACING * (1.0 + sc.params.search_margin);
+        let missing: Vec<_> = brute_pairs(sc, x, t, |_| guaranteed)
             .into_iter()
             .filter(|p| list.binary_search(p).is_err())
             .collect();
@@ -760,7 +774,7 @@ mod tests {
     }
 
     #[test]
-    fn skin_list_holds_exactly_the_brute_force_contacts_until_a_quarter_skin_move() {
+    fn skin_list_holds_exactly_the_brute_force_contacts_until_a_half_skin_move() {
         let (solver, mut x, t) = folded();
         let params = SelfCollisionParams::default();
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
@@ -768,15 +782,17 @@ mod tests {
         assert_eq!(sc.rebuilds(), 1);
         let contacts = listed_contacts(&sc, &x);
         assert!(contacts.len() > 200, "only {} contacts", contacts.len());
-        let limit = REBUILD_FRACTION * params.search_margin * SPACING;
-        assert_complete(&sc, &x, &t, limit, "built");
+        // Whatever limit the list uses, moves up to it must keep every close pair listed.
+        let limit = sc.limit(SPACING);
+        assert!(limit > 0.0);
+        assert_complete(&sc, &x, &t, "built");
         // Exactly the pairs within R at the build, no more.
         let list = listed(&sc);
-        let radius = SPACING * (1.0 + params.search_margin);
+        let radius = SPACING * (1.0 + params.search_margin + SKIN);
         assert_eq!(list, brute_pairs(&sc, &x, &t, |_| radius * (1.0 + 1e-12)));
 
         // Adversarial moves within the skin: each particle heads for the nearest particle the
-        // list does not pair it with; less their mean, scaled to just under a quarter skin.
+        // list does not pair it with; less their mean, scaled to just under half the skin.
         let x0 = x.clone();
         let mut moves: Vec<DVec3> = (0..x.len())
             .map(|a| {
@@ -805,9 +821,9 @@ mod tests {
         assert_eq!(
             (sc.rebuilds(), sc.updates()),
             (1, 0),
-            "list changed although nothing moved a quarter skin"
+            "list changed although nothing moved half the skin"
         );
-        assert_complete(&sc, &x, &t, limit, "after the moves");
+        assert_complete(&sc, &x, &t, "after the moves");
         // The moves did bring unlisted pairs closer than R: the skin was needed.
         let closer = brute_pairs(&sc, &x, &t, |_| radius);
         assert!(closer.iter().any(|p| list.binary_search(p).is_err()));
@@ -818,9 +834,9 @@ mod tests {
         let (solver, mut x, t) = folded();
         let params = SelfCollisionParams::default();
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
-        let limit = REBUILD_FRACTION * params.search_margin * SPACING;
+        let limit = 0.5 * SKIN * SPACING;
         sc.refresh(&x, &t);
-        // The whole cloth carried 10 quarter-skins away: its list still holds.
+        // The whole cloth carried 10 half-skins away: its list still holds.
         for xi in &mut x {
             *xi += DVec3::new(10.0 * limit, -3.0 * limit, 0.0);
         }
@@ -841,7 +857,7 @@ mod tests {
         assert_eq!((sc.rebuilds(), sc.updates()), (1, 1), "two movers");
         assert!(listed(&sc).binary_search(&(200, 300)).is_ok());
         assert!(listed(&sc).binary_search(&(201, 300)).is_ok());
-        assert_complete(&sc, &x, &t, limit, "after re-anchoring");
+        assert_complete(&sc, &x, &t, "after re-anchoring");
         // Everything shaken by half a skin: a full rebuild.
         let mut seed = 3;
         for xi in &mut x {
@@ -849,7 +865,7 @@ mod tests {
         }
         sc.refresh(&x, &t);
         assert_eq!((sc.rebuilds(), sc.updates()), (2, 1), "shaken");
-        assert_complete(&sc, &x, &t, limit, "after the rebuild");
+        assert_complete(&sc, &x, &t, "after the rebuild");
         // A thickness change drops the list.
         sc.invalidate();
         sc.refresh(&x, &t);
@@ -881,11 +897,11 @@ mod tests {
         }
     }
 
-    fn fold_with(rebuild_fraction: f64) -> (Vec<DVec3>, u64, u64) {
+    fn fold_with(skin: f64) -> (Vec<DVec3>, u64, u64) {
         let (mut solver, _) = self_fold(Method::Xpbd, 10, 30).expect("scenario");
         let mut sc = SelfCollision::new(&solver, &[0], SelfCollisionParams::default())
             .expect("self-collision");
-        sc.rebuild_fraction = rebuild_fraction;
+        sc.skin = skin;
         let thickness = vec![solver.cloths()[0].thickness; solver.particles().len()];
         let mut hook = Hook {
             sc,
@@ -904,9 +920,9 @@ mod tests {
 
     #[test]
     fn skin_list_folds_exactly_like_a_search_before_every_sweep() {
-        // Fraction 0: any motion at all rebuilds the list, i.e. a fresh search every sweep.
+        // No skin: any motion at all rebuilds the list, i.e. a fresh search every sweep.
         let (every, sweeps, _) = fold_with(0.0);
-        let (skin, rebuilds, updates) = fold_with(REBUILD_FRACTION);
+        let (skin, rebuilds, updates) = fold_with(SKIN);
         assert!(updates > 0, "no partial update was exercised");
         assert_eq!(sweeps, 90 * 10, "a fresh search every sweep");
         assert!(
