@@ -158,9 +158,9 @@ impl PairList {
         Err(lo)
     }
 
-    /// Both lists in one, sorted (they share no pair).
-    fn merged(&self, other: &PairList) -> PairList {
-        let mut out = PairList::default();
+    /// Both lists in one, sorted (they share no pair), into `out`.
+    fn merge_into(&self, other: &PairList, out: &mut PairList) {
+        out.clear();
         let (mut i, mut j) = (0, 0);
         while i < self.a.len() || j < other.a.len() {
             let take_self = j == other.a.len()
@@ -173,7 +173,6 @@ impl PairList {
                 j += 1;
             }
         }
-        out
     }
 }
 
@@ -199,9 +198,12 @@ pub(crate) struct SelfCollision {
     extra: PairList,
     /// Partial updates (re-anchoring a few members) so far.
     updates: u64,
-    /// Scratch: members that moved past the limit; pairs found for them.
+    /// Scratch: members that moved past the limit; pairs found for them; pairs to add; the
+    /// merged extra list.
     movers: Vec<u32>,
     new_pairs: Vec<(u32, u32)>,
+    added: PairList,
+    merged: PairList,
     /// Largest member thickness the list was built for; `None` when there is no list.
     built_for: Option<f64>,
     /// Lists built so far.
@@ -320,6 +322,8 @@ impl SelfCollision {
             updates: 0,
             movers: Vec::new(),
             new_pairs: Vec::new(),
+            added: PairList::default(),
+            merged: PairList::default(),
             built_for: None,
             rebuilds: 0,
             skin: SKIN,
@@ -491,7 +495,8 @@ impl SelfCollision {
         new_pairs.sort_unstable();
         new_pairs.dedup();
         let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
-        let mut added = PairList::default();
+        let added = &mut self.added;
+        added.clear();
         for &(a, b) in new_pairs.iter() {
             if self.pairs.position(a, b).is_ok() || self.extra.position(a, b).is_ok() {
                 continue;
@@ -510,8 +515,8 @@ impl SelfCollision {
             }
         }
         if !added.a.is_empty() {
-            let old = std::mem::take(&mut self.extra);
-            self.extra = old.merged(&added);
+            self.extra.merge_into(added, &mut self.merged);
+            std::mem::swap(&mut self.extra, &mut self.merged);
         }
     }
 
@@ -717,7 +722,9 @@ mod tests {
 
     /// The whole list (`pairs` and `extra`), in solve order.
     fn whole(sc: &SelfCollision) -> PairList {
-        sc.pairs.merged(&sc.extra)
+        let mut out = PairList::default();
+        sc.pairs.merge_into(&sc.extra, &mut out);
+        out
     }
 
     /// Pairs listed by `sc` that touch at `x`.
