@@ -65,6 +65,9 @@ impl CollisionWorld {
         for cloth in solver.cloths() {
             self.thickness[cloth.particles.clone()].fill(cloth.thickness);
         }
+        if let Some(sc) = &mut self.self_collision {
+            sc.invalidate();
+        }
     }
 
     /// Builds and adds a collider; returns its index.
@@ -104,6 +107,14 @@ impl CollisionWorld {
             .map(|s| s.target(a, b, &self.thickness))
     }
 
+    /// Self-collision candidate lists: full builds and partial updates so far and the current
+    /// list's length, or `None` when self-collision is off.
+    pub fn self_collision_lists(&self) -> Option<(u64, u64, usize)> {
+        self.self_collision
+            .as_ref()
+            .map(|s| (s.rebuilds(), s.updates(), s.pair_count()))
+    }
+
     /// Per-particle thickness (m).
     pub fn thickness(&self) -> &[f64] {
         &self.thickness
@@ -118,7 +129,7 @@ impl CollisionWorld {
         self.thickness.iter().copied().fold(0.0, f64::max)
     }
 
-    /// Once per substep, before the first projection: clamp, sweep, gather candidates, pairs.
+    /// Once per substep, before the first projection: clamp, sweep, gather candidates.
     fn prepare(&mut self, p: &mut Particles) {
         if let Some(sc) = &self.self_collision {
             sc.clamp_displacements(p, &self.thickness);
@@ -141,9 +152,6 @@ impl CollisionWorld {
                     list.push(i as u32);
                 }
             }
-        }
-        if let Some(sc) = &mut self.self_collision {
-            sc.find_pairs(&p.positions, &self.thickness);
         }
     }
 
@@ -227,10 +235,13 @@ impl SubstepHook for CollisionWorld {
         // Particle pairs first, colliders last: a stack of layers pressed together must not
         // end the substep pushed into the ground, while a slight overlap between layers is
         // harmless and corrected next time.
-        let (self_contacts, self_depth) = self
-            .self_collision
-            .as_ref()
-            .map_or((0, 0.0), |sc| sc.solve(particles));
+        let (self_contacts, self_depth) = match &mut self.self_collision {
+            Some(sc) => {
+                sc.refresh(&particles.positions, &self.thickness);
+                sc.solve(particles)
+            }
+            None => (0, 0.0),
+        };
         let collider_contacts = self.resolve_colliders(particles);
         self.stats.collider_contacts = collider_contacts;
         self.stats.self_contacts = self_contacts;
