@@ -219,6 +219,11 @@ impl CollisionWorld {
 }
 
 impl SubstepHook for CollisionWorld {
+    /// A world with no collider and no self-collision does nothing, so the solver may fuse.
+    fn is_active(&self) -> bool {
+        !self.colliders.is_empty() || self.self_collision.is_some()
+    }
+
     fn begin_substep(&mut self, ctx: &SubstepContext, _particles: &Particles) {
         let t0 = ctx.time - ctx.h;
         for c in &mut self.colliders {
