@@ -22,10 +22,10 @@ struct Options {
     frames: usize,
     warmup: usize,
     threads: usize,
+    domain_size: usize,
 }
 
-const USAGE: &str =
-    "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] | [N [FRAMES]]";
+const USAGE: &str = "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] [--domain-size D] | [N [FRAMES]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
@@ -33,6 +33,7 @@ fn parse_args() -> Result<Options, String> {
         frames: 60,
         warmup: 3,
         threads: 1,
+        domain_size: Settings::default().domain_size,
     };
     let mut positional = 0;
     let mut args = std::env::args().skip(1);
@@ -49,6 +50,7 @@ fn parse_args() -> Result<Options, String> {
             "--frames" => o.frames = value("--frames")?,
             "--warmup" => o.warmup = value("--warmup")?,
             "--threads" => o.threads = value("--threads")?,
+            "--domain-size" => o.domain_size = value("--domain-size")?,
             "-h" | "--help" => return Err(USAGE.to_owned()),
             _ if !a.starts_with('-') && positional < 2 => {
                 let v: usize = a
@@ -94,7 +96,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         params.get_mut(f).enabled = matches!(f, Family::Stretch | Family::Shear);
         params.get_mut(f).compliance = 0.0;
     }
-    let settings = Settings::default();
+    let settings = Settings {
+        domain_size: o.domain_size,
+        ..Settings::default()
+    };
     let mut b = SolverBuilder::new(settings, Forces::default())?;
     b.add_cloth("cloth", &mesh, params, 0.0)?;
     let mut s = b.build();

@@ -584,9 +584,9 @@ fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8>(
     store_ends::<LAYOUT>(x2, p, q, &e.p[2], &e.q[2]);
 }
 
-/// Constraints whose particles lie in different domains, projected serially in colour order.
+/// Constraints whose particles lie in different domains, for one node of the fork–join tree.
 #[derive(Clone, Debug, Default)]
-struct Links {
+struct LinkSet {
     /// Domain and local index of each end.
     ends: Vec<[(u32, u32); 2]>,
     rest: Vec<f64>,
@@ -601,7 +601,9 @@ pub(crate) struct Domains {
     size: usize,
     /// The domains, in particle order.
     list: Vec<Domain>,
-    links: Links,
+    /// Links of each internal node of the fork–join tree over the domains, in preorder (a
+    /// node, then its left subtree, then its right one, so every subtree is one sub-slice).
+    links: Vec<LinkSet>,
     /// Multiplier-step coefficients per parameter group, refreshed every frame.
     coef: Vec<Coef>,
     /// Which optional terms the coefficients need.
@@ -623,7 +625,7 @@ impl Domains {
                 dom
             })
             .collect();
-        let mut links = Links::default();
+        let mut links = vec![LinkSet::default(); count - 1];
         let locate = |i: u32| ((i as usize / size) as u32, (i as usize % size) as u32);
         let mut interior: Vec<Vec<Interior>> = vec![Vec::new(); count];
         for k in block.colors.iter().flat_map(|c| c.clone()) {
@@ -635,10 +637,11 @@ impl Domains {
                 let (p, q) = (dp.1.min(dq.1), dp.1.max(dq.1));
                 interior[dp.0 as usize].push(Interior { p, q, rest, group });
             } else {
-                links.ends.push([dp, dq]);
-                links.rest.push(rest);
-                links.group.push(group);
-                links.lambda.push(0.0);
+                let set = &mut links[tree_node(dp.0 as usize, dq.0 as usize, count)];
+                set.ends.push([dp, dq]);
+                set.rest.push(rest);
+                set.group.push(group);
+                set.lambda.push(0.0);
             }
         }
         for (dom, cons) in list.iter_mut().zip(interior) {
@@ -658,7 +661,7 @@ impl Domains {
         let mut s = DomainStats {
             domains: self.list.len(),
             domain_size: self.size,
-            links: self.links.rest.len(),
+            links: self.links.iter().map(|l| l.rest.len()).sum(),
             ..DomainStats::default()
         };
         for d in &self.list {
@@ -713,97 +716,53 @@ impl Domains {
         }
     }
 
-    /// The domains with their slices of the global arrays, for a parallel region.
-    pub fn par_with<'a>(
-        &'a mut self,
-        x: &'a [DVec3],
-        v: &'a [DVec3],
-        w: &'a [f64],
-    ) -> impl IndexedParallelIterator<Item = (&'a mut Domain, AosChunk<'a>)> + 'a {
-        let size = self.size;
-        self.list
-            .par_iter_mut()
-            .zip(x.par_chunks(size))
-            .zip(v.par_chunks(size))
-            .zip(w.par_chunks(size))
-            .map(|(((d, x), v), w)| (d, AosChunk { x, v, w }))
-    }
-
-    /// Projects every domain in parallel, then the links; `coef`/`damped` from [`Self::prepare`].
+    /// Projects every domain and link once; coefficients from [`Self::prepare`].
     pub fn project(&mut self) {
-        let (coef, mode) = (&self.coef[..], self.mode);
-        self.list.par_iter_mut().for_each(|d| d.project(coef, mode));
-        self.project_links();
+        self.project_with(|_, _| {});
     }
 
-    /// Projects every domain (in parallel) and link once, for the given domain-side closure
-    /// run first in the same parallel region (e.g. integration).
+    /// Runs `before` on every domain, then projects every domain and link once, all in one
+    /// fork–join tree over the domains (see [`fork`]).
     pub fn project_after<F>(&mut self, x: &[DVec3], v: &[DVec3], w: &[f64], before: F)
     where
         F: Fn(&mut Domain, &AosChunk<'_>) + Sync,
     {
-        let coef = std::mem::take(&mut self.coef);
-        let mode = self.mode;
-        self.par_with(x, v, w).for_each(|(d, aos)| {
+        let size = self.size;
+        let n = x.len();
+        self.project_with(|d, index| {
+            let r = index * size..((index + 1) * size).min(n);
+            let aos = AosChunk {
+                x: &x[r.clone()],
+                v: &v[r.clone()],
+                w: &w[r],
+            };
             before(d, &aos);
-            d.project(&coef, mode);
         });
-        self.coef = coef;
-        self.project_links();
+    }
+
+    fn project_with<F>(&mut self, before: F)
+    where
+        F: Fn(&mut Domain, usize) + Sync,
+    {
+        let Self {
+            list,
+            links,
+            coef,
+            mode,
+            ..
+        } = self;
+        let job = Job {
+            before: &before,
+            coef,
+            mode: *mode,
+        };
+        fork(list, 0, links, &job);
     }
 
     /// Clears the link multipliers (the domains clear theirs when integrating).
     pub fn reset_link_multipliers(&mut self) {
-        self.links.lambda.fill(0.0);
-    }
-
-    /// Projects the links serially, in colour order.
-    fn project_links(&mut self) {
-        if self.mode.damped {
-            self.project_links_with::<true>();
-        } else {
-            self.project_links_with::<false>();
-        }
-    }
-
-    fn project_links_with<const DAMPED: bool>(&mut self) {
-        let Self {
-            list, links, coef, ..
-        } = self;
-        for k in 0..links.rest.len() {
-            let [(dp, ip), (dq, iq)] = links.ends[k];
-            let (dp, ip, dq, iq) = (dp as usize, ip as usize, dq as usize, iq as usize);
-            let get = |d: &Domain, i: usize, prev: bool| {
-                let s = if prev { &d.prev } else { &d.x };
-                [[s[0][i]], [s[1][i]], [s[2][i]]]
-            };
-            let mut e = Ends {
-                p: get(&list[dp], ip, false),
-                q: get(&list[dq], iq, false),
-            };
-            let pr = if DAMPED {
-                Ends {
-                    p: get(&list[dp], ip, true),
-                    q: get(&list[dq], iq, true),
-                }
-            } else {
-                e
-            };
-            let mut lambda = [links.lambda[k]];
-            lanes::project::<1, DAMPED>(
-                &mut e,
-                &pr,
-                &[list[dp].w[ip]],
-                &[list[dq].w[iq]],
-                &[links.rest[k]],
-                &Coefs::splat(coef[links.group[k] as usize]),
-                &mut lambda,
-            );
-            links.lambda[k] = lambda[0];
-            for a in 0..3 {
-                list[dp].x[a][ip] = e.p[a][0];
-                list[dq].x[a][iq] = e.q[a][0];
-            }
+        for set in &mut self.links {
+            set.lambda.fill(0.0);
         }
     }
 
@@ -852,6 +811,111 @@ impl Domains {
                 d.finish_velocities(inv_h, keep);
                 d.store(x, prev, v);
             });
+    }
+}
+
+/// The preorder index of the internal node of the fork–join tree over `count` domains that
+/// first separates domains `a` and `b` (the node where a link between them is solved).
+fn tree_node(a: usize, b: usize, count: usize) -> usize {
+    let (a, b) = (a.min(b), a.max(b));
+    let (mut lo, mut hi, mut node) = (0, count, 0);
+    loop {
+        let mid = lo + (hi - lo) / 2;
+        if a < mid && b >= mid {
+            return node;
+        }
+        if b < mid {
+            node += 1;
+            hi = mid;
+        } else {
+            node += mid - lo;
+            lo = mid;
+        }
+    }
+}
+
+/// What every leaf and node of the fork–join tree needs.
+struct Job<'a, F> {
+    before: &'a F,
+    coef: &'a [Coef],
+    mode: Mode,
+}
+
+/// Solves `doms` (domains `first..`) with their `links` (the subtree's internal nodes, in
+/// preorder): the two halves in parallel (`rayon::join`), then the links between them.
+///
+/// A leaf runs `before` and its own interior constraints. The tree's shape depends only on
+/// the number of domains, so the order of every link relative to every domain is fixed: the
+/// result does not depend on the thread count. Links are solved where both their domains are
+/// finished, so most of them run in parallel too; only the root's are solved alone.
+fn fork<F>(doms: &mut [Domain], first: usize, links: &mut [LinkSet], job: &Job<'_, F>)
+where
+    F: Fn(&mut Domain, usize) + Sync,
+{
+    if let [d] = doms {
+        (job.before)(d, first);
+        d.project(job.coef, job.mode);
+        return;
+    }
+    let mid = doms.len() / 2;
+    let Some((own, below)) = links.split_first_mut() else {
+        return;
+    };
+    let (left_links, right_links) = below.split_at_mut(mid - 1);
+    let (left, right) = doms.split_at_mut(mid);
+    rayon::join(
+        || fork(left, first, left_links, job),
+        || fork(right, first + mid, right_links, job),
+    );
+    if job.mode.damped {
+        project_links::<true>(doms, first, own, job.coef);
+    } else {
+        project_links::<false>(doms, first, own, job.coef);
+    }
+}
+
+/// Projects one node's links serially, in colour order.
+fn project_links<const DAMPED: bool>(
+    list: &mut [Domain],
+    first: usize,
+    links: &mut LinkSet,
+    coef: &[Coef],
+) {
+    for k in 0..links.rest.len() {
+        let [(dp, ip), (dq, iq)] = links.ends[k];
+        let (dp, ip) = (dp as usize - first, ip as usize);
+        let (dq, iq) = (dq as usize - first, iq as usize);
+        let get = |d: &Domain, i: usize, prev: bool| {
+            let s = if prev { &d.prev } else { &d.x };
+            [[s[0][i]], [s[1][i]], [s[2][i]]]
+        };
+        let mut e = Ends {
+            p: get(&list[dp], ip, false),
+            q: get(&list[dq], iq, false),
+        };
+        let pr = if DAMPED {
+            Ends {
+                p: get(&list[dp], ip, true),
+                q: get(&list[dq], iq, true),
+            }
+        } else {
+            e
+        };
+        let mut lambda = [links.lambda[k]];
+        lanes::project::<1, DAMPED>(
+            &mut e,
+            &pr,
+            &[list[dp].w[ip]],
+            &[list[dq].w[iq]],
+            &[links.rest[k]],
+            &Coefs::splat(coef[links.group[k] as usize]),
+            &mut lambda,
+        );
+        links.lambda[k] = lambda[0];
+        for a in 0..3 {
+            list[dp].x[a][ip] = e.p[a][0];
+            list[dq].x[a][iq] = e.q[a][0];
+        }
     }
 }
 
@@ -1034,6 +1098,35 @@ mod tests {
         (b.build().constraints().distance.clone(), n)
     }
 
+    /// Preorder list of the internal nodes' (lo, mid, hi) over `lo..hi`, as `fork` walks them.
+    fn nodes(lo: usize, hi: usize, out: &mut Vec<(usize, usize, usize)>) {
+        if hi - lo < 2 {
+            return;
+        }
+        let mid = lo + (hi - lo) / 2;
+        out.push((lo, mid, hi));
+        nodes(lo, mid, out);
+        nodes(mid, hi, out);
+    }
+
+    #[test]
+    fn a_link_goes_to_the_tree_node_that_splits_its_two_domains() {
+        for count in 1..24 {
+            let mut list = Vec::new();
+            nodes(0, count, &mut list);
+            assert_eq!(list.len(), count - 1);
+            for a in 0..count {
+                for b in a + 1..count {
+                    let (lo, mid, hi) = list[tree_node(b, a, count)];
+                    assert!(
+                        lo <= a && a < mid && mid <= b && b < hi,
+                        "{a} {b} of {count}"
+                    );
+                }
+            }
+        }
+    }
+
     fn global(d: &Domain, k: usize) -> (u32, u32) {
         let s = d.start as u32;
         (s + d.pairs.p[k], s + d.pairs.q[k])
@@ -1067,7 +1160,7 @@ mod tests {
                 }
             }
             let size = domains.size as u32;
-            for [(dp, ip), (dq, iq)] in &domains.links.ends {
+            for [(dp, ip), (dq, iq)] in domains.links.iter().flat_map(|l| &l.ends) {
                 assert_ne!(dp, dq);
                 let (p, q) = (dp * size + ip, dq * size + iq);
                 seen.push((p.min(q), p.max(q)));
