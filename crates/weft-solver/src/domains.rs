@@ -203,20 +203,10 @@ impl Domain {
 
     /// The PBD velocity update v = (x − x_prev)/h, then global damping v ← v e^(−c h) of free
     /// particles when `keep` is given — the same arithmetic as the solver's general loop.
-    pub fn finish_velocities(&mut self, inv_h: f64, keep: Option<f64>) {
+    pub fn finish_velocities(&mut self, finish: Finish) {
+        let w = &self.w[..];
         for a in 0..3 {
-            for i in 0..self.len() {
-                self.v[a][i] = (self.x[a][i] - self.prev[a][i]) * inv_h;
-            }
-        }
-        if let Some(keep) = keep {
-            for a in 0..3 {
-                for i in 0..self.len() {
-                    if self.w[i] > 0.0 {
-                        self.v[a][i] *= keep;
-                    }
-                }
-            }
+            end_velocities(&self.x[a], &self.prev[a], &mut self.v[a], w, finish);
         }
     }
 
@@ -264,6 +254,21 @@ pub(crate) struct Finish {
     pub keep: Option<f64>,
 }
 
+/// One axis of the PBD velocity update v = (x − x_prev)/h, then global damping v ← v·keep of
+/// free particles — the solver's general loop does the same arithmetic.
+#[inline(always)]
+fn end_velocities(x: &[f64], prev: &[f64], v: &mut [f64], w: &[f64], finish: Finish) {
+    let (x, prev, v) = (&x[..w.len()], &prev[..w.len()], &mut v[..w.len()]);
+    for i in 0..w.len() {
+        v[i] = (x[i] - prev[i]) * finish.inv_h;
+    }
+    if let Some(keep) = finish.keep {
+        for i in 0..w.len() {
+            v[i] = if w[i] > 0.0 { v[i] * keep } else { v[i] };
+        }
+    }
+}
+
 /// The per-particle part of [`Domain::integrate`], compiled like [`sweep`].
 #[multiversion(targets(
     "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
@@ -278,15 +283,8 @@ fn advance<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>)
         let (g, wv, drag) = (f.gravity[a], f.wind.velocity[a], f.wind.drag);
         let (x, v, prev) = (&mut dom.x[a][..], &mut dom.v[a][..], &mut dom.prev[a][..]);
         let (x, v, prev) = (&mut x[..w.len()], &mut v[..w.len()], &mut prev[..w.len()]);
-        if let Some(Finish { inv_h, keep }) = finish {
-            for i in 0..w.len() {
-                v[i] = (x[i] - prev[i]) * inv_h;
-            }
-            if let Some(keep) = keep {
-                for i in 0..w.len() {
-                    v[i] = if w[i] > 0.0 { v[i] * keep } else { v[i] };
-                }
-            }
+        if let Some(finish) = finish {
+            end_velocities(x, prev, v, w, finish);
         }
         for i in 0..w.len() {
             prev[i] = x[i];
@@ -334,34 +332,20 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool>(dom: &mut Domain, coef: &[
         }
         for k in *tail..colours[c].end {
             let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
-            let mut e = Ends {
-                p: [[x[0][p]], [x[1][p]], [x[2][p]]],
-                q: [[x[0][q]], [x[1][q]], [x[2][q]]],
-            };
-            let pr = if DAMPED {
-                Ends {
-                    p: [[prev[0][p]], [prev[1][p]], [prev[2][p]]],
-                    q: [[prev[0][q]], [prev[1][q]], [prev[2][q]]],
-                }
-            } else {
-                e
-            };
-            let mut lambda = [if LAMBDA { pairs.lambda[k] } else { 0.0 }];
-            lanes::project::<1, DAMPED>(
-                &mut e,
-                &pr,
-                &[w[p]],
-                &[w[q]],
-                &[pairs.rest[k]],
-                &Coefs::splat(coef[pairs.group[k] as usize]),
+            let mut lambda = if LAMBDA { pairs.lambda[k] } else { 0.0 };
+            let (xp, xq) = project_one::<DAMPED>(
+                End::of(x, prev, w, p),
+                End::of(x, prev, w, q),
+                pairs.rest[k],
+                coef[pairs.group[k] as usize],
                 &mut lambda,
             );
             if LAMBDA {
-                pairs.lambda[k] = lambda[0];
+                pairs.lambda[k] = lambda;
             }
             for a in 0..3 {
-                x[a][p] = e.p[a][0];
-                x[a][q] = e.q[a][0];
+                x[a][p] = xp[a];
+                x[a][q] = xq[a];
             }
         }
     }
@@ -808,7 +792,7 @@ impl Domains {
             .zip(prev.par_chunks_mut(size))
             .zip(v.par_chunks_mut(size))
             .for_each(|(((d, x), prev), v)| {
-                d.finish_velocities(inv_h, keep);
+                d.finish_velocities(Finish { inv_h, keep });
                 d.store(x, prev, v);
             });
     }
@@ -885,38 +869,71 @@ fn project_links<const DAMPED: bool>(
         let [(dp, ip), (dq, iq)] = links.ends[k];
         let (dp, ip) = (dp as usize - first, ip as usize);
         let (dq, iq) = (dq as usize - first, iq as usize);
-        let get = |d: &Domain, i: usize, prev: bool| {
-            let s = if prev { &d.prev } else { &d.x };
-            [[s[0][i]], [s[1][i]], [s[2][i]]]
-        };
-        let mut e = Ends {
-            p: get(&list[dp], ip, false),
-            q: get(&list[dq], iq, false),
-        };
-        let pr = if DAMPED {
-            Ends {
-                p: get(&list[dp], ip, true),
-                q: get(&list[dq], iq, true),
-            }
-        } else {
-            e
-        };
-        let mut lambda = [links.lambda[k]];
-        lanes::project::<1, DAMPED>(
-            &mut e,
-            &pr,
-            &[list[dp].w[ip]],
-            &[list[dq].w[iq]],
-            &[links.rest[k]],
-            &Coefs::splat(coef[links.group[k] as usize]),
-            &mut lambda,
+        let end = |d: &Domain, i| End::of(&d.x, &d.prev, &d.w, i);
+        let (xp, xq) = project_one::<DAMPED>(
+            end(&list[dp], ip),
+            end(&list[dq], iq),
+            links.rest[k],
+            coef[links.group[k] as usize],
+            &mut links.lambda[k],
         );
-        links.lambda[k] = lambda[0];
         for a in 0..3 {
-            list[dp].x[a][ip] = e.p[a][0];
-            list[dq].x[a][iq] = e.q[a][0];
+            list[dp].x[a][ip] = xp[a];
+            list[dq].x[a][iq] = xq[a];
         }
     }
+}
+
+/// One end of a single constraint: position, previous position and inverse mass.
+#[derive(Clone, Copy, Debug)]
+struct End {
+    x: [f64; 3],
+    prev: [f64; 3],
+    w: f64,
+}
+
+impl End {
+    /// Particle `i` of struct-of-arrays state.
+    #[inline(always)]
+    fn of(x: &[Vec<f64>; 3], prev: &[Vec<f64>; 3], w: &[f64], i: usize) -> Self {
+        Self {
+            x: [x[0][i], x[1][i], x[2][i]],
+            prev: [prev[0][i], prev[1][i], prev[2][i]],
+            w: w[i],
+        }
+    }
+}
+
+/// Projects one constraint with the one-lane kernel (a colour's remainder, or a link);
+/// returns the two new positions. `prev` is read only when `DAMPED`.
+#[inline(always)]
+fn project_one<const DAMPED: bool>(
+    p: End,
+    q: End,
+    rest: f64,
+    coef: Coef,
+    lambda: &mut f64,
+) -> ([f64; 3], [f64; 3]) {
+    let mut e = Ends {
+        p: p.x.map(|v| [v]),
+        q: q.x.map(|v| [v]),
+    };
+    let pr = Ends {
+        p: p.prev.map(|v| [v]),
+        q: q.prev.map(|v| [v]),
+    };
+    let mut l = [*lambda];
+    lanes::project::<1, DAMPED>(
+        &mut e,
+        &pr,
+        &[p.w],
+        &[q.w],
+        &[rest],
+        &Coefs::splat(coef),
+        &mut l,
+    );
+    *lambda = l[0];
+    (e.p.map(|[v]| v), e.q.map(|[v]| v))
 }
 
 /// An interior constraint before ordering (local indices, p < q).

@@ -65,7 +65,7 @@ impl ConstraintSet {
 
     /// Clears the XPBD multipliers (at the start of each substep).
     pub(crate) fn reset_multipliers(&mut self) {
-        self.distance.reset_multipliers();
+        // The distance constraints' multipliers live in `Domains`, which clears its own.
         self.dihedral.reset_multipliers();
         self.tethers.reset_multipliers();
     }
