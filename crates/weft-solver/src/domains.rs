@@ -5,15 +5,16 @@
 //! struct-of-arrays copy of its particles and projects its interior constraints colour by colour,
 //! eight at a time, without touching any other domain — so domains run on any threads, in any
 //! order, with no synchronisation. Constraints across domains (*links*, a few per cent on
-//! meshes with local particle order) are projected after the domains, serially. The split
+//! meshes with local particle order) are projected in a fork–join tree over the domains, each
+//! link once both its domains are done (see [`fork`]). The split
 //! depends on `size` and the mesh only, never on the thread count: results are bit-identical
 //! for 1, 2 or 64 threads.
 //!
-//! Inside a colour, constraints are sorted by parameter group and particle index, so that on
-//! structured meshes eight consecutive constraints usually touch eight consecutive particles
-//! (`Layout::Contiguous`, e.g. a row of vertical grid edges) or sixteen consecutive ones
-//! pairwise (`Layout::Paired`, every other horizontal edge): those chunks load and store with
-//! unit stride, and anything else is gathered lane by lane.
+//! Inside a domain, constraints fall into conflict-free sets (see `Domain::order`), sorted by
+//! particle index, so that on structured meshes eight consecutive constraints usually touch
+//! eight consecutive particles (`Layout::Contiguous`, e.g. a row of vertical grid edges) or a
+//! window of 15–31 consecutive ones (`Layout::Paired`, `Quad`, `Spaced`, `Strided`): those
+//! chunks load and store with unit stride, and anything else is gathered lane by lane.
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
