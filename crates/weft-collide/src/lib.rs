@@ -11,6 +11,7 @@ mod mesh;
 mod obj;
 pub mod scenarios;
 mod self_collision;
+mod self_contact;
 mod shape;
 mod spatial_hash;
 mod tessellate;

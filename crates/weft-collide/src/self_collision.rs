@@ -6,23 +6,31 @@
 //! closer than a thickness at rest are only kept at their rest distance.
 //!
 //! Candidate pairs live in a Verlet ("skin") list (Verlet 1967; Allen & Tildesley, "Computer
-//! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + search_margin) + s
-//! apart when the list was built, t the largest member thickness and s the skin. The list is
-//! reused while every member stays within s/2 of its anchor (up to a displacement common to
-//! all), so that every pair within t (1 + search_margin) is always listed, as when pairs were
-//! searched every substep; the few members that stray are re-anchored
-//! and their new pairs added, and the list is rebuilt from a [`CellGrid`] (points sorted by
-//! cell, swept once) when many do. [`SelfCollision::refresh`] says why no contact can be
-//! missing. Pairs are solved Gauss–Seidel in (a, b) order, so results depend neither on
-//! thread count nor on grid order, nor on when the list was rebuilt: a listed pair that is not
-//! touching does nothing.
+//! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + m) apart when the
+//! list was built, t the largest member thickness and m the search margin, which is the skin.
+//! The list is reused while every member stays within m t / 2 of its anchor (up to a
+//! displacement common to all), so that every pair within t, every pair that can touch, is
+//! always listed; the few members that stray are re-anchored and their new pairs added, and the
+//! list is rebuilt from a [`CellGrid`] (points sorted by cell, swept in runs of cells on
+//! rayon's threads) when many do. [`SelfCollision::refresh`] says why no contact can be missing.
+//!
+//! Contacts are solved Jacobi-style with constraint averaging (Macklin et al. 2014, "Unified
+//! Particle Physics for Real-Time Applications", §4.2): every listed pair closer than its
+//! target at the start of a sweep gives its two particles corrections computed from those same
+//! positions, and each particle moves by the mean of its corrections. The corrections are
+//! rounded to a common quantum and summed exactly, so their order does not matter: results
+//! depend neither on the thread count, nor on the list's order, nor on when it was rebuilt (a
+//! listed pair that is not touching does nothing), and both the pair search and the sweep run
+//! in parallel.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use weft_solver::{Particles, Solver};
 
 use crate::error::CollideError;
 use crate::friction::Friction;
-use crate::spatial_hash::CellGrid;
+use crate::self_contact::{Contact, State, apply, find_contacts};
+use crate::spatial_hash::{CellGrid, SpatialHash};
 
 /// Self-collision settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,8 +42,10 @@ pub struct SelfCollisionParams {
     /// Two particles approach by at most twice this per substep, so below 0.5 a layer cannot
     /// jump through another within one substep (the velocity clamp of Müller's method).
     pub max_displacement: f64,
-    /// Extra search radius for candidate pairs, as a fraction of the thickness (contacts
-    /// pushed inside the substep may bring new pairs this close).
+    /// The candidate list's skin, as a fraction of the thickness: pairs up to
+    /// thickness · (1 + search_margin) apart are listed, and the list is kept until a particle
+    /// strays half the margin. It changes only the cost, never the result: 0 searches anew
+    /// whenever anything moved.
     pub search_margin: f64,
 }
 
@@ -77,14 +87,14 @@ impl SelfCollisionParams {
     }
 }
 
-/// The skin s of the list, as a fraction of the thickness. The list holds the pairs within
-/// R = t (1 + search_margin) + s, and a member may stray s/2 from its anchor (beyond the common
-/// displacement) before it is re-anchored: two members within s/2 of their anchors are at
-/// most s closer than their anchors, so every pair within t (1 + search_margin) now has anchors
-/// within R and is listed. A larger skin means fewer re-anchorings and rebuilds but a longer
-/// list to sweep; of 0.25, 0.5 and 1, 0.5 cost least overall in the 128² cost example
-/// (`examples/self_collision_cost.rs`).
-const SKIN: f64 = 0.5;
+/// A list is rebuilt rather than updated when more than 1/MOVERS_CAP of the members stray at
+/// once, or more than 1/REANCHORED_CAP have strayed since the last build: a partial update
+/// costs about eight times a rebuild per member (measured at 128², 2 threads).
+const MOVERS_CAP: usize = 16;
+const REANCHORED_CAP: usize = 8;
+
+/// Members per rayon task in the per-member loops.
+const MEMBER_CHUNK: usize = 4096;
 
 /// What decides each pair's treatment: cloths, rest positions and triangle adjacency.
 #[derive(Clone, Debug)]
@@ -123,7 +133,41 @@ impl Exemptions {
     }
 }
 
-/// Candidate pairs as struct-of-arrays, sorted by (a, b), a < b.
+/// Marks an exempt pair in [`Special`].
+const EXEMPT: f64 = -1.0;
+
+/// The pairs whose treatment is not the default (keep the mean thickness), as CSR over
+/// particles: `pairs[offsets[a]..offsets[a + 1]]` holds (b > a, target) sorted by b, with
+/// [`EXEMPT`] for exempt pairs.
+#[derive(Clone, Debug, Default)]
+struct Special {
+    offsets: Vec<u32>,
+    pairs: Vec<(u32, f64)>,
+}
+
+impl Special {
+    /// What [`Exemptions::target`] gives for a < b, or [`EXEMPT`], without its searches over
+    /// the adjacency and its square roots.
+    fn target(&self, a: u32, b: u32, thickness: &[f64]) -> f64 {
+        let (s, e) = (
+            self.offsets[a as usize] as usize,
+            self.offsets[a as usize + 1] as usize,
+        );
+        // Rows are short (a particle's triangle neighbours, and the few closer at rest): a
+        // forward scan beats a binary search.
+        for &(sb, target) in &self.pairs[s..e] {
+            if sb >= b {
+                if sb == b {
+                    return target;
+                }
+                break;
+            }
+        }
+        0.5 * (thickness[a as usize] + thickness[b as usize])
+    }
+}
+
+/// Candidate pairs as struct-of-arrays, a < b.
 #[derive(Clone, Debug, Default)]
 struct PairList {
     a: Vec<u32>,
@@ -144,7 +188,11 @@ impl PairList {
         self.target.push(target);
     }
 
-    /// Index of (a, b), or where it would go.
+    fn len(&self) -> usize {
+        self.a.len()
+    }
+
+    /// Index of (a, b), or where it would go, in a list sorted by (a, b).
     fn position(&self, a: u32, b: u32) -> Result<usize, usize> {
         let (mut lo, mut hi) = (0, self.a.len());
         while lo < hi {
@@ -158,7 +206,7 @@ impl PairList {
         Err(lo)
     }
 
-    /// Both lists in one, sorted (they share no pair), into `out`.
+    /// Both sorted lists in one, sorted (they share no pair), into `out`.
     fn merge_into(&self, other: &PairList, out: &mut PairList) {
         out.clear();
         let (mut i, mut j) = (0, 0);
@@ -184,7 +232,11 @@ pub(crate) struct SelfCollision {
     members: Vec<u32>,
     exempt: Exemptions,
     grid: CellGrid,
-    pairs: PairList,
+    /// The pairs of the last full build, one list per run of grid cells.
+    pairs: Vec<PairList>,
+    /// Each member's position at the last full build (member order): a pair is in `pairs`
+    /// exactly when it is not exempt and these two are at most R apart by the grid's own test.
+    built_pos: Vec<DVec3>,
     /// Each member's anchor x⁰ (member order): its position at the last full build, or, for
     /// a member re-anchored since, its position then less the common displacement.
     built_at: Vec<DVec3>,
@@ -202,61 +254,23 @@ pub(crate) struct SelfCollision {
     /// merged extra list.
     movers: Vec<u32>,
     new_pairs: Vec<(u32, u32)>,
+    /// Re-anchored members (slots) by anchor, and a query's answer.
+    recent: SpatialHash,
+    near: Vec<u32>,
     added: PairList,
     merged: PairList,
     /// Largest member thickness the list was built for; `None` when there is no list.
     built_for: Option<f64>,
     /// Lists built so far.
     rebuilds: u64,
-    /// [`SKIN`], or another value in tests.
-    skin: f64,
-    /// Pairs whose treatment is not the default (keep the mean thickness): CSR over particles,
-    /// `special[special_offsets[a]..special_offsets[a + 1]]` holds (b > a, target), sorted by
-    /// b, with a negative target for exempt pairs. Built at the first list build after
-    /// creation or a thickness change; `None` until then.
-    special_offsets: Option<Vec<u32>>,
-    special: Vec<(u32, f64)>,
-    /// Build scratch: pairs as found, per-particle offsets, partners sorted by `a`.
-    found: Vec<(u32, u32, ())>,
+    /// Pairs whose treatment is not the default; found at the first list build after creation
+    /// or a thickness change, `None` until then.
+    special: Option<Special>,
+    /// Sweep scratch: per list, the touching pairs' indices and their contacts; per particle,
+    /// the exact sum of its corrections and their count (zero between sweeps).
+    contacts: Vec<(Vec<u32>, Vec<Contact>)>,
+    sums: Vec<DVec3>,
     counts: Vec<u32>,
-    sorted: Vec<(u32, ())>,
-}
-
-/// Marks an exempt pair in [`SelfCollision::special`].
-const EXEMPT: f64 = -1.0;
-
-/// Counting sort of `(a, b, value)` by a, then by b within each a (a fixed order whatever
-/// order the grid found them in): `out[offsets[a]..offsets[a + 1]]` is a's (b, value), and
-/// `offsets` has `n + 1` entries.
-fn sort_pairs<T: Copy + Default>(
-    found: &[(u32, u32, T)],
-    n: usize,
-    offsets: &mut Vec<u32>,
-    out: &mut Vec<(u32, T)>,
-) {
-    offsets.clear();
-    offsets.resize(n + 1, 0);
-    for &(a, _, _) in found {
-        offsets[a as usize + 1] += 1;
-    }
-    for i in 0..n {
-        offsets[i + 1] += offsets[i];
-    }
-    out.clear();
-    out.resize(found.len(), (0, T::default()));
-    for &(a, b, value) in found {
-        let slot = &mut offsets[a as usize];
-        out[*slot as usize] = (b, value);
-        *slot += 1;
-    }
-    // offsets[a] is now a's end = a + 1's start: shift back to starts.
-    for i in (1..=n).rev() {
-        offsets[i] = offsets[i - 1];
-    }
-    offsets[0] = 0;
-    for w in offsets.windows(2) {
-        out[w[0] as usize..w[1] as usize].sort_unstable_by_key(|&(b, _)| b);
-    }
 }
 
 impl SelfCollision {
@@ -313,7 +327,8 @@ impl SelfCollision {
                 adjacency,
             },
             grid: CellGrid::new(),
-            pairs: PairList::default(),
+            pairs: Vec::new(),
+            built_pos: Vec::new(),
             built_at: Vec::new(),
             reanchored: Vec::new(),
             is_reanchored: Vec::new(),
@@ -322,16 +337,16 @@ impl SelfCollision {
             updates: 0,
             movers: Vec::new(),
             new_pairs: Vec::new(),
+            recent: SpatialHash::default(),
+            near: Vec::new(),
             added: PairList::default(),
             merged: PairList::default(),
             built_for: None,
             rebuilds: 0,
-            skin: SKIN,
-            special_offsets: None,
-            special: Vec::new(),
-            found: Vec::new(),
-            counts: Vec::new(),
-            sorted: Vec::new(),
+            special: None,
+            contacts: Vec::new(),
+            sums: vec![DVec3::ZERO; n],
+            counts: vec![0; n],
         })
     }
 
@@ -352,19 +367,19 @@ impl SelfCollision {
 
     /// Candidate pairs in the current list.
     pub(crate) fn pair_count(&self) -> usize {
-        self.pairs.a.len() + self.extra.a.len()
+        self.pairs.iter().map(PairList::len).sum::<usize>() + self.extra.len()
     }
 
     /// Drops the list (thickness changed): the next [`SelfCollision::refresh`] rebuilds it.
     pub(crate) fn invalidate(&mut self) {
         self.built_for = None;
-        self.special_offsets = None;
+        self.special = None;
     }
 
     /// Finds the pairs whose treatment is not the default: those sharing a triangle (exempt)
     /// and those closer at rest than their mean thickness (kept at their rest distance), i.e.
     /// every pair for which [`Exemptions::target`] is not `Some(mean thickness)`.
-    fn find_special(&mut self, thickness: &[f64], max_t: f64) -> Vec<u32> {
+    fn find_special(&mut self, thickness: &[f64], max_t: f64) -> Special {
         let n = thickness.len();
         let exempt = &self.exempt;
         let mut found = Vec::new();
@@ -386,34 +401,48 @@ impl SelfCollision {
                 _ => {} // exempt pairs are in already; the others take the default
             }
         });
-        let mut offsets = Vec::new();
-        sort_pairs(&found, n, &mut offsets, &mut self.special);
-        offsets
+        // Counting sort by a, then by b within each a.
+        let mut offsets = vec![0u32; n + 1];
+        for &(a, _, _) in &found {
+            offsets[a as usize + 1] += 1;
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut pairs = vec![(0, 0.0); found.len()];
+        let mut next = offsets.clone();
+        for &(a, b, target) in &found {
+            pairs[next[a as usize] as usize] = (b, target);
+            next[a as usize] += 1;
+        }
+        for w in offsets.windows(2) {
+            pairs[w[0] as usize..w[1] as usize].sort_unstable_by_key(|&(b, _)| b);
+        }
+        Special { offsets, pairs }
     }
 
     /// The list radius R for largest thickness `t` (m).
     fn radius(&self, t: f64) -> f64 {
-        t * (1.0 + self.params.search_margin + self.skin)
+        t * (1.0 + self.params.search_margin)
     }
 
     /// How far a member may stray from its anchor for thickness `t` (m): half the skin.
     fn limit(&self, t: f64) -> f64 {
-        0.5 * self.skin * t
+        0.5 * self.params.search_margin * t
     }
 
     /// Makes sure the list holds every pair that may touch at `positions`.
     ///
     /// Invariant: the list (`pairs` and `extra`) holds every non-exempt pair whose anchors are
-    /// at most R = t (1 + m) + s apart (m the search margin, s the skin), |x⁰ₐ − x⁰ᵦ| ≤ R. With
-    /// displacements Δᵢ = xᵢ − x⁰ᵢ and a common displacement c (their mean), a member is a
-    /// mover if |Δᵢ − c| > s/2. Movers are re-anchored at x⁰ᵢ = xᵢ − c (so Δᵢ − c = 0) and
-    /// their pairs within R of the new anchor added, which keeps the invariant; when there are
-    /// many, the list is rebuilt. Then |Δᵢ − c| ≤ s/2 for every member, so |Δₐ − Δᵦ| ≤ s and,
-    /// by the triangle inequality, |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + s: every pair within t (1 + m) now
-    /// is listed. Every target is at most t (the mean of two thicknesses, or less), so no
-    /// contact is missing, with m t to spare for pairs pushed together within a sweep — the
-    /// guarantee of a fresh search every sweep. c lets a cloth that falls or is carried as a
-    /// whole keep its list. The check runs before every sweep, so it also catches moves
+    /// at most R = t (1 + m) apart (m t the skin). With displacements Δᵢ = xᵢ − x⁰ᵢ and a
+    /// common displacement c (their mean), a member is a mover if |Δᵢ − c| > m t / 2. Movers
+    /// are re-anchored at x⁰ᵢ = xᵢ − c (so Δᵢ − c = 0) and their pairs within R of the new
+    /// anchor added, which keeps the invariant; when there are many, the list is rebuilt. Then
+    /// |Δᵢ − c| ≤ m t / 2 for every member, so |Δₐ − Δᵦ| ≤ m t and, by the triangle
+    /// inequality, |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + m t: every pair within t now is listed. Every
+    /// target is at most t (the mean of two thicknesses, or less), so no contact is missing —
+    /// the guarantee of a fresh search every sweep. c lets a cloth that falls or is carried as
+    /// a whole keep its list. The check runs before every sweep, so it also catches moves
     /// between frames (pins, grabs, edits).
     pub(crate) fn refresh(&mut self, positions: &[DVec3], thickness: &[f64]) {
         let Some(t) = self.built_for else {
@@ -424,34 +453,53 @@ impl SelfCollision {
         }
         let limit = self.limit(t);
         let limit2 = limit * limit;
-        let displacements = || {
-            self.members
-                .iter()
-                .zip(&self.built_at)
-                .map(|(&i, x0)| positions[i as usize] - *x0)
-        };
-        let (lo, hi, sum) = displacements().fold(
+        // Per chunk of members (fixed chunks, so the sum is the same on any thread count):
+        // the box and the sum of the displacements.
+        let bounds: Vec<(DVec3, DVec3, DVec3)> = self
+            .members
+            .par_chunks(MEMBER_CHUNK)
+            .zip(self.built_at.par_chunks(MEMBER_CHUNK))
+            .map(|(members, anchors)| {
+                members.iter().zip(anchors).fold(
+                    (
+                        DVec3::splat(f64::INFINITY),
+                        DVec3::splat(f64::NEG_INFINITY),
+                        DVec3::ZERO,
+                    ),
+                    |(lo, hi, sum), (&i, x0)| {
+                        let d = positions[i as usize] - *x0;
+                        (lo.min(d), hi.max(d), sum + d)
+                    },
+                )
+            })
+            .collect();
+        let (lo, hi, sum) = bounds.iter().fold(
             (
                 DVec3::splat(f64::INFINITY),
                 DVec3::splat(f64::NEG_INFINITY),
                 DVec3::ZERO,
             ),
-            |(lo, hi, sum), d| (lo.min(d), hi.max(d), sum + d),
+            |(lo, hi, sum), &(l, h, s)| (lo.min(l), hi.max(h), sum + s),
         );
         // Every |Δᵢ − box centre| is at most the box's half-diagonal: often that settles it.
         if (0.5 * (hi - lo)).length_squared() <= limit2 {
             return;
         }
         let c = sum / self.members.len() as f64;
-        let cap = (self.members.len() / 64).max(64);
+        let (members, built_at) = (&self.members, &self.built_at);
         self.movers.clear();
-        for (slot, d) in displacements().enumerate() {
-            if (d - c).length_squared() > limit2 {
-                if self.movers.len() == cap {
-                    return self.rebuild(positions, thickness);
-                }
-                self.movers.push(slot as u32);
-            }
+        self.movers.par_extend(
+            (0..members.len())
+                .into_par_iter()
+                .with_min_len(MEMBER_CHUNK)
+                .filter(|&slot| {
+                    let d = positions[members[slot] as usize] - built_at[slot];
+                    (d - c).length_squared() > limit2
+                })
+                .map(|slot| slot as u32),
+        );
+        if self.movers.len() > (self.members.len() / MOVERS_CAP).max(64) {
+            return self.rebuild(positions, thickness);
         }
         if !self.movers.is_empty() {
             self.reanchor(positions, thickness, c, t);
@@ -469,12 +517,14 @@ impl SelfCollision {
                 self.reanchored.push(m as u32);
             }
         }
-        if self.reanchored.len() > (self.members.len() / 32).max(64) {
+        if self.reanchored.len() > (self.members.len() / REANCHORED_CAP).max(64) {
             return self.rebuild(positions, thickness);
         }
         self.updates += 1;
         let radius = self.radius(t);
         let r2 = radius * radius;
+        self.recent.reset(radius);
+        self.recent.build(&self.built_at, &self.reanchored);
         let new_pairs = &mut self.new_pairs;
         new_pairs.clear();
         for &m in &self.movers {
@@ -486,7 +536,8 @@ impl SelfCollision {
                     new_pairs.push(pair(j));
                 }
             });
-            for &r in &self.reanchored {
+            self.recent.query(x0, radius, &mut self.near);
+            for &r in &self.near {
                 if r != m && self.built_at[r as usize].distance_squared(x0) <= r2 {
                     new_pairs.push(pair(self.members[r as usize]));
                 }
@@ -494,22 +545,20 @@ impl SelfCollision {
         }
         new_pairs.sort_unstable();
         new_pairs.dedup();
-        let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
+        let Some(special) = &self.special else {
+            return self.rebuild(positions, thickness);
+        };
         let added = &mut self.added;
         added.clear();
         for &(a, b) in new_pairs.iter() {
-            if self.pairs.position(a, b).is_ok() || self.extra.position(a, b).is_ok() {
+            let (sa, sb) = (self.slot_of[a as usize], self.slot_of[b as usize]);
+            // Listed at the build (the grid's test, replayed), or added since.
+            let built =
+                self.built_pos[sa as usize].distance_squared(self.built_pos[sb as usize]) <= r2;
+            if built || self.extra.position(a, b).is_ok() {
                 continue;
             }
-            let (s, e) = (
-                special_offsets[a as usize] as usize,
-                special_offsets[a as usize + 1] as usize,
-            );
-            let special = &self.special[s..e];
-            let target = match special.binary_search_by_key(&b, |&(sb, _)| sb) {
-                Ok(k) => special[k].1,
-                Err(_) => 0.5 * (thickness[a as usize] + thickness[b as usize]),
-            };
+            let target = special.target(a, b, thickness);
             if target != EXEMPT {
                 added.push(a, b, target);
             }
@@ -520,7 +569,8 @@ impl SelfCollision {
         }
     }
 
-    /// Builds the list at `positions`: pairs from the grid, their targets, sorted by (a, b).
+    /// Builds the list at `positions`: pairs from the grid, run by run on rayon's threads,
+    /// with their targets.
     fn rebuild(&mut self, positions: &[DVec3], thickness: &[f64]) {
         self.rebuilds += 1;
         for &r in &self.reanchored {
@@ -532,135 +582,87 @@ impl SelfCollision {
         self.built_at.clear();
         self.built_at
             .extend(self.members.iter().map(|&i| positions[i as usize]));
+        self.built_pos.clone_from(&self.built_at);
         let max_t = self
             .members
             .iter()
             .map(|&i| thickness[i as usize])
             .fold(0.0f64, f64::max);
         self.built_for = Some(max_t);
-        self.pairs.clear();
+        self.pairs.iter_mut().for_each(PairList::clear);
         if max_t <= 0.0 {
             return;
         }
-        if self.special_offsets.is_none() {
-            self.special_offsets = Some(self.find_special(thickness, max_t));
+        if self.special.is_none() {
+            self.special = Some(self.find_special(thickness, max_t));
         }
         let radius = self.radius(max_t);
         self.grid.build(positions, &self.members, radius);
-        let found = &mut self.found;
-        found.clear();
-        self.grid
-            .for_each_pair(radius, |i, j| found.push((i.min(j), i.max(j), ())));
-        let n = positions.len();
-        sort_pairs(found, n, &mut self.counts, &mut self.sorted);
-        // Each a's partners and its special pairs are both sorted by b: merge them. The
-        // result is what Exemptions::target gives, without its searches and square roots.
-        let special_offsets = self.special_offsets.as_deref().unwrap_or(&[]);
-        let pairs = &mut self.pairs;
-        for a in 0..n {
-            let (s, e) = (self.counts[a] as usize, self.counts[a + 1] as usize);
-            if s == e {
-                continue;
-            }
-            let (ss, se) = (special_offsets[a] as usize, special_offsets[a + 1] as usize);
-            let special = &self.special[ss..se];
-            let mut k = 0;
-            for &(b, ()) in &self.sorted[s..e] {
-                while k < special.len() && special[k].0 < b {
-                    k += 1;
-                }
-                let target = match special.get(k) {
-                    Some(&(sb, target)) if sb == b => target,
-                    _ => 0.5 * (thickness[a] + thickness[b as usize]),
-                };
+        // A few runs per thread balance the load; the runs change nothing but the cost.
+        let runs = self.grid.cell_runs(4 * rayon::current_num_threads());
+        self.pairs.resize_with(runs.len(), PairList::default);
+        let (grid, special) = (&self.grid, self.special.as_ref());
+        self.pairs.par_iter_mut().zip(runs).for_each(|(list, run)| {
+            list.clear();
+            let Some(special) = special else { return };
+            grid.for_each_pair_in(run, radius, |i, j| {
+                let (a, b) = (i.min(j), i.max(j));
+                let target = special.target(a, b, thickness);
                 if target != EXEMPT {
-                    pairs.a.push(a as u32);
-                    pairs.b.push(b);
-                    pairs.target.push(target);
+                    list.push(a, b, target);
                 }
-            }
-        }
+            });
+        });
     }
 
     /// Limits each member's displacement this substep to `max_displacement` · thickness.
     pub(crate) fn clamp_displacements(&self, p: &mut Particles, thickness: &[f64]) {
-        for &i in &self.members {
-            let i = i as usize;
-            if p.inv_masses[i] == 0.0 {
-                continue;
-            }
-            let limit = self.params.max_displacement * thickness[i];
-            let d = p.positions[i] - p.prev_positions[i];
-            let len = d.length();
-            if len > limit {
-                p.positions[i] = p.prev_positions[i] + d * (limit / len);
-            }
-        }
+        let max = self.params.max_displacement;
+        let slot_of = &self.slot_of;
+        p.positions
+            .par_iter_mut()
+            .with_min_len(MEMBER_CHUNK)
+            .enumerate()
+            .zip(&p.prev_positions)
+            .zip(&p.inv_masses)
+            .for_each(|(((i, x), &prev), &w)| {
+                if w == 0.0 || slot_of[i] == u32::MAX {
+                    return;
+                }
+                let limit = max * thickness[i];
+                let d = *x - prev;
+                let len = d.length();
+                if len > limit {
+                    *x = prev + d * (limit / len);
+                }
+            });
     }
 
-    /// Pushes touching pairs apart to their target distance, with friction; returns the
-    /// number of contacts and the deepest overlap (m). Call [`SelfCollision::refresh`] first.
-    pub(crate) fn solve(&self, p: &mut Particles) -> (usize, f64) {
-        let mut acc = (0, 0.0f64);
-        // `pairs` and `extra` in one (a, b) order: the order a full rebuild would give.
-        let mut k = 0;
-        for e in 0..self.extra.a.len() {
-            let (a, b) = (self.extra.a[e], self.extra.b[e]);
-            let end = self.pairs.position(a, b).unwrap_or_else(|i| i);
-            self.solve_range(p, &self.pairs, k..end, &mut acc);
-            self.solve_range(p, &self.extra, e..e + 1, &mut acc);
-            k = end;
-        }
-        self.solve_range(p, &self.pairs, k..self.pairs.a.len(), &mut acc);
-        acc
-    }
-
-    /// Solves `list[range]`, adding to (contacts, deepest).
-    fn solve_range(
-        &self,
-        p: &mut Particles,
-        list: &PairList,
-        range: std::ops::Range<usize>,
-        (contacts, deepest): &mut (usize, f64),
-    ) {
-        let (a, b, target) = (
-            &list.a[range.clone()],
-            &list.b[range.clone()],
-            &list.target[range],
-        );
-        for ((&a, &b), &target) in a.iter().zip(b).zip(target) {
-            let (a, b) = (a as usize, b as usize);
-            let delta = p.positions[a] - p.positions[b];
-            // Most listed pairs are not touching: rule them out before any square root.
-            let dist2 = delta.length_squared();
-            if dist2 >= target * target {
-                continue;
-            }
-            let (wa, wb) = (p.inv_masses[a], p.inv_masses[b]);
-            let w = wa + wb;
-            if w == 0.0 {
-                continue;
-            }
-            let dist = dist2.sqrt();
-            if dist >= target || dist <= 1e-9 {
-                continue;
-            }
-            let depth = target - dist;
-            let n = delta / dist;
-            // Distance constraint C = |xa − xb| − target ≥ 0, mass-weighted projection
-            // (Müller et al. 2007, eq. 9–10).
-            p.positions[a] += n * (depth * wa / w);
-            p.positions[b] -= n * (depth * wb / w);
-            // Friction on the relative tangential displacement over the substep.
-            let rel =
-                (p.positions[a] - p.prev_positions[a]) - (p.positions[b] - p.prev_positions[b]);
-            let tangential = rel - n * n.dot(rel);
-            let corr = self.params.friction.correction(tangential, depth);
-            p.positions[a] -= corr * (wa / w);
-            p.positions[b] += corr * (wb / w);
-            *contacts += 1;
-            *deepest = deepest.max(depth);
-        }
+    /// One Jacobi sweep over the touching pairs (see the module doc); returns the number of
+    /// contacts and the deepest overlap (m). Call [`SelfCollision::refresh`] first.
+    pub(crate) fn solve(&mut self, p: &mut Particles) -> (usize, f64) {
+        let lists: Vec<&PairList> = self.pairs.iter().chain([&self.extra]).collect();
+        self.contacts.resize_with(lists.len(), Default::default);
+        let friction = self.params.friction;
+        let state = State {
+            x: &p.positions,
+            prev: &p.prev_positions,
+            w: &p.inv_masses,
+        };
+        let deepest = lists
+            .par_iter()
+            .zip(self.contacts.par_iter_mut())
+            .map(|(list, (hits, out))| {
+                out.clear();
+                find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
+            })
+            .reduce(|| 0.0, f64::max);
+        let found: Vec<&Vec<Contact>> = self.contacts.iter().map(|(_, out)| out).collect();
+        let n = p.positions.len();
+        self.sums.resize(n, DVec3::ZERO);
+        self.counts.resize(n, 0);
+        apply(&found, &mut p.positions, &mut self.sums, &mut self.counts);
+        (found.iter().map(|c| c.len()).sum(), deepest)
     }
 }
 
@@ -720,10 +722,23 @@ mod tests {
         (solver, x, thickness)
     }
 
-    /// The whole list (`pairs` and `extra`), in solve order.
+    /// The whole list (`pairs` and `extra`), sorted by (a, b); asserts no pair is listed twice.
     fn whole(sc: &SelfCollision) -> PairList {
+        let mut all: Vec<(u32, u32, f64)> = sc
+            .pairs
+            .iter()
+            .chain([&sc.extra])
+            .flat_map(|l| (0..l.len()).map(move |k| (l.a[k], l.b[k], l.target[k])))
+            .collect();
+        all.sort_by_key(|&(a, b, _)| (a, b));
+        assert!(
+            all.windows(2).all(|w| (w[0].0, w[0].1) < (w[1].0, w[1].1)),
+            "a pair is listed twice"
+        );
         let mut out = PairList::default();
-        sc.pairs.merge_into(&sc.extra, &mut out);
+        for (a, b, t) in all {
+            out.push(a, b, t);
+        }
         out
     }
 
@@ -766,8 +781,7 @@ mod tests {
     /// touching pairs are exactly the brute-force ones.
     fn assert_complete(sc: &SelfCollision, x: &[DVec3], t: &[f64], when: &str) {
         let list = listed(sc);
-        assert!(list.windows(2).all(|w| w[0] < w[1]), "{when}: not sorted");
-        let guaranteed = SPACING * (1.0 + sc.params.search_margin);
+        let guaranteed = SPACING;
         let missing: Vec<_> = brute_pairs(sc, x, t, |_| guaranteed)
             .into_iter()
             .filter(|p| list.binary_search(p).is_err())
@@ -795,7 +809,7 @@ mod tests {
         assert_complete(&sc, &x, &t, "built");
         // Exactly the pairs within R at the build, no more.
         let list = listed(&sc);
-        let radius = SPACING * (1.0 + params.search_margin + SKIN);
+        let radius = SPACING * (1.0 + params.search_margin);
         assert_eq!(list, brute_pairs(&sc, &x, &t, |_| radius * (1.0 + 1e-12)));
 
         // Adversarial moves within the skin: each particle heads for the nearest particle the
@@ -841,7 +855,7 @@ mod tests {
         let (solver, mut x, t) = folded();
         let params = SelfCollisionParams::default();
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
-        let limit = 0.5 * SKIN * SPACING;
+        let limit = 0.5 * params.search_margin * SPACING;
         sc.refresh(&x, &t);
         // The whole cloth carried 10 half-skins away: its list still holds.
         for xi in &mut x {
@@ -904,11 +918,13 @@ mod tests {
         }
     }
 
-    fn fold_with(skin: f64) -> (Vec<DVec3>, u64, u64) {
+    fn fold_with(search_margin: f64) -> (Vec<DVec3>, u64, u64) {
         let (mut solver, _) = self_fold(Method::Xpbd, 10, 30).expect("scenario");
-        let mut sc = SelfCollision::new(&solver, &[0], SelfCollisionParams::default())
-            .expect("self-collision");
-        sc.skin = skin;
+        let params = SelfCollisionParams {
+            search_margin,
+            ..SelfCollisionParams::default()
+        };
+        let sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
         let thickness = vec![solver.cloths()[0].thickness; solver.particles().len()];
         let mut hook = Hook {
             sc,
@@ -929,7 +945,7 @@ mod tests {
     fn skin_list_folds_exactly_like_a_search_before_every_sweep() {
         // No skin: any motion at all rebuilds the list, i.e. a fresh search every sweep.
         let (every, sweeps, _) = fold_with(0.0);
-        let (skin, rebuilds, updates) = fold_with(SKIN);
+        let (skin, rebuilds, updates) = fold_with(SelfCollisionParams::default().search_margin);
         assert!(updates > 0, "no partial update was exercised");
         assert_eq!(sweeps, 90 * 10, "a fresh search every sweep");
         assert!(

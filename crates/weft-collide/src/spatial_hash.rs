@@ -9,7 +9,14 @@
 //! (the sorted cell list of Green, "Particle Simulation using CUDA", NVIDIA 2010, walked on
 //! the CPU with one forward-only cursor per neighbour column instead of hashed look-ups).
 
+use std::ops::Range;
+
 use glam::DVec3;
+use rayon::prelude::*;
+
+/// Fewest items per rayon task in the grid's parallel loops (smaller ones cost more to hand
+/// to another thread than to do).
+const PAR_MIN: usize = 2048;
 
 /// Points bucketed by hashed grid cell.
 #[derive(Clone, Debug, Default)]
@@ -28,6 +35,13 @@ impl SpatialHash {
             spacing,
             ..Self::default()
         }
+    }
+
+    /// Empties the hash and sets its cell size to `spacing` (m), keeping its storage.
+    pub fn reset(&mut self, spacing: f64) {
+        self.spacing = spacing;
+        self.cell_start.clear();
+        self.cell_entries.clear();
     }
 
     /// Cell size (m).
@@ -158,7 +172,8 @@ impl CellGrid {
     }
 
     /// Sorts `items` (indices into `positions`) by their cell of size `spacing` (m), then by
-    /// index.
+    /// index. Keys and the sort run on rayon's threads; the order is a function of the
+    /// positions alone.
     pub(crate) fn build(&mut self, positions: &[DVec3], items: &[u32], spacing: f64) {
         self.spacing = spacing;
         if self.items != items {
@@ -168,13 +183,44 @@ impl CellGrid {
             self.sorted.extend(items.iter().map(|&i| (0, i)));
         }
         let inv = 1.0 / spacing;
-        for (key, i) in &mut self.sorted {
-            *key = cell_key(positions[*i as usize], inv);
-        }
-        self.sorted.sort();
+        self.sorted
+            .par_iter_mut()
+            .with_min_len(PAR_MIN)
+            .for_each(|(key, i)| *key = cell_key(positions[*i as usize], inv));
+        // Keys are unique with their item, so an unstable sort gives the one sorted order.
+        self.sorted.par_sort_unstable();
         self.positions.clear();
-        self.positions
-            .extend(self.sorted.iter().map(|&(_, i)| positions[i as usize]));
+        self.positions.par_extend(
+            self.sorted
+                .par_iter()
+                .with_min_len(PAR_MIN)
+                .map(|&(_, i)| positions[i as usize]),
+        );
+    }
+
+    /// Splits the sorted items into about `parts` runs of whole cells, for
+    /// [`CellGrid::for_each_pair_in`] on several threads.
+    pub(crate) fn cell_runs(&self, parts: usize) -> Vec<Range<usize>> {
+        let n = self.sorted.len();
+        let parts = parts.clamp(1, n.max(1));
+        let mut runs = Vec::with_capacity(parts);
+        let mut start = 0;
+        for k in 1..=parts {
+            let mut end = if k == parts {
+                n
+            } else {
+                (n * k / parts).max(start)
+            };
+            // Move the cut to the end of the cell it falls in.
+            while end < n && end > 0 && self.sorted[end].0 == self.sorted[end - 1].0 {
+                end += 1;
+            }
+            if end > start {
+                runs.push(start..end);
+                start = end;
+            }
+        }
+        runs
     }
 
     /// Calls `f(i)` for every built item at most `radius` (≤ spacing) from `p`, in key order.
@@ -204,12 +250,24 @@ impl CellGrid {
     /// Calls `f(i, j)` once for every unordered pair {i, j} of built items at most `radius`
     /// apart (`radius` must not exceed the spacing); which comes first, and the order of the
     /// calls, depend on the positions alone.
+    pub(crate) fn for_each_pair(&self, radius: f64, f: impl FnMut(u32, u32)) {
+        self.for_each_pair_in(0..self.sorted.len(), radius, f);
+    }
+
+    /// [`CellGrid::for_each_pair`] for the pairs whose first point (in key order) lies in
+    /// `run`, a run of whole cells from [`CellGrid::cell_runs`]: the runs of a split together
+    /// give every pair once.
     ///
     /// With `radius` ≤ spacing two such points lie in the same or neighbouring cells. Walking
     /// the cells in key order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
     /// form one contiguous run whose start only moves forward, so one cursor per column finds
-    /// it without any search.
-    pub(crate) fn for_each_pair(&self, radius: f64, mut f: impl FnMut(u32, u32)) {
+    /// it without any search after the first cell.
+    pub(crate) fn for_each_pair_in(
+        &self,
+        run: Range<usize>,
+        radius: f64,
+        mut f: impl FnMut(u32, u32),
+    ) {
         assert!(
             radius <= self.spacing,
             "pair radius {radius} exceeds the cell size {}",
@@ -219,8 +277,13 @@ impl CellGrid {
         let (cells, pos) = (&self.sorted, &self.positions);
         let n = cells.len();
         let mut cursors = [0usize; COLUMNS.len()];
-        let mut s = 0;
-        while s < n {
+        if let Some(&(first, _)) = cells.get(run.start) {
+            for (cursor, offset) in cursors.iter_mut().zip(COLUMNS) {
+                *cursor = cells.partition_point(|&(k, _)| k < first + offset);
+            }
+        }
+        let mut s = run.start;
+        while s < run.end {
             let c = cells[s].0;
             let mut e = s + 1;
             while e < n && cells[e].0 == c {
@@ -311,6 +374,20 @@ mod tests {
             grid.build(&moved, &items, radius);
             let mut found = Vec::new();
             grid.for_each_pair(radius, |i, j| found.push((i.min(j), i.max(j))));
+            // Split into runs of cells, the runs find the same pairs, each once.
+            for parts in [2, 7, 64] {
+                let mut split = Vec::new();
+                let runs = grid.cell_runs(parts);
+                assert!(runs.windows(2).all(|w| w[0].end == w[1].start));
+                assert_eq!((runs[0].start, runs[runs.len() - 1].end), (0, items.len()));
+                for run in runs {
+                    grid.for_each_pair_in(run, radius, |i, j| split.push((i.min(j), i.max(j))));
+                }
+                split.sort_unstable();
+                let mut whole = found.clone();
+                whole.sort_unstable();
+                assert_eq!(split, whole, "round {round}: {parts} runs");
+            }
             let count = found.len();
             found.sort_unstable();
             found.dedup();

@@ -1,0 +1,404 @@
+//! One Jacobi sweep over self-collision contacts: find the touching pairs of a candidate
+//! list, compute each one's corrections eight at a time, and move every particle by the mean
+//! of its corrections (constraint averaging, Macklin et al. 2014, "Unified Particle Physics
+//! for Real-Time Applications", §4.2, eq. 11 with ω = 1).
+//!
+//! Each correction is rounded to a multiple of q = 2⁻⁴⁰ m (0.9 pm) before it is summed: f64
+//! sums of such multiples are exact while they stay below 2⁵³ q = 8192 m, so addition is
+//! associative and order-free. A particle's move depends only on the set of its contacts, not
+//! on the order of the list, on how it is split into tasks, or on the thread count.
+
+// Lane and axis loops index several arrays in step; written as index loops on purpose so
+// that each compiles to one vector operation per axis.
+#![allow(clippy::needless_range_loop)]
+
+use glam::DVec3;
+use multiversion::multiversion;
+use rayon::prelude::*;
+
+use crate::friction::Friction;
+
+/// Adding and subtracting 1.5 · 2¹² rounds an f64 of magnitude below 2¹¹ to the nearest
+/// multiple of 2⁻⁴⁰ (its unit in the last place is 2⁻⁴⁰ there): round-to-nearest by a "magic
+/// number" (Muller et al., "Handbook of Floating-Point Arithmetic", 2018, §5.2.1 — Rust never
+/// reassociates or contracts the two operations).
+const ROUND: f64 = 1.5 * 4096.0;
+
+/// `v` rounded to a multiple of 2⁻⁴⁰ (for |v| < 2¹¹ m; see [`ROUND`]).
+#[inline(always)]
+fn quantize(v: f64) -> f64 {
+    (v + ROUND) - ROUND
+}
+
+/// Touching pairs handled together by the contact kernel.
+const LANES: usize = 8;
+
+/// Fewest particles per task when the corrections are summed.
+const SUM_CHUNK: usize = 2048;
+
+/// One touching pair's corrections, each a multiple of 2⁻⁴⁰ m.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Contact {
+    a: u32,
+    b: u32,
+    da: [f64; 3],
+    db: [f64; 3],
+}
+
+/// The particle state a sweep reads.
+#[derive(Clone, Copy)]
+pub(crate) struct State<'a> {
+    /// Positions at the start of the sweep.
+    pub x: &'a [DVec3],
+    /// Positions at the start of the substep.
+    pub prev: &'a [DVec3],
+    /// Inverse masses.
+    pub w: &'a [f64],
+}
+
+/// Finds the pairs (`a[k]`, `b[k]`) closer than `target[k]` and appends their corrections to
+/// `out`; returns the deepest overlap (m). `hits` is scratch.
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
+    "x86_64+avx2+fma",
+    "aarch64+neon"
+))]
+pub(crate) fn find_contacts<'a>(
+    (a, b, target): (&[u32], &[u32], &[f64]),
+    s: State<'a>,
+    friction: Friction,
+    hits: &mut Vec<u32>,
+    out: &mut Vec<Contact>,
+) -> f64 {
+    // Most listed pairs do not touch: a branch-free filter first (a branch here would be
+    // mispredicted for about every fourth pair of a dense fold).
+    hits.clear();
+    hits.resize(a.len(), 0);
+    let mut n = 0;
+    for k in 0..a.len() {
+        let d2 = (s.x[a[k] as usize] - s.x[b[k] as usize]).length_squared();
+        hits[n] = k as u32;
+        n += usize::from(d2 < target[k] * target[k]);
+    }
+    hits.truncate(n);
+    out.reserve(n);
+    let mut deepest = [0.0f64; LANES];
+    let mut chunks = hits.chunks_exact(LANES);
+    for chunk in &mut chunks {
+        let lanes: [u32; LANES] = std::array::from_fn(|l| chunk[l]);
+        contacts::<LANES>(lanes, (a, b, target), s, friction, out, &mut deepest);
+    }
+    for &k in chunks.remainder() {
+        contacts::<1>([k], (a, b, target), s, friction, out, &mut deepest[..1]);
+    }
+    deepest.into_iter().fold(0.0, f64::max)
+}
+
+/// The corrections of the touching pairs `ks` (`L` of them), lane by lane: the contact is the
+/// distance constraint C = |xa − xb| − target ≥ 0 projected with mass weights (Müller et al.
+/// 2007, eq. 9–10), then position-based Coulomb friction on the relative tangential
+/// displacement over the substep ([`Friction::correction`], Macklin et al. 2014, eq. 24).
+/// Every step is a loop over lanes with selects instead of branches, so that it compiles to
+/// vector instructions (measured 1.4× faster than one pair at a time at 128²); the scalar
+/// remainder (`L = 1`) runs the same operations, so a pair's result does not depend on which
+/// path computed it. Lanes where neither particle can move, or the two coincide, are dropped.
+#[inline(always)]
+fn contacts<const L: usize>(
+    ks: [u32; L],
+    (a, b, target): (&[u32], &[u32], &[f64]),
+    s: State<'_>,
+    friction: Friction,
+    out: &mut Vec<Contact>,
+    deepest: &mut [f64],
+) {
+    let ia: [usize; L] = std::array::from_fn(|l| a[ks[l] as usize] as usize);
+    let ib: [usize; L] = std::array::from_fn(|l| b[ks[l] as usize] as usize);
+    let t: [f64; L] = std::array::from_fn(|l| target[ks[l] as usize]);
+    let gather = |v: &[DVec3], i: &[usize; L]| -> [[f64; L]; 3] {
+        std::array::from_fn(|c| std::array::from_fn(|l| v[i[l]][c]))
+    };
+    let (xa, xb, pa, pb) = (
+        gather(s.x, &ia),
+        gather(s.x, &ib),
+        gather(s.prev, &ia),
+        gather(s.prev, &ib),
+    );
+    let wa: [f64; L] = std::array::from_fn(|l| s.w[ia[l]]);
+    let wb: [f64; L] = std::array::from_fn(|l| s.w[ib[l]]);
+    let mut d = [[0.0; L]; 3];
+    let mut d2 = [0.0; L];
+    for c in 0..3 {
+        for l in 0..L {
+            d[c][l] = xa[c][l] - xb[c][l];
+            d2[l] += d[c][l] * d[c][l];
+        }
+    }
+    let mut depth = [0.0; L];
+    let mut valid = [false; L];
+    let mut fa = [0.0; L];
+    let mut fb = [0.0; L];
+    let mut n = [[0.0; L]; 3];
+    for l in 0..L {
+        let dist = d2[l].sqrt();
+        let sum = wa[l] + wb[l];
+        valid[l] = sum > 0.0 && dist > 1e-9;
+        let inv_dist = if valid[l] { 1.0 / dist } else { 0.0 };
+        let inv_sum = if valid[l] { 1.0 / sum } else { 0.0 };
+        depth[l] = t[l] - dist;
+        fa[l] = wa[l] * inv_sum;
+        fb[l] = wb[l] * inv_sum;
+        for c in 0..3 {
+            n[c][l] = d[c][l] * inv_dist;
+        }
+    }
+    // Normal push: Δxa = +n depth wa / (wa + wb), Δxb = −n depth wb / (wa + wb).
+    let mut da = [[0.0; L]; 3];
+    let mut db = [[0.0; L]; 3];
+    let mut dot = [0.0; L];
+    let mut rel = [[0.0; L]; 3];
+    for c in 0..3 {
+        for l in 0..L {
+            da[c][l] = n[c][l] * (depth[l] * fa[l]);
+            db[c][l] = -n[c][l] * (depth[l] * fb[l]);
+            rel[c][l] = (xa[c][l] + da[c][l] - pa[c][l]) - (xb[c][l] + db[c][l] - pb[c][l]);
+            dot[l] += n[c][l] * rel[c][l];
+        }
+    }
+    let mut tangential = [[0.0; L]; 3];
+    let mut slip2 = [0.0; L];
+    for c in 0..3 {
+        for l in 0..L {
+            tangential[c][l] = rel[c][l] - n[c][l] * dot[l];
+            slip2[l] += tangential[c][l] * tangential[c][l];
+        }
+    }
+    // Friction::correction as a factor on the tangential slip: 1 when static, the dynamic
+    // reduction μk d / |slip| (at most 1) otherwise, 0 without slip.
+    let (mu_s, mu_k) = (friction.static_coefficient, friction.dynamic_coefficient);
+    let mut factor = [0.0; L];
+    for l in 0..L {
+        let slip = slip2[l].sqrt();
+        let dynamic = (mu_k * depth[l] / slip).min(1.0);
+        let f = if slip < mu_s * depth[l] { 1.0 } else { dynamic };
+        factor[l] = if depth[l] <= 0.0 || slip <= 0.0 {
+            0.0
+        } else {
+            f
+        };
+    }
+    for c in 0..3 {
+        for l in 0..L {
+            let corr = tangential[c][l] * factor[l];
+            da[c][l] = quantize(da[c][l] - corr * fa[l]);
+            db[c][l] = quantize(db[c][l] + corr * fb[l]);
+        }
+    }
+    for l in 0..L {
+        if valid[l] {
+            out.push(Contact {
+                a: ia[l] as u32,
+                b: ib[l] as u32,
+                da: std::array::from_fn(|c| da[c][l]),
+                db: std::array::from_fn(|c| db[c][l]),
+            });
+            deepest[l] = deepest[l].max(depth[l]);
+        }
+    }
+}
+
+/// Moves every particle with a contact in `found` by the mean of its corrections; `sums` and
+/// `counts` (one per particle, zero on entry) are scratch and zero again on return. Runs over
+/// ranges of particles on rayon's threads, each range reading every contact.
+pub(crate) fn apply(
+    found: &[&Vec<Contact>],
+    positions: &mut [DVec3],
+    sums: &mut [DVec3],
+    counts: &mut [u32],
+) {
+    let total: usize = found.iter().map(|c| c.len()).sum();
+    if total == 0 {
+        return;
+    }
+    // Enough particles per task that its scan of every contact stays a small part of it.
+    let chunk = (positions.len() / rayon::current_num_threads().max(1))
+        .max(SUM_CHUNK)
+        .max(1);
+    positions
+        .par_chunks_mut(chunk)
+        .zip(sums.par_chunks_mut(chunk))
+        .zip(counts.par_chunks_mut(chunk))
+        .enumerate()
+        .for_each(|(k, ((x, sums), counts))| {
+            let lo = k * chunk;
+            let mut add = |i: u32, d: &[f64; 3]| {
+                let j = (i as usize).wrapping_sub(lo);
+                if j < x.len() {
+                    counts[j] += 1;
+                    sums[j] += DVec3::from_array(*d);
+                }
+            };
+            for c in found.iter().copied().flatten() {
+                add(c.a, &c.da);
+                add(c.b, &c.db);
+            }
+            for ((x, sum), count) in x.iter_mut().zip(sums.iter_mut()).zip(counts.iter_mut()) {
+                if *count > 0 {
+                    *x += *sum / f64::from(*count);
+                    *sum = DVec3::ZERO;
+                    *count = 0;
+                }
+            }
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic pseudo-random number in [−1, 1) (64-bit LCG, Knuth's MMIX constants).
+    fn rand(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// Sweeps the pairs (`a`, `b`, target) once and returns the new positions.
+    fn sweep(pairs: &[(u32, u32, f64)], x: &[DVec3], prev: &[DVec3], w: &[f64]) -> Vec<DVec3> {
+        let (a, b, t): (Vec<u32>, Vec<u32>, Vec<f64>) = (
+            pairs.iter().map(|p| p.0).collect(),
+            pairs.iter().map(|p| p.1).collect(),
+            pairs.iter().map(|p| p.2).collect(),
+        );
+        let state = State { x, prev, w };
+        let (mut hits, mut out) = (Vec::new(), Vec::new());
+        find_contacts((&a, &b, &t), state, Friction::NONE, &mut hits, &mut out);
+        let mut x = x.to_vec();
+        let mut sums = vec![DVec3::ZERO; x.len()];
+        let mut counts = vec![0; x.len()];
+        apply(&[&out], &mut x, &mut sums, &mut counts);
+        assert!(sums.iter().all(|s| *s == DVec3::ZERO) && counts.iter().all(|&c| c == 0));
+        x
+    }
+
+    #[test]
+    fn an_overlapping_pair_is_pushed_to_its_target_by_inverse_mass() {
+        // Particle 1 is three times as heavy: it moves a quarter of the overlap.
+        let x = vec![DVec3::ZERO, DVec3::new(0.006, 0.0, 0.0)];
+        let w = [3.0, 1.0];
+        let after = sweep(&[(0, 1, 0.01)], &x, &x, &w);
+        assert!((after[0].x - -0.003).abs() < 1e-12, "{after:?}");
+        assert!((after[1].x - 0.007).abs() < 1e-12, "{after:?}");
+        assert!((after[0].distance(after[1]) - 0.01).abs() < 1e-12);
+        // Not touching: nothing moves.
+        assert_eq!(sweep(&[(0, 1, 0.005)], &x, &x, &w), x);
+    }
+
+    #[test]
+    fn a_particle_with_two_contacts_moves_by_their_mean() {
+        // Particle 0 overlaps two pinned particles, by 2 mm on the left and 4 mm below.
+        let x = vec![
+            DVec3::ZERO,
+            DVec3::new(-0.008, 0.0, 0.0),
+            DVec3::new(0.0, -0.006, 0.0),
+        ];
+        let w = [1.0, 0.0, 0.0];
+        let after = sweep(&[(0, 1, 0.01), (0, 2, 0.01)], &x, &x, &w);
+        let expected = DVec3::new(0.002, 0.004, 0.0) / 2.0;
+        assert!((after[0] - expected).length() < 1e-12, "{after:?}");
+        assert_eq!(&after[1..], &x[1..], "pinned particles moved");
+    }
+
+    #[test]
+    fn result_does_not_depend_on_pair_order_nor_on_the_vector_path() {
+        // A clump of 40 particles, all pairs listed (many more than one lane chunk touch).
+        let mut seed = 11;
+        let n = 40;
+        let x: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(rand(&mut seed), rand(&mut seed), rand(&mut seed)) * 0.02)
+            .collect();
+        let prev: Vec<DVec3> = x
+            .iter()
+            .map(|p| *p + DVec3::new(rand(&mut seed), rand(&mut seed), 0.0) * 1e-3)
+            .collect();
+        let w: Vec<f64> = (0..n)
+            .map(|i| {
+                if i % 7 == 0 {
+                    0.0
+                } else {
+                    1.0 + (i % 3) as f64
+                }
+            })
+            .collect();
+        let mut pairs: Vec<(u32, u32, f64)> = (0..n as u32)
+            .flat_map(|a| (a + 1..n as u32).map(move |b| (a, b, 0.015)))
+            .collect();
+        let state = State {
+            x: &x,
+            prev: &prev,
+            w: &w,
+        };
+        let friction = Friction::new(0.3, 0.2);
+        let run = |pairs: &[(u32, u32, f64)]| {
+            let (a, b, t): (Vec<u32>, Vec<u32>, Vec<f64>) = (
+                pairs.iter().map(|p| p.0).collect(),
+                pairs.iter().map(|p| p.1).collect(),
+                pairs.iter().map(|p| p.2).collect(),
+            );
+            let (mut hits, mut out) = (Vec::new(), Vec::new());
+            find_contacts((&a, &b, &t), state, friction, &mut hits, &mut out);
+            let mut moved = x.clone();
+            let (mut sums, mut counts) = (vec![DVec3::ZERO; n], vec![0; n]);
+            apply(&[&out], &mut moved, &mut sums, &mut counts);
+            (moved, out)
+        };
+        let (first, contacts) = run(&pairs);
+        assert!(contacts.len() > 100, "only {} contacts", contacts.len());
+        // Each pair alone (the scalar path) gives the same corrections as in a full chunk.
+        for c in &contacts {
+            let alone = run(&[(c.a, c.b, 0.015)]).1;
+            assert_eq!(alone.len(), 1);
+            assert_eq!(
+                (alone[0].da, alone[0].db),
+                (c.da, c.db),
+                "pair {} {}",
+                c.a,
+                c.b
+            );
+        }
+        // Reversed and shuffled lists, split in two: the same bits.
+        pairs.reverse();
+        assert_eq!(run(&pairs).0, first, "reversed");
+        let mut k = 5;
+        for i in (1..pairs.len()).rev() {
+            k = (k * 1_103_515_245 + 12_345) % 2_147_483_648;
+            pairs.swap(i, k % (i + 1));
+        }
+        assert_eq!(run(&pairs).0, first, "shuffled");
+        // It is not a trivial sweep: particles moved.
+        assert!(first.iter().zip(&x).filter(|(a, b)| a != b).count() > n / 2);
+    }
+
+    #[test]
+    fn quantized_corrections_sum_exactly_in_any_order() {
+        let mut seed = 5;
+        let values: Vec<f64> = (0..1000)
+            .map(|_| quantize(rand(&mut seed) * 0.01))
+            .collect();
+        let forward = values.iter().fold(0.0, |s, v| s + v);
+        let backward = values.iter().rev().fold(0.0, |s, v| s + v);
+        let strided = (0..7)
+            .map(|k| values.iter().skip(k).step_by(7).fold(0.0, |s, v| s + v))
+            .fold(0.0, |s, v| s + v);
+        assert_eq!(forward.to_bits(), backward.to_bits());
+        assert_eq!(forward.to_bits(), strided.to_bits());
+        // Unquantized, the same sums differ in the last bits (the test can fail).
+        let raw: Vec<f64> = (0..1000).map(|_| rand(&mut seed) * 0.01).collect();
+        let f = raw.iter().fold(0.0, |s, v| s + v);
+        let b = raw.iter().rev().fold(0.0, |s, v| s + v);
+        assert_ne!(f.to_bits(), b.to_bits());
+        // Quantization moves a value by at most half a quantum.
+        let v = 0.123_456_789_012_345;
+        assert!((quantize(v) - v).abs() <= 0.5 / (1u64 << 40) as f64);
+    }
+}
