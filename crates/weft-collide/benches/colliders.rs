@@ -3,7 +3,8 @@
 //!
 //! - `collide_sphere`: `sphere_drop` (a 1.6 m cloth draped over a sphere, and the ground),
 //! - `collide_trimesh`: `mesh_drop` (a 1.2 m cloth on the triangle-mesh blob, and the ground),
-//! - `collide_self`: `self_fold` at N×N (a strip folding onto itself: self-collision, ground).
+//! - `collide_self`: `curtain_fold` at N×N (a curtain folding onto itself in layers:
+//!   self-collision, ground).
 //!
 //! Each scenario is first stepped with its collision world until the cloth is in contact;
 //! `with` then steps it through the world (`step_with`), `without` steps a fresh copy of
@@ -21,7 +22,7 @@ use criterion::{
     BatchSize, Bencher, BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, Throughput,
     criterion_group, criterion_main, measurement::WallTime,
 };
-use weft_collide::scenarios::{mesh_drop, self_fold, sphere_drop};
+use weft_collide::scenarios::{curtain_fold, mesh_drop, sphere_drop};
 use weft_collide::{CollideError, CollisionWorld, SelfCollisionParams};
 use weft_solver::{Method, Solver, SubstepContext, SubstepHook};
 
@@ -94,7 +95,7 @@ fn trimesh(c: &mut Criterion) {
 }
 
 fn self_collision(c: &mut Criterion) {
-    with_and_without(c, "collide_self", |n| self_fold(Method::Xpbd, n, n));
+    with_and_without(c, "collide_self", |n| curtain_fold(Method::Xpbd, n));
 }
 
 /// One frame's worth of hook calls on `particles` (which do not move between substeps).
@@ -118,7 +119,7 @@ fn hook_frame(world: &mut CollisionWorld, solver: &Solver, particles: &mut weft_
 
 fn self_vs_solve(c: &mut Criterion) {
     let n = 128;
-    let (solver, _) = in_contact(|n| self_fold(Method::Xpbd, n, n), n);
+    let (solver, _) = in_contact(|n| curtain_fold(Method::Xpbd, n), n);
     let mut self_only = CollisionWorld::new(&solver);
     self_only
         .enable_self_collision(&solver, &[0], SelfCollisionParams::default())

@@ -1,27 +1,27 @@
-//! What self-collision costs per frame at 128² particles, against the constraint solve itself.
+//! What self-collision costs per frame at 128² particles, against the constraint solve itself,
+//! measured along a real trajectory.
 //!
-//! Two scenes, each stepped `--warmup` frames with self-collision (so that the cloth is folded
-//! or draped onto itself), then, from that same state, `--frames` frames of dt = 1/60 s with
-//! 10 substeps × 1 iteration (XPBD) three ways:
-//! (a) the collision world with self-collision, (b) the same world with self-collision off,
-//! (c) no hook at all (`solver.step()`). Prints the median wall time per frame of each and
-//! (a) − (b) against (c), in wall time and in CPU time (all threads).
+//! Each scene runs with two hooks in turn each substep: a collision world holding only the
+//! self-collision and one holding only the colliders (the ground, and the sphere for `drape`).
+//! The time spent inside the self-collision hook is timed directly, frame by frame, while the
+//! cloth falls, folds and settles. Frames `--warmup`..`--warmup + --frames` (dt = 1/60 s,
+//! 10 substeps × 1 iteration, XPBD) are reported: the median self-collision time per frame,
+//! and, stepped from the window's first state without any hook (the fused frame), the median
+//! constraint solve per frame; then their ratio.
 //!
-//! `cargo run --release -p weft-collide --example self_collision_cost -- [--scene curtain|drape|fold]
-//! [--only a|b|c] [--frames F] [--warmup W] [--n N] [--margin M]`; `--only` runs one variant (for
-//! `perf stat -e task-clock`). Set `RAYON_NUM_THREADS` to choose the thread count.
+//! `cargo run --release -p weft-collide --example self_collision_cost -- [--scene curtain|drape]
+//! [--frames F] [--warmup W] [--n N] [--margin M]`. Set `RAYON_NUM_THREADS` to choose the
+//! thread count.
 #![allow(clippy::unwrap_used)]
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-use weft_collide::scenarios::{self, THICKNESS};
+use weft_collide::scenarios;
 use weft_collide::{CollisionWorld, SelfCollisionParams};
-use weft_solver::glam::DVec3;
-use weft_solver::{GridDesc, Mass, Method, Orientation, Solver, SolverBuilder};
+use weft_solver::{Method, Particles, Solver, SubstepContext, SubstepHook};
 
 struct Args {
     scenes: Vec<String>,
-    only: Option<char>,
     frames: usize,
     warmup: usize,
     n: usize,
@@ -30,8 +30,7 @@ struct Args {
 
 fn args() -> Args {
     let mut a = Args {
-        scenes: vec!["curtain".into(), "drape".into(), "fold".into()],
-        only: None,
+        scenes: vec!["curtain".into(), "drape".into()],
         frames: 30,
         warmup: 60,
         n: 128,
@@ -42,7 +41,6 @@ fn args() -> Args {
         let value = it.next().unwrap_or_else(|| panic!("{flag} needs a value"));
         match flag.as_str() {
             "--scene" => a.scenes = vec![value],
-            "--only" => a.only = value.chars().next(),
             "--frames" => a.frames = value.parse().unwrap(),
             "--warmup" => a.warmup = value.parse().unwrap(),
             "--n" => a.n = value.parse().unwrap(),
@@ -53,162 +51,116 @@ fn args() -> Args {
     a
 }
 
-/// A vertical square n × n sheet, 0.9 m wide, thickness = particle spacing, 5 cm above the
-/// ground, with the self-fold scenario's wavy sideways velocity: it buckles and folds onto
-/// itself like [`scenarios::self_fold`], but with square cells.
-fn curtain(n: usize) -> (Solver, CollisionWorld) {
-    let (size, bottom) = (0.9, 0.05);
-    let thickness = size / (n - 1) as f64;
-    let mesh = GridDesc {
-        resolution: (n, n),
-        size: (size, size),
-        center: DVec3::new(0.0, bottom + 0.5 * size, 0.0),
-        orientation: Orientation::Vertical,
-        mass: Mass::Total(0.2),
-        pins: vec![],
-    }
-    .build()
-    .unwrap();
-    let (settings, params) = scenarios::method_setup(Method::Xpbd);
-    let mut builder = SolverBuilder::new(settings, scenarios::scenario_forces()).unwrap();
-    builder
-        .add_cloth("curtain", &mesh, params, thickness)
-        .unwrap();
-    let mut solver = builder.build();
-    let p = solver.particles_mut();
-    for i in 0..p.len() {
-        let y = p.positions[i].y - bottom;
-        p.velocities[i].z = 0.3 * (std::f64::consts::TAU * y / 0.3).sin();
-    }
-    let mut world = CollisionWorld::new(&solver);
-    world.add_collider(&scenarios::ground(0.0)).unwrap();
-    world
-        .enable_self_collision(&solver, &[0], SelfCollisionParams::default())
-        .unwrap();
-    (solver, world)
+/// Self-collision and colliders as two hooks, self-collision first (as inside one world),
+/// with the time spent in the self-collision one.
+struct Split {
+    own: CollisionWorld,
+    colliders: CollisionWorld,
+    spent: Duration,
 }
 
-/// The scene: `fold` is the self-fold strip at n × n (0.3 m × 0.9 m, so its cells are three
-/// times wider than tall); `curtain` the same fall with square cells ([`curtain`]); `drape`
-/// an n × n sheet dropped on the sphere (thickness below the spacing: few self contacts).
-fn scene(name: &str, n: usize) -> (Solver, CollisionWorld) {
-    match name {
-        "curtain" => curtain(n),
-        "fold" => scenarios::self_fold(Method::Xpbd, n, n).unwrap(),
-        "drape" => {
-            let (solver, mut world) = scenarios::sphere_drop(Method::Xpbd, n).unwrap();
-            world
-                .enable_self_collision(&solver, &[0], SelfCollisionParams::default())
-                .unwrap();
-            (solver, world)
-        }
-        _ => panic!("unknown scene {name}"),
+impl SubstepHook for Split {
+    fn begin_substep(&mut self, ctx: &SubstepContext, p: &Particles) {
+        let t = Instant::now();
+        self.own.begin_substep(ctx, p);
+        self.spent += t.elapsed();
+        self.colliders.begin_substep(ctx, p);
     }
+
+    fn project(&mut self, ctx: &SubstepContext, p: &mut Particles) -> usize {
+        let t = Instant::now();
+        let own = self.own.project(ctx, p);
+        self.spent += t.elapsed();
+        own + self.colliders.project(ctx, p)
+    }
+
+    fn end_substep(&mut self, ctx: &SubstepContext, p: &mut Particles) {
+        let t = Instant::now();
+        self.own.end_substep(ctx, p);
+        self.spent += t.elapsed();
+        self.colliders.end_substep(ctx, p);
+    }
+}
+
+/// The scene's solver and its split hook: `curtain` is [`scenarios::curtain_fold`] (a curtain
+/// folding onto itself in layers on the ground), `drape` an n × n sheet dropped on the sphere
+/// ([`scenarios::sphere_drop`]) with self-collision on.
+fn scene(name: &str, n: usize, params: SelfCollisionParams) -> (Solver, Split) {
+    let (solver, mut colliders) = match name {
+        "curtain" => scenarios::curtain_fold(Method::Xpbd, n).unwrap(),
+        "drape" => scenarios::sphere_drop(Method::Xpbd, n).unwrap(),
+        _ => panic!("unknown scene {name}"),
+    };
+    colliders.disable_self_collision();
+    let mut own = CollisionWorld::new(&solver);
+    own.enable_self_collision(&solver, &[0], params).unwrap();
+    let spent = Duration::ZERO;
+    (
+        solver,
+        Split {
+            own,
+            colliders,
+            spent,
+        },
+    )
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
-    }
-}
-
-/// CPU time of this process so far (ns), summed over its threads from Linux's
-/// `/proc/self/task/*/schedstat` (first field: time on CPU); 0 where that is not available.
-/// On a machine shared with other work, CPU time is steadier than wall time.
-fn cpu_ns() -> u64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return 0;
-    };
-    tasks
-        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
-        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
-        .sum()
-}
-
-/// Median wall and CPU ms per frame over `frames` frames from a copy of `solver`, with
-/// `world` or no hook.
-fn time_frames(solver: &Solver, world: Option<&CollisionWorld>, frames: usize) -> (f64, f64) {
-    let mut solver = solver.clone();
-    let mut world = world.cloned();
-    let lists = |w: &Option<CollisionWorld>| w.as_ref().and_then(|w| w.self_collision_lists());
-    let mut wall = Vec::with_capacity(frames);
-    let mut cpu = Vec::with_capacity(frames);
-    let before = lists(&world);
-    for _ in 0..frames {
-        let (t, c) = (Instant::now(), cpu_ns());
-        match &mut world {
-            Some(w) => solver.step_with(w).unwrap(),
-            None => solver.step().unwrap(),
-        };
-        wall.push(t.elapsed().as_secs_f64() * 1e3);
-        cpu.push((cpu_ns() - c) as f64 * 1e-6);
-    }
-    if let (Some((r0, u0, _)), Some((r1, u1, len))) = (before, lists(&world)) {
-        println!(
-            "  self-collision lists: {} rebuilds and {} partial updates in {frames} frames of \
-             {} substeps; {len} pairs",
-            r1 - r0,
-            u1 - u0,
-            solver.settings().substeps
-        );
-    }
-    (median(wall), median(cpu))
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 fn main() {
     let a = args();
     let threads = rayon::current_num_threads();
+    let params = SelfCollisionParams {
+        search_margin: a
+            .margin
+            .unwrap_or(SelfCollisionParams::default().search_margin),
+        ..SelfCollisionParams::default()
+    };
     for name in &a.scenes {
-        let (mut solver, mut world) = scene(name, a.n);
-        if let Some(search_margin) = a.margin {
-            let params = SelfCollisionParams {
-                search_margin,
-                ..SelfCollisionParams::default()
-            };
-            world.enable_self_collision(&solver, &[0], params).unwrap();
-        }
+        let (mut solver, mut hook) = scene(name, a.n, params);
         for _ in 0..a.warmup {
-            solver.step_with(&mut world).unwrap();
+            solver.step_with(&mut hook).unwrap();
         }
-        let stats = world.stats();
-        let thickness = solver.cloths()[0].thickness;
+        let start = solver.clone();
+        let lists = |h: &Split| h.own.self_collision_lists().unwrap();
+        let (r0, u0, _) = lists(&hook);
+        let mut own = Vec::new();
+        let mut contacts = 0;
+        for _ in 0..a.frames {
+            hook.spent = Duration::ZERO;
+            solver.step_with(&mut hook).unwrap();
+            own.push(hook.spent.as_secs_f64() * 1e3);
+            contacts = contacts.max(hook.own.stats().self_contacts);
+        }
+        let (r1, u1, len) = lists(&hook);
+        let mut bare = start.clone();
+        let solve: Vec<f64> = (0..a.frames)
+            .map(|_| {
+                let t = Instant::now();
+                bare.step().unwrap();
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        let (own, solve) = (median(own), median(solve));
         println!(
-            "{name} {n}x{n} (thickness {thickness:.4} m, sphere-drop thickness {THICKNESS}), \
-             {threads} thread(s), after {w} warm-up frames: {} self contacts, deepest {:.2e} m, \
-             KE {:.2e} J",
-            stats.self_contacts,
-            stats.max_self_depth,
+            "{name} {n}x{n}, thickness {t:.4} m, {threads} thread(s), frames {w}..{e}: up to \
+             {contacts} self contacts per substep; {} rebuilds and {} partial updates of the \
+             list, {len} pairs at the end; KE {:.2e} J",
+            r1 - r0,
+            u1 - u0,
             solver.particles().kinetic_energy(),
             n = a.n,
+            t = solver.cloths()[0].thickness,
             w = a.warmup,
+            e = a.warmup + a.frames,
         );
-        let mut without = world.clone();
-        without.disable_self_collision();
-        let run = |v: char| a.only.is_none_or(|o| o == v);
-        let ta = run('a').then(|| time_frames(&solver, Some(&world), a.frames));
-        let tb = run('b').then(|| time_frames(&solver, Some(&without), a.frames));
-        let tc = run('c').then(|| time_frames(&solver, None, a.frames));
-        for (what, pick) in [("wall", 0), ("cpu", 1)] {
-            let get = |t: Option<(f64, f64)>| t.map(|t| if pick == 0 { t.0 } else { t.1 });
-            let show = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{t:.3} ms"));
-            let (ta, tb, tc) = (get(ta), get(tb), get(tc));
-            println!(
-                "  median {what} per frame: (a) self-collision {}, (b) without {}, (c) no hook {}",
-                show(ta),
-                show(tb),
-                show(tc)
-            );
-            if let (Some(ta), Some(tb), Some(tc)) = (ta, tb, tc) {
-                println!(
-                    "    self-collision adds (a)-(b) = {:.3} ms per frame; constraint solve (c) \
-                     = {tc:.3} ms; ratio {:.2}",
-                    ta - tb,
-                    (ta - tb) / tc
-                );
-            }
-        }
+        println!(
+            "  median per frame: self-collision {own:.3} ms, constraint solve {solve:.3} ms; \
+             ratio {:.2}",
+            own / solve
+        );
     }
 }

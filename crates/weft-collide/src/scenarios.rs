@@ -178,6 +178,35 @@ pub fn self_fold(
     Ok((solver, world))
 }
 
+/// A vertical square curtain (`n`×`n`, 0.9 m, thickness = particle spacing) 5 cm above the
+/// ground, with [`self_fold`]'s wavy sideways velocity: it buckles and folds onto itself in
+/// layers, every particle ending in contact with the layer below or above it. Square cells,
+/// so at any `n` each particle's in-plane neighbourhood is the same.
+pub fn curtain_fold(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
+    let (size, bottom) = (0.9, 0.05);
+    let thickness = size / (n.max(2) - 1) as f64;
+    let mesh = GridDesc {
+        resolution: (n, n),
+        size: (size, size),
+        center: DVec3::new(0.0, bottom + 0.5 * size, 0.0),
+        orientation: Orientation::Vertical,
+        mass: Mass::Total(0.2),
+        pins: vec![],
+    }
+    .build()
+    .map_err(solver_error)?;
+    let mut solver = build_one(method, "curtain", &mesh, thickness)?;
+    let p = solver.particles_mut();
+    for i in 0..p.len() {
+        let y = p.positions[i].y - bottom;
+        p.velocities[i].z = 0.3 * (std::f64::consts::TAU * y / 0.3).sin();
+    }
+    let mut world = CollisionWorld::new(&solver);
+    world.add_collider(&ground(0.0))?;
+    world.enable_self_collision(&solver, &[0], SelfCollisionParams::default())?;
+    Ok((solver, world))
+}
+
 /// The OBJ mesh shipped with the project: a bumpy blob of radius ≈ 0.4 m (1280 triangles).
 pub fn blob_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/blob.obj")
