@@ -111,39 +111,44 @@ impl Analytic {
     /// The closest surface point to world point `x` at `pose`, if `x` is inside or within
     /// `max_dist` of the surface.
     pub fn closest(&self, pose: &WorldPose, x: DVec3, max_dist: f64) -> Option<SurfacePoint> {
-        let hit = match *self {
+        // Each shape's distance comes first; the rest only where it passes `max_dist`.
+        match *self {
             Self::Sphere { radius } => {
                 // Distance to a ball: |x − c| − r.
                 let v = x - pose.translation;
                 let len = v.length();
+                let distance = len - radius;
+                if distance > max_dist {
+                    return None;
+                }
                 let normal = if len > TINY {
                     v / len
                 } else {
                     pose.basis.y_axis
                 };
-                SurfacePoint {
+                Some(SurfacePoint {
                     point: pose.translation + normal * radius,
                     normal,
-                    distance: len - radius,
-                }
+                    distance,
+                })
             }
             Self::HalfSpace { normal } => {
                 // Distance to a plane n·x = n·t (Ericson, Real-Time Collision Detection, §5.1.1).
                 let n = pose.basis * normal;
-                let d = n.dot(x - pose.translation);
-                SurfacePoint {
-                    point: x - n * d,
+                let distance = n.dot(x - pose.translation);
+                (distance <= max_dist).then(|| SurfacePoint {
+                    point: x - n * distance,
                     normal: n,
-                    distance: d,
-                }
+                    distance,
+                })
             }
             Self::Cuboid { half } => {
-                let (q, n, d) = cuboid_closest(half, pose.inverse_transform_point(x));
-                SurfacePoint {
+                let (q, n, distance) = cuboid_closest(half, pose.inverse_transform_point(x));
+                (distance <= max_dist).then(|| SurfacePoint {
                     point: pose.transform_point(q),
                     normal: pose.basis * n,
-                    distance: d,
-                }
+                    distance,
+                })
             }
             Self::Capsule {
                 half_height,
@@ -158,20 +163,23 @@ impl Analytic {
                 let core = pose.translation + axis * s;
                 let v = x - core;
                 let len = v.length();
+                let distance = len - radius;
+                if distance > max_dist {
+                    return None;
+                }
                 // On the core segment itself every radial direction is closest: take local x.
                 let normal = if len > TINY {
                     v / len
                 } else {
                     pose.basis.x_axis
                 };
-                SurfacePoint {
+                Some(SurfacePoint {
                     point: core + normal * radius,
                     normal,
-                    distance: len - radius,
-                }
+                    distance,
+                })
             }
-        };
-        (hit.distance <= max_dist).then_some(hit)
+        }
     }
 
     /// First crossing of the segment `from → to` with the surface at `pose`, as
@@ -368,4 +376,79 @@ fn capsule_interval(
         ));
     }
     span
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, Vec3};
+
+    use crate::collider::{Collider, ColliderDesc};
+    use crate::shape::ShapeDesc;
+
+    use super::*;
+
+    /// What lets the world push a particle out of a closed-form shape once, without a
+    /// re-query: after a push along the normal to distance r, the particle is at distance r,
+    /// and any move in the plane normal to that normal (friction's) keeps it at least there.
+    #[test]
+    fn one_push_along_the_normal_clears_the_shell() {
+        let r = 0.05;
+        let shapes = [
+            ShapeDesc::Sphere { radius: 0.7 },
+            ShapeDesc::HalfSpace {
+                normal: Vec3::new(0.3, 1.0, -0.2),
+            },
+            ShapeDesc::Cuboid {
+                half_extents: Vec3::new(0.5, 0.3, 0.8),
+            },
+            ShapeDesc::Capsule {
+                half_height: 0.6,
+                radius: 0.4,
+            },
+        ];
+        let mut seed = 1u64;
+        let mut next = move || {
+            // 64-bit LCG (Knuth's MMIX constants), top 53 bits as a fraction in [0, 1).
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for shape in shapes {
+            let kind = shape.kind();
+            let c = Collider::new(
+                &ColliderDesc::new(shape)
+                    .at(Vec3::new(0.2, 0.1, -0.4))
+                    .rotated(Quat::from_axis_angle(
+                        Vec3::new(1.0, 1.0, 0.0).normalize(),
+                        0.7,
+                    )),
+            )
+            .expect("valid");
+            assert!(c.one_push_clears(), "{kind}");
+            let mut pushed = 0;
+            for _ in 0..3000 {
+                let x = DVec3::new(next(), next(), next()) * 2.4 - DVec3::splat(1.2)
+                    + DVec3::new(0.2, 0.1, -0.4);
+                let Some(s) = c.closest(x, r) else {
+                    continue;
+                };
+                let out = x + s.normal * (r - s.distance);
+                let after = c.closest(out, 2.0 * r).expect("at r");
+                assert!(
+                    (after.distance - r).abs() < 1e-12,
+                    "{kind}: {x} → {after:?}"
+                );
+                // A tangential move of up to 2r.
+                let t = DVec3::new(next(), next(), next()) - DVec3::splat(0.5);
+                let t = (t - s.normal * s.normal.dot(t)) * (4.0 * r);
+                let slid = c
+                    .closest(out + t, 2.0 * r)
+                    .map_or(f64::INFINITY, |s| s.distance);
+                assert!(slid >= r - 1e-12, "{kind}: {x} slid to distance {slid}");
+                pushed += 1;
+            }
+            assert!(pushed > 200, "{kind}: only {pushed} pushes");
+        }
+    }
 }

@@ -99,6 +99,8 @@ pub struct Collider {
     pose64: WorldPose,
     /// Pose at the start of the substep in f64.
     prev_pose64: WorldPose,
+    /// Whether the f64 pose did not change over the substep.
+    still: bool,
 }
 
 impl std::fmt::Debug for Collider {
@@ -145,6 +147,7 @@ impl Collider {
             rest64,
             pose64: start64,
             prev_pose64: start64,
+            still: true,
         })
     }
 
@@ -179,6 +182,16 @@ impl Collider {
         self.pose = compose(self.motion.transform(t1), &self.rest);
         self.prev_pose64 = carry(self.motion, t0, &self.rest64);
         self.pose64 = carry(self.motion, t1, &self.rest64);
+        self.still = self.pose64 == self.prev_pose64;
+    }
+
+    /// Whether one push along [`Self::closest`]'s normal to a distance r always clears a
+    /// contact, so that no re-query is needed: true for the closed-form shapes. They are
+    /// convex, so the points within r of one form a convex set; the push lands on its
+    /// boundary where the normal is the boundary's, and a move in that tangent plane
+    /// (friction's) stays outside.
+    pub(crate) fn one_push_clears(&self) -> bool {
+        self.analytic.is_some()
     }
 
     /// World AABB at the current pose grown by `margin`, or `None` if unbounded.
@@ -215,7 +228,7 @@ impl Collider {
     /// How far the material point of the collider now at `point` moved during this substep.
     pub fn displacement_at(&self, point: DVec3) -> DVec3 {
         if self.analytic.is_some() {
-            if self.pose64 == self.prev_pose64 {
+            if self.still {
                 return DVec3::ZERO; // exactly, as below
             }
             let local = self.pose64.inverse_transform_point(point);

@@ -47,7 +47,8 @@ pub struct CollisionWorld {
     stats: ContactStats,
 }
 
-/// Rounds of re-query per particle and collider (a push out of one face may land in another).
+/// Rounds of re-query per particle and collider (a push out of one face of a mesh may land in
+/// another); one for the closed-form shapes ([`Collider::one_push_clears`]).
 const ROUNDS: usize = 3;
 
 /// Particles per parallel task. Fixed, and every particle's contacts depend on that particle
@@ -240,10 +241,11 @@ fn sweep_one(
     x: &mut DVec3,
     r: f64,
 ) -> usize {
-    let step = (*x - from).length();
-    if step <= 0.5 * r.max(1e-6) {
+    let slow = 0.5 * r.max(1e-6);
+    if (*x - from).length_squared() <= slow * slow {
         return 0;
     }
+    let step = (*x - from).length();
     let mut swept = 0;
     for (c, b) in colliders.iter().zip(bounds) {
         // Cheap reject: a path whose box misses the collider's (grown) box cannot cross it.
@@ -271,8 +273,16 @@ fn sweep_one(
 fn resolve_one(c: &Collider, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64) {
     let friction = c.friction();
     let (mut contacts, mut deepest) = (0, 0.0f64);
-    for _ in 0..ROUNDS {
-        let Some(s) = c.closest(*x, 2.0 * r) else {
+    // A closed-form shape reports any point inside it, so only a surface nearer than r can
+    // overlap the shell (depth = r − distance > 0). A mesh reports points behind its surface
+    // only within the search distance, so it searches 2r to catch particles pushed deep.
+    let (rounds, reach) = if c.one_push_clears() {
+        (1, r)
+    } else {
+        (ROUNDS, 2.0 * r)
+    };
+    for _ in 0..rounds {
+        let Some(s) = c.closest(*x, reach) else {
             break;
         };
         let depth = r - s.distance;
