@@ -205,8 +205,9 @@ impl Collider {
     /// The closest surface point to `x` if it lies within `max_dist` of the surface or `x` is
     /// inside (for meshes: within `max_dist` on either side).
     ///
-    /// Particles are f64; parry works in f32, so the query point is rounded to f32 here and
-    /// the answer widened back (a ~1e-7 m error on the surface point, none on the state).
+    /// Spheres, half-spaces, cuboids and capsules are answered in closed form in f64. For the
+    /// other shapes parry works in f32, so the query point is rounded to f32 here and the
+    /// answer widened back (a ~1e-7 m error on the surface point, none on the state).
     pub fn closest(&self, x: DVec3, max_dist: f64) -> Option<SurfacePoint> {
         match &self.analytic {
             Some(a) => a.closest(&self.pose64, x, max_dist),
