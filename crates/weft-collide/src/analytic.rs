@@ -194,7 +194,7 @@ impl Analytic {
                 ((t0, at(t0)), (t1, at(t1)))
             }
             Self::HalfSpace { normal } => {
-                // n·(from + t d − p0) ≤ 0 is one half-line of t.
+                // n·(from + t d − p0) ≤ 0 is one half-line of t (segment–plane, Ericson §5.3.1).
                 let n = pose.basis * normal;
                 let dist = n.dot(from - pose.translation);
                 let rate = n.dot(d);
