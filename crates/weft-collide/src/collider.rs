@@ -7,6 +7,7 @@ use parry3d::query::{PointProjection, PointQuery, PointQueryWithLocation, Ray};
 use parry3d::shape::{Shape, SharedShape};
 use weft_solver::Motion;
 
+use crate::analytic::{Analytic, WorldPose};
 use crate::convert::{compose, pose};
 use crate::error::ShapeError;
 use crate::friction::Friction;
@@ -76,6 +77,9 @@ pub struct SurfacePoint {
 }
 
 /// A built collider: parry shape, rest pose, motion, friction and the current pose.
+///
+/// Spheres, half-spaces, cuboids and capsules are queried in closed form in f64
+/// (`analytic.rs`) with the pose held in f64; other shapes go through parry in f32.
 #[derive(Clone)]
 pub struct Collider {
     shape: SharedShape,
@@ -87,6 +91,16 @@ pub struct Collider {
     prev_pose: Pose,
     /// Local AABB; `None` for unbounded shapes (half-spaces).
     local_aabb: Option<Aabb>,
+    /// The closed form of the shape, where it has one.
+    analytic: Option<Analytic>,
+    /// Rest pose in f64.
+    rest64: WorldPose,
+    /// Current pose in f64.
+    pose64: WorldPose,
+    /// Pose at the start of the substep in f64.
+    prev_pose64: WorldPose,
+    /// Whether the f64 pose did not change over the substep.
+    still: bool,
 }
 
 impl std::fmt::Debug for Collider {
@@ -118,6 +132,8 @@ impl Collider {
         };
         let rest = pose(desc.position, desc.rotation.normalize());
         let start = compose(desc.motion.transform(0.0), &rest);
+        let rest64 = WorldPose::new(desc.position.as_dvec3(), desc.rotation.as_dquat());
+        let start64 = carry(desc.motion, 0.0, &rest64);
         Ok(Self {
             shape,
             kind: desc.shape.kind(),
@@ -127,6 +143,11 @@ impl Collider {
             pose: start,
             prev_pose: start,
             local_aabb,
+            analytic: Analytic::of(&desc.shape),
+            rest64,
+            pose64: start64,
+            prev_pose64: start64,
+            still: true,
         })
     }
 
@@ -159,6 +180,18 @@ impl Collider {
     pub fn set_time(&mut self, t0: f64, t1: f64) {
         self.prev_pose = compose(self.motion.transform(t0), &self.rest);
         self.pose = compose(self.motion.transform(t1), &self.rest);
+        self.prev_pose64 = carry(self.motion, t0, &self.rest64);
+        self.pose64 = carry(self.motion, t1, &self.rest64);
+        self.still = self.pose64 == self.prev_pose64;
+    }
+
+    /// Whether one push along [`Self::closest`]'s normal to a distance r always clears a
+    /// contact, so that no re-query is needed: true for the closed-form shapes. They are
+    /// convex, so the points within r of one form a convex set; the push lands on its
+    /// boundary where the normal is the boundary's, and a move in that tangent plane
+    /// (friction's) stays outside.
+    pub(crate) fn one_push_clears(&self) -> bool {
+        self.analytic.is_some()
     }
 
     /// World AABB at the current pose grown by `margin`, or `None` if unbounded.
@@ -172,9 +205,18 @@ impl Collider {
     /// The closest surface point to `x` if it lies within `max_dist` of the surface or `x` is
     /// inside (for meshes: within `max_dist` on either side).
     ///
-    /// Particles are f64; parry works in f32, so the query point is rounded to f32 here and
-    /// the answer widened back (a ~1e-7 m error on the surface point, none on the state).
+    /// Spheres, half-spaces, cuboids and capsules are answered in closed form in f64. For the
+    /// other shapes parry works in f32, so the query point is rounded to f32 here and the
+    /// answer widened back (a ~1e-7 m error on the surface point, none on the state).
     pub fn closest(&self, x: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        match &self.analytic {
+            Some(a) => a.closest(&self.pose64, x, max_dist),
+            None => self.parry_closest(x, max_dist),
+        }
+    }
+
+    /// [`Self::closest`] through parry's f32 queries, for any shape.
+    pub(crate) fn parry_closest(&self, x: DVec3, max_dist: f64) -> Option<SurfacePoint> {
         let local = self.pose.inverse_transform_point(x.as_vec3());
         let (q, n, d) = local_closest(self.shape.as_ref(), local, max_dist as f32)?;
         Some(SurfacePoint {
@@ -186,6 +228,13 @@ impl Collider {
 
     /// How far the material point of the collider now at `point` moved during this substep.
     pub fn displacement_at(&self, point: DVec3) -> DVec3 {
+        if self.analytic.is_some() {
+            if self.still {
+                return DVec3::ZERO; // exactly, as below
+            }
+            let local = self.pose64.inverse_transform_point(point);
+            return self.pose64.transform_point(local) - self.prev_pose64.transform_point(local);
+        }
         if self.pose == self.prev_pose {
             // Exactly zero: a round trip through the inverse pose would leave a rounding error
             // that is the same every substep, which friction would read as a slowly moving
@@ -198,6 +247,15 @@ impl Collider {
 
     /// First hit of the segment `from → to` with the surface: `(fraction, normal facing from)`.
     pub fn sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
+        let Some(shape) = &self.analytic else {
+            return self.parry_sweep(from, to);
+        };
+        let (toi, n) = shape.sweep(&self.pose64, from, to)?;
+        Some((toi, if n.dot(to - from) > 0.0 { -n } else { n }))
+    }
+
+    /// [`Self::sweep`] through parry's f32 ray cast, for any shape.
+    pub(crate) fn parry_sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
         let a = self.pose.inverse_transform_point(from.as_vec3());
         let b = self.pose.inverse_transform_point(to.as_vec3());
         let ray = Ray::new(a, b - a);
@@ -211,6 +269,12 @@ impl Collider {
             (self.pose.rotation * n).as_dvec3().normalize_or_zero(),
         ))
     }
+}
+
+/// The f64 pose of a body at `rest` carried by `motion` at time `t` (s).
+fn carry(motion: Motion, t: f64, rest: &WorldPose) -> WorldPose {
+    let m = motion.transform(t);
+    WorldPose::carry(m.rotation, m.translation, rest)
 }
 
 /// Signed closest-point query in the shape's frame: `(point, outward normal, signed distance)`.

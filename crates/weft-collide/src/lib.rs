@@ -3,6 +3,9 @@
 //! [`weft_solver::SubstepHook`] ([`CollisionWorld`]).
 #![warn(missing_docs)]
 
+mod analytic;
+#[cfg(test)]
+mod analytic_vs_parry;
 mod collider;
 mod convert;
 mod error;

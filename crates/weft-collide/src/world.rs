@@ -9,6 +9,8 @@
 //! v = (x − x_prev) / h then removes the normal approach velocity, exactly as it does for XPBD
 //! and PBD.
 
+use glam::DVec3;
+use rayon::prelude::*;
 use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 
 use crate::collider::{Collider, ColliderDesc};
@@ -36,13 +38,30 @@ pub struct CollisionWorld {
     colliders: Vec<Collider>,
     thickness: Vec<f64>,
     self_collision: Option<SelfCollision>,
-    candidates: Vec<Vec<u32>>,
+    /// Per collider, its world AABB at the current pose grown by [`Self::search_margin`], or
+    /// `None` if unbounded; refreshed every substep.
+    bounds: Vec<Option<Bounds>>,
+    /// Largest thickness of any particle (m).
+    max_thickness: f64,
     fresh: bool,
     stats: ContactStats,
 }
 
-/// Rounds of re-query per particle and collider (a push out of one face may land in another).
+/// Rounds of re-query per particle and collider (a push out of one face of a mesh may land in
+/// another); one for the closed-form shapes ([`Collider::one_push_clears`]).
 const ROUNDS: usize = 3;
+
+/// Particles per parallel task. Fixed, and every particle's contacts depend on that particle
+/// alone, so results are the same bit for bit for any number of threads.
+const CHUNK: usize = 1024;
+
+/// An axis-aligned box in f64: (min corner, max corner).
+type Bounds = (DVec3, DVec3);
+
+/// Whether `x` lies in `b` (`None`: unbounded, always).
+fn within(b: &Option<Bounds>, x: DVec3) -> bool {
+    b.is_none_or(|(lo, hi)| x.cmpge(lo).all() && x.cmple(hi).all())
+}
 
 impl CollisionWorld {
     /// An empty world for `solver`'s particles, with each cloth's thickness.
@@ -51,7 +70,8 @@ impl CollisionWorld {
             colliders: Vec::new(),
             thickness: Vec::new(),
             self_collision: None,
-            candidates: Vec::new(),
+            bounds: Vec::new(),
+            max_thickness: 0.0,
             fresh: true,
             stats: ContactStats::default(),
         };
@@ -65,6 +85,7 @@ impl CollisionWorld {
         for cloth in solver.cloths() {
             self.thickness[cloth.particles.clone()].fill(cloth.thickness);
         }
+        self.max_thickness = self.thickness.iter().copied().fold(0.0, f64::max);
         if let Some(sc) = &mut self.self_collision {
             sc.invalidate();
         }
@@ -73,7 +94,7 @@ impl CollisionWorld {
     /// Builds and adds a collider; returns its index.
     pub fn add_collider(&mut self, desc: &ColliderDesc) -> Result<usize, ShapeError> {
         self.colliders.push(Collider::new(desc)?);
-        self.candidates.push(Vec::new());
+        self.bounds.push(None);
         Ok(self.colliders.len() - 1)
     }
 
@@ -125,97 +146,159 @@ impl CollisionWorld {
         self.stats
     }
 
-    fn max_thickness(&self) -> f64 {
-        self.thickness.iter().copied().fold(0.0, f64::max)
+    /// How far outside a collider's AABB a particle may be and still be tested against it:
+    /// three thicknesses (contacts are sought within two), plus 0.1 mm for the f32 AABB.
+    fn search_margin(&self) -> f64 {
+        3.0 * self.max_thickness + 1e-4
     }
 
-    /// Once per substep, before the first projection: clamp, sweep, gather candidates.
+    /// Once per substep, before the first projection: clamp, then sweep.
     fn prepare(&mut self, p: &mut Particles) {
         if let Some(sc) = &self.self_collision {
             sc.clamp_displacements(p, &self.thickness);
         }
         self.sweep(p);
-        // Broad phase: one AABB per collider grown by the search margin; inside a mesh
-        // collider parry's BVH prunes triangles per query.
-        let margin = 3.0 * self.max_thickness();
-        for (collider, list) in self.colliders.iter().zip(&mut self.candidates) {
-            list.clear();
-            let aabb = collider.world_aabb(margin as f32);
-            for (i, x) in p.positions.iter().enumerate() {
-                if p.inv_masses[i] == 0.0 {
-                    continue;
-                }
-                let inside = aabb.is_none_or(|a| {
-                    x.cmpge(a.mins.as_dvec3()).all() && x.cmple(a.maxs.as_dvec3()).all()
-                });
-                if inside {
-                    list.push(i as u32);
-                }
-            }
-        }
     }
 
     /// Continuous collision for fast particles: a particle whose substep path crosses a
-    /// collider's surface is stopped a thickness before it.
+    /// collider's surface is stopped a thickness before it. In parallel over particles.
     fn sweep(&mut self, p: &mut Particles) {
-        let mut swept = 0;
-        for i in 0..p.len() {
-            let r = self.thickness[i];
-            let from = p.prev_positions[i];
-            let to = p.positions[i];
-            let step = (to - from).length();
-            if p.inv_masses[i] == 0.0 || step <= 0.5 * r.max(1e-6) {
-                continue;
-            }
-            for c in &self.colliders {
-                // Only a path that starts outside the surface can tunnel through it.
-                let outside = c.closest(from, step + r).is_none_or(|s| s.distance >= 0.0);
-                if !outside {
-                    continue;
-                }
-                if let Some((toi, n)) = c.sweep(from, p.positions[i]) {
-                    let hit = from + (p.positions[i] - from) * toi;
-                    p.positions[i] = hit + n * r;
-                    swept += 1;
-                }
-            }
+        if self.colliders.is_empty() {
+            self.stats.swept = 0;
+            return;
         }
-        self.stats.swept = swept;
+        let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
+        let Particles {
+            positions,
+            prev_positions,
+            inv_masses,
+            ..
+        } = p;
+        let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
+        self.stats.swept = positions
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(k, xs)| {
+                let mut swept = 0;
+                for (j, x) in xs.iter_mut().enumerate() {
+                    let i = k * CHUNK + j;
+                    if inv[i] != 0.0 {
+                        swept += sweep_one(colliders, bounds, prev[i], x, thickness[i]);
+                    }
+                }
+                swept
+            })
+            .sum();
     }
 
-    /// Pushes particles out of colliders to surface + thickness, with Coulomb friction.
+    /// Pushes particles out of colliders to surface + thickness, with Coulomb friction. In
+    /// parallel over particles; each particle meets the colliders in their order.
     fn resolve_colliders(&mut self, p: &mut Particles) -> usize {
-        let mut contacts = 0;
-        let mut deepest = self.stats.max_depth;
-        for (c, list) in self.colliders.iter().zip(&self.candidates) {
-            let friction = c.friction();
-            for &i in list {
-                let i = i as usize;
-                let r = self.thickness[i];
-                let mut x = p.positions[i];
-                for _ in 0..ROUNDS {
-                    let Some(s) = c.closest(x, 2.0 * r) else {
-                        break;
-                    };
-                    let depth = r - s.distance;
-                    if depth <= 1e-6 * r.max(1e-3) {
-                        break;
-                    }
-                    x += s.normal * depth;
-                    // Relative tangential displacement over the substep against the surface's
-                    // own motion there (Macklin et al. 2014, eq. 24).
-                    let rel = (x - p.prev_positions[i]) - c.displacement_at(s.point);
-                    let tangential = rel - s.normal * s.normal.dot(rel);
-                    x -= friction.correction(tangential, depth);
-                    contacts += 1;
-                    deepest = deepest.max(depth);
-                }
-                p.positions[i] = x;
-            }
+        if self.colliders.is_empty() {
+            return 0;
         }
-        self.stats.max_depth = deepest;
+        let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
+        let Particles {
+            positions,
+            prev_positions,
+            inv_masses,
+            ..
+        } = p;
+        let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
+        let (contacts, deepest) = positions
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(k, xs)| {
+                let (mut contacts, mut deepest) = (0, 0.0f64);
+                for (j, x) in xs.iter_mut().enumerate() {
+                    let i = k * CHUNK + j;
+                    if inv[i] == 0.0 {
+                        continue;
+                    }
+                    for (c, b) in colliders.iter().zip(bounds) {
+                        // Cheap reject: farther than the margin from the collider's box.
+                        if within(b, *x) {
+                            let (n, depth) = resolve_one(c, prev[i], x, thickness[i]);
+                            contacts += n;
+                            deepest = deepest.max(depth);
+                        }
+                    }
+                }
+                (contacts, deepest)
+            })
+            .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+        self.stats.max_depth = self.stats.max_depth.max(deepest);
         contacts
     }
+}
+
+/// Sweeps one particle's substep path `from → x` against every collider; returns how many
+/// stopped it.
+fn sweep_one(
+    colliders: &[Collider],
+    bounds: &[Option<Bounds>],
+    from: DVec3,
+    x: &mut DVec3,
+    r: f64,
+) -> usize {
+    let slow = 0.5 * r.max(1e-6);
+    if (*x - from).length_squared() <= slow * slow {
+        return 0;
+    }
+    let step = (*x - from).length();
+    let mut swept = 0;
+    for (c, b) in colliders.iter().zip(bounds) {
+        // Cheap reject: a path whose box misses the collider's (grown) box cannot cross it.
+        if let Some((lo, hi)) = b
+            && (from.min(*x).cmpgt(*hi).any() || from.max(*x).cmplt(*lo).any())
+        {
+            continue;
+        }
+        // Only a path that starts outside the surface can tunnel through it.
+        let outside = c.closest(from, step + r).is_none_or(|s| s.distance >= 0.0);
+        if !outside {
+            continue;
+        }
+        if let Some((toi, n)) = c.sweep(from, *x) {
+            let hit = from + (*x - from) * toi;
+            *x = hit + n * r;
+            swept += 1;
+        }
+    }
+    swept
+}
+
+/// Pushes one particle out of one collider to surface + `r`, with friction against the
+/// surface's motion; returns the contacts resolved and the deepest overlap.
+fn resolve_one(c: &Collider, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64) {
+    let friction = c.friction();
+    let (mut contacts, mut deepest) = (0, 0.0f64);
+    // A closed-form shape reports any point inside it, so only a surface nearer than r can
+    // overlap the shell (depth = r − distance > 0). A mesh reports points behind its surface
+    // only within the search distance, so it searches 2r to catch particles pushed deep.
+    let (rounds, reach) = if c.one_push_clears() {
+        (1, r)
+    } else {
+        (ROUNDS, 2.0 * r)
+    };
+    for _ in 0..rounds {
+        let Some(s) = c.closest(*x, reach) else {
+            break;
+        };
+        let depth = r - s.distance;
+        if depth <= 1e-6 * r.max(1e-3) {
+            break;
+        }
+        *x += s.normal * depth;
+        // Relative tangential displacement over the substep against the surface's own
+        // motion there (Macklin et al. 2014, eq. 24).
+        let rel = (*x - prev) - c.displacement_at(s.point);
+        let tangential = rel - s.normal * s.normal.dot(rel);
+        *x -= friction.correction(tangential, depth);
+        contacts += 1;
+        deepest = deepest.max(depth);
+    }
+    (contacts, deepest)
 }
 
 impl SubstepHook for CollisionWorld {
@@ -226,8 +309,13 @@ impl SubstepHook for CollisionWorld {
 
     fn begin_substep(&mut self, ctx: &SubstepContext, _particles: &Particles) {
         let t0 = ctx.time - ctx.h;
-        for c in &mut self.colliders {
+        let margin = self.search_margin();
+        for (c, b) in self.colliders.iter_mut().zip(&mut self.bounds) {
             c.set_time(t0, ctx.time);
+            *b = c.world_aabb(0.0).map(|a| {
+                let m = DVec3::splat(margin);
+                (a.mins.as_dvec3() - m, a.maxs.as_dvec3() + m)
+            });
         }
         self.fresh = true;
         self.stats = ContactStats::default();

@@ -1,6 +1,7 @@
 //! External forces: gravity, wind (uniform drag and per-triangle aerodynamics), global damping.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::error::ParamError;
 use crate::particles::Particles;
@@ -94,9 +95,16 @@ impl Forces {
     /// Writes every particle's external acceleration (m/s²) into `accel`.
     pub(crate) fn accelerations(&self, p: &Particles, triangles: &[[u32; 3]], accel: &mut [DVec3]) {
         let wind = self.wind;
-        for (a, v) in accel.iter_mut().zip(&p.velocities) {
-            *a = self.gravity + wind.drag * (wind.velocity - *v);
-        }
+        let gravity = self.gravity;
+        // Per particle, in parallel (each result depends on that particle alone).
+        accel
+            .par_chunks_mut(1024)
+            .zip(p.velocities.par_chunks(1024))
+            .for_each(|(a, v)| {
+                for (a, v) in a.iter_mut().zip(v) {
+                    *a = gravity + wind.drag * (wind.velocity - *v);
+                }
+            });
         if let Some(aero) = wind.aero {
             for t in triangles {
                 let f = aero_force(aero, wind.velocity, p, t);

@@ -3,6 +3,7 @@
 use std::ops::Range;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::constraints::{ConstraintSet, Residual, Rule};
 use crate::domains::{DomainStats, Domains, Finish, Integration};
@@ -69,6 +70,10 @@ pub struct Solver {
     time: f64,
     frame: u64,
 }
+
+/// Particles per parallel task in the general loop's per-particle passes. Each particle's
+/// update reads only its own state, so results do not depend on the thread count.
+const CHUNK: usize = 1024;
 
 impl Solver {
     #[allow(clippy::too_many_arguments)]
@@ -406,13 +411,21 @@ impl Solver {
             );
             // Semi-implicit Euler: v ← v + h a, x ← x + h v (for PBD/XPBD, the prediction).
             let p = &mut self.particles;
-            for i in 0..p.len() {
-                p.prev_positions[i] = p.positions[i];
-                if p.inv_masses[i] > 0.0 {
-                    p.velocities[i] += self.accel[i] * h;
-                    p.positions[i] += p.velocities[i] * h;
-                }
-            }
+            p.positions
+                .par_chunks_mut(CHUNK)
+                .zip(p.prev_positions.par_chunks_mut(CHUNK))
+                .zip(p.velocities.par_chunks_mut(CHUNK))
+                .zip(p.inv_masses.par_chunks(CHUNK))
+                .zip(self.accel.par_chunks(CHUNK))
+                .for_each(|((((x, prev), v), w), a)| {
+                    for j in 0..x.len() {
+                        prev[j] = x[j];
+                        if w[j] > 0.0 {
+                            v[j] += a[j] * h;
+                            x[j] += v[j] * h;
+                        }
+                    }
+                });
             for &(i, x) in &self.targets {
                 p.positions[i] = x;
             }
@@ -442,17 +455,28 @@ impl Solver {
             // Velocities from positions (the PBD update; for mass-spring it equals v unless
             // a contact moved the particle).
             let inv_h = 1.0 / h;
-            for i in 0..p.len() {
-                p.velocities[i] = (p.positions[i] - p.prev_positions[i]) * inv_h;
-            }
+            p.velocities
+                .par_chunks_mut(CHUNK)
+                .zip(p.positions.par_chunks(CHUNK))
+                .zip(p.prev_positions.par_chunks(CHUNK))
+                .for_each(|((v, x), prev)| {
+                    for j in 0..v.len() {
+                        v[j] = (x[j] - prev[j]) * inv_h;
+                    }
+                });
             hook.end_substep(&ctx, p);
             if self.forces.damping > 0.0 {
                 let keep = (-self.forces.damping * h).exp();
-                for (v, w) in p.velocities.iter_mut().zip(&p.inv_masses) {
-                    if *w > 0.0 {
-                        *v *= keep;
-                    }
-                }
+                p.velocities
+                    .par_chunks_mut(CHUNK)
+                    .zip(p.inv_masses.par_chunks(CHUNK))
+                    .for_each(|(v, w)| {
+                        for (v, w) in v.iter_mut().zip(w) {
+                            if *w > 0.0 {
+                                *v *= keep;
+                            }
+                        }
+                    });
             }
         }
         stats
