@@ -114,23 +114,7 @@ impl Analytic {
         // Each shape's distance comes first; the rest only where it passes `max_dist`.
         match *self {
             Self::Sphere { radius } => {
-                // Distance to a ball: |x − c| − r.
-                let v = x - pose.translation;
-                let len = v.length();
-                let distance = len - radius;
-                if distance > max_dist {
-                    return None;
-                }
-                let normal = if len > TINY {
-                    v / len
-                } else {
-                    pose.basis.y_axis
-                };
-                Some(SurfacePoint {
-                    point: pose.translation + normal * radius,
-                    normal,
-                    distance,
-                })
+                ball_closest(pose.translation, radius, x, max_dist, pose.basis.y_axis)
             }
             Self::HalfSpace { normal } => {
                 // Distance to a plane n·x = n·t (Ericson, Real-Time Collision Detection, §5.1.1).
@@ -161,23 +145,8 @@ impl Analytic {
                     .dot(x - pose.translation)
                     .clamp(-half_height, half_height);
                 let core = pose.translation + axis * s;
-                let v = x - core;
-                let len = v.length();
-                let distance = len - radius;
-                if distance > max_dist {
-                    return None;
-                }
                 // On the core segment itself every radial direction is closest: take local x.
-                let normal = if len > TINY {
-                    v / len
-                } else {
-                    pose.basis.x_axis
-                };
-                Some(SurfacePoint {
-                    point: core + normal * radius,
-                    normal,
-                    distance,
-                })
+                ball_closest(core, radius, x, max_dist, pose.basis.x_axis)
             }
         }
     }
@@ -235,6 +204,30 @@ impl Analytic {
         let (t, n) = if enter.0 >= 0.0 { enter } else { leave };
         (0.0..=1.0).contains(&t).then_some((t, n))
     }
+}
+
+/// The closest point on the surface of the ball of `radius` about `center` to `x`, if `x` is
+/// inside or within `max_dist`: distance |x − c| − r along (x − c)/|x − c|, or along
+/// `fallback` when `x` is at the centre.
+fn ball_closest(
+    center: DVec3,
+    radius: f64,
+    x: DVec3,
+    max_dist: f64,
+    fallback: DVec3,
+) -> Option<SurfacePoint> {
+    let v = x - center;
+    let len = v.length();
+    let distance = len - radius;
+    if distance > max_dist {
+        return None;
+    }
+    let normal = if len > TINY { v / len } else { fallback };
+    Some(SurfacePoint {
+        point: center + normal * radius,
+        normal,
+        distance,
+    })
 }
 
 /// Closest boundary point of the box |p_i| ≤ h_i to local point `p`: (point, outward normal,
@@ -382,8 +375,8 @@ fn capsule_interval(
 mod tests {
     use glam::{Quat, Vec3};
 
+    use crate::analytic_vs_parry::{Rng, shapes};
     use crate::collider::{Collider, ColliderDesc};
-    use crate::shape::ShapeDesc;
 
     use super::*;
 
@@ -393,28 +386,8 @@ mod tests {
     #[test]
     fn one_push_along_the_normal_clears_the_shell() {
         let r = 0.05;
-        let shapes = [
-            ShapeDesc::Sphere { radius: 0.7 },
-            ShapeDesc::HalfSpace {
-                normal: Vec3::new(0.3, 1.0, -0.2),
-            },
-            ShapeDesc::Cuboid {
-                half_extents: Vec3::new(0.5, 0.3, 0.8),
-            },
-            ShapeDesc::Capsule {
-                half_height: 0.6,
-                radius: 0.4,
-            },
-        ];
-        let mut seed = 1u64;
-        let mut next = move || {
-            // 64-bit LCG (Knuth's MMIX constants), top 53 bits as a fraction in [0, 1).
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for shape in shapes {
+        let mut rng = Rng(1);
+        for shape in shapes() {
             let kind = shape.kind();
             let c = Collider::new(
                 &ColliderDesc::new(shape)
@@ -428,8 +401,7 @@ mod tests {
             assert!(c.one_push_clears(), "{kind}");
             let mut pushed = 0;
             for _ in 0..3000 {
-                let x = DVec3::new(next(), next(), next()) * 2.4 - DVec3::splat(1.2)
-                    + DVec3::new(0.2, 0.1, -0.4);
+                let x = rng.cube(1.2) + DVec3::new(0.2, 0.1, -0.4);
                 let Some(s) = c.closest(x, r) else {
                     continue;
                 };
@@ -440,7 +412,7 @@ mod tests {
                     "{kind}: {x} → {after:?}"
                 );
                 // A tangential move of up to 2r.
-                let t = DVec3::new(next(), next(), next()) - DVec3::splat(0.5);
+                let t = rng.cube(0.5);
                 let t = (t - s.normal * s.normal.dot(t)) * (4.0 * r);
                 let slid = c
                     .closest(out + t, 2.0 * r)

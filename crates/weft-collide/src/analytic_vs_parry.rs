@@ -12,10 +12,10 @@ use crate::shape::ShapeDesc;
 const TOL: f64 = 1e-5;
 
 /// splitmix64: a small deterministic generator.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn next(&mut self) -> f64 {
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -25,12 +25,13 @@ impl Rng {
     }
 
     /// Uniform in [−s, s]³.
-    fn cube(&mut self, s: f64) -> DVec3 {
+    pub(crate) fn cube(&mut self, s: f64) -> DVec3 {
         DVec3::new(self.next(), self.next(), self.next()) * (2.0 * s) - DVec3::splat(s)
     }
 }
 
-fn shapes() -> Vec<ShapeDesc> {
+/// One of each closed-form shape, in general position.
+pub(crate) fn shapes() -> Vec<ShapeDesc> {
     vec![
         ShapeDesc::Sphere { radius: 0.7 },
         ShapeDesc::HalfSpace {

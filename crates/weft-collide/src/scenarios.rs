@@ -152,10 +152,37 @@ pub fn self_fold(
 ) -> Result<(Solver, CollisionWorld), CollideError> {
     let (width, height) = (0.3, 0.9);
     let spacing = (width / (columns.max(2) - 1) as f64).max(height / (rows.max(2) - 1) as f64);
-    let thickness = spacing;
+    folding_sheet(method, "strip", (columns, rows), (width, height), spacing)
+}
+
+/// A vertical square curtain (`n`×`n`, 0.9 m, thickness = particle spacing) 5 cm above the
+/// ground, with [`self_fold`]'s wavy sideways velocity: it buckles and folds onto itself in
+/// layers, every particle ending in contact with the layer below or above it. Square cells,
+/// so at any `n` each particle's in-plane neighbourhood is the same.
+pub fn curtain_fold(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
+    let size = 0.9;
+    folding_sheet(
+        method,
+        "curtain",
+        (n, n),
+        (size, size),
+        size / (n.max(2) - 1) as f64,
+    )
+}
+
+/// A vertical sheet of `resolution` particles and `size` m whose bottom edge is 5 cm above the
+/// ground, on the ground with self-collision. A small wavy sideways velocity breaks the
+/// symmetry so that it buckles into folds instead of balancing on its edge.
+fn folding_sheet(
+    method: Method,
+    name: &str,
+    resolution: (usize, usize),
+    (width, height): (f64, f64),
+    thickness: f64,
+) -> Result<(Solver, CollisionWorld), CollideError> {
     let bottom = 0.05;
     let mesh = GridDesc {
-        resolution: (columns, rows),
+        resolution,
         size: (width, height),
         center: DVec3::new(0.0, bottom + 0.5 * height, 0.0),
         orientation: Orientation::Vertical,
@@ -164,38 +191,7 @@ pub fn self_fold(
     }
     .build()
     .map_err(solver_error)?;
-    let mut solver = build_one(method, "strip", &mesh, thickness)?;
-    // A small wavy sideways velocity breaks the symmetry so that the strip buckles into folds
-    // instead of balancing on its edge.
-    let p = solver.particles_mut();
-    for i in 0..p.len() {
-        let y = p.positions[i].y - bottom;
-        p.velocities[i].z = 0.3 * (std::f64::consts::TAU * y / 0.3).sin();
-    }
-    let mut world = CollisionWorld::new(&solver);
-    world.add_collider(&ground(0.0))?;
-    world.enable_self_collision(&solver, &[0], SelfCollisionParams::default())?;
-    Ok((solver, world))
-}
-
-/// A vertical square curtain (`n`×`n`, 0.9 m, thickness = particle spacing) 5 cm above the
-/// ground, with [`self_fold`]'s wavy sideways velocity: it buckles and folds onto itself in
-/// layers, every particle ending in contact with the layer below or above it. Square cells,
-/// so at any `n` each particle's in-plane neighbourhood is the same.
-pub fn curtain_fold(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
-    let (size, bottom) = (0.9, 0.05);
-    let thickness = size / (n.max(2) - 1) as f64;
-    let mesh = GridDesc {
-        resolution: (n, n),
-        size: (size, size),
-        center: DVec3::new(0.0, bottom + 0.5 * size, 0.0),
-        orientation: Orientation::Vertical,
-        mass: Mass::Total(0.2),
-        pins: vec![],
-    }
-    .build()
-    .map_err(solver_error)?;
-    let mut solver = build_one(method, "curtain", &mesh, thickness)?;
+    let mut solver = build_one(method, name, &mesh, thickness)?;
     let p = solver.particles_mut();
     for i in 0..p.len() {
         let y = p.positions[i].y - bottom;

@@ -657,12 +657,17 @@ impl SelfCollision {
                 find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
             })
             .reduce(|| 0.0, f64::max);
-        let found: Vec<&Vec<Contact>> = self.contacts.iter().map(|(_, out)| out).collect();
         let n = p.positions.len();
         self.sums.resize(n, DVec3::ZERO);
         self.counts.resize(n, 0);
-        apply(&found, &mut p.positions, &mut self.sums, &mut self.counts);
-        (found.iter().map(|c| c.len()).sum(), deepest)
+        apply(
+            &self.contacts,
+            &mut p.positions,
+            &mut self.sums,
+            &mut self.counts,
+        );
+        let contacts = self.contacts.iter().map(|(_, c)| c.len()).sum();
+        (contacts, deepest)
     }
 }
 

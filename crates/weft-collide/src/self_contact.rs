@@ -214,16 +214,17 @@ fn contacts<const L: usize>(
     }
 }
 
-/// Moves every particle with a contact in `found` by the mean of its corrections; `sums` and
+/// Moves every particle with a contact in `found` (per list: scratch, contacts) by the mean
+/// of its corrections; `sums` and
 /// `counts` (one per particle, zero on entry) are scratch and zero again on return. Runs over
 /// ranges of particles on rayon's threads, each range reading every contact.
 pub(crate) fn apply(
-    found: &[&Vec<Contact>],
+    found: &[(Vec<u32>, Vec<Contact>)],
     positions: &mut [DVec3],
     sums: &mut [DVec3],
     counts: &mut [u32],
 ) {
-    let total: usize = found.iter().map(|c| c.len()).sum();
+    let total: usize = found.iter().map(|(_, c)| c.len()).sum();
     if total == 0 {
         return;
     }
@@ -245,7 +246,7 @@ pub(crate) fn apply(
                     sums[j] += DVec3::from_array(*d);
                 }
             };
-            for c in found.iter().copied().flatten() {
+            for c in found.iter().flat_map(|(_, c)| c) {
                 add(c.a, &c.da);
                 add(c.b, &c.db);
             }
@@ -284,7 +285,7 @@ mod tests {
         let mut x = x.to_vec();
         let mut sums = vec![DVec3::ZERO; x.len()];
         let mut counts = vec![0; x.len()];
-        apply(&[&out], &mut x, &mut sums, &mut counts);
+        apply(&[(hits, out)], &mut x, &mut sums, &mut counts);
         assert!(sums.iter().all(|s| *s == DVec3::ZERO) && counts.iter().all(|&c| c == 0));
         x
     }
@@ -357,7 +358,9 @@ mod tests {
             find_contacts((&a, &b, &t), state, friction, &mut hits, &mut out);
             let mut moved = x.clone();
             let (mut sums, mut counts) = (vec![DVec3::ZERO; n], vec![0; n]);
-            apply(&[&out], &mut moved, &mut sums, &mut counts);
+            let found = [(hits, out)];
+            apply(&found, &mut moved, &mut sums, &mut counts);
+            let [(_, out)] = found;
             (moved, out)
         };
         let (first, contacts) = run(&pairs);

@@ -168,27 +168,12 @@ impl CollisionWorld {
             return;
         }
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
-        let Particles {
-            positions,
-            prev_positions,
-            inv_masses,
-            ..
-        } = p;
-        let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
-        self.stats.swept = positions
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(k, xs)| {
-                let mut swept = 0;
-                for (j, x) in xs.iter_mut().enumerate() {
-                    let i = k * CHUNK + j;
-                    if inv[i] != 0.0 {
-                        swept += sweep_one(colliders, bounds, prev[i], x, thickness[i]);
-                    }
-                }
-                swept
-            })
-            .sum();
+        self.stats.swept = over_free_particles(
+            p,
+            0,
+            |i, x, prev| sweep_one(colliders, bounds, prev, x, thickness[i]),
+            |a, b| a + b,
+        );
     }
 
     /// Pushes particles out of colliders to surface + thickness, with Coulomb friction. In
@@ -198,38 +183,59 @@ impl CollisionWorld {
             return 0;
         }
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
-        let Particles {
-            positions,
-            prev_positions,
-            inv_masses,
-            ..
-        } = p;
-        let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
-        let (contacts, deepest) = positions
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(k, xs)| {
+        let (contacts, deepest) = over_free_particles(
+            p,
+            (0, 0.0f64),
+            |i, x, prev| {
                 let (mut contacts, mut deepest) = (0, 0.0f64);
-                for (j, x) in xs.iter_mut().enumerate() {
-                    let i = k * CHUNK + j;
-                    if inv[i] == 0.0 {
-                        continue;
-                    }
-                    for (c, b) in colliders.iter().zip(bounds) {
-                        // Cheap reject: farther than the margin from the collider's box.
-                        if within(b, *x) {
-                            let (n, depth) = resolve_one(c, prev[i], x, thickness[i]);
-                            contacts += n;
-                            deepest = deepest.max(depth);
-                        }
+                for (c, b) in colliders.iter().zip(bounds) {
+                    // Cheap reject: farther than the margin from the collider's box.
+                    if within(b, *x) {
+                        let (n, depth) = resolve_one(c, prev, x, thickness[i]);
+                        contacts += n;
+                        deepest = deepest.max(depth);
                     }
                 }
                 (contacts, deepest)
-            })
-            .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+            },
+            |a, b| (a.0 + b.0, a.1.max(b.1)),
+        );
         self.stats.max_depth = self.stats.max_depth.max(deepest);
         contacts
     }
+}
+
+/// Calls `f(i, position, previous position)` for every particle with a nonzero inverse mass,
+/// in parallel over fixed chunks of [`CHUNK`] particles, and folds the results with
+/// `combine`, which must not depend on order (sums of counts, maxima) so that the answer is
+/// the same on any thread count.
+fn over_free_particles<T: Copy + Send + Sync>(
+    p: &mut Particles,
+    zero: T,
+    f: impl Fn(usize, &mut DVec3, DVec3) -> T + Sync,
+    combine: impl Fn(T, T) -> T + Sync + Send,
+) -> T {
+    let Particles {
+        positions,
+        prev_positions,
+        inv_masses,
+        ..
+    } = p;
+    let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
+    positions
+        .par_chunks_mut(CHUNK)
+        .enumerate()
+        .map(|(k, xs)| {
+            let mut acc = zero;
+            for (j, x) in xs.iter_mut().enumerate() {
+                let i = k * CHUNK + j;
+                if inv[i] != 0.0 {
+                    acc = combine(acc, f(i, x, prev[i]));
+                }
+            }
+            acc
+        })
+        .reduce(|| zero, &combine)
 }
 
 /// Sweeps one particle's substep path `from → x` against every collider; returns how many
