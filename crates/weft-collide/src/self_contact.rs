@@ -30,8 +30,8 @@ fn quantize(v: f64) -> f64 {
     (v + ROUND) - ROUND
 }
 
-/// Touching pairs handled together by the contact kernel.
-const LANES: usize = 8;
+/// Touching pairs gathered into one block before the contact kernel runs over them.
+const BLOCK: usize = 64;
 
 /// Fewest particles per task when the corrections are summed.
 const SUM_CHUNK: usize = 2048;
@@ -82,134 +82,163 @@ pub(crate) fn find_contacts<'a>(
     }
     hits.truncate(n);
     out.reserve(n);
-    let mut deepest = [0.0f64; LANES];
-    let mut chunks = hits.chunks_exact(LANES);
-    for chunk in &mut chunks {
-        let mut lanes = [0u32; LANES];
-        lanes.copy_from_slice(chunk);
-        contacts::<LANES>(lanes, (a, b, target), s, friction, out, &mut deepest);
-    }
-    for &k in chunks.remainder() {
-        contacts::<1>([k], (a, b, target), s, friction, out, &mut deepest[..1]);
+    let mut deepest = [0.0f64; BLOCK];
+    let mut block = Block::EMPTY;
+    for chunk in hits.chunks(BLOCK) {
+        block.gather(chunk, (a, b, target), s);
+        block.contacts(friction, out, &mut deepest);
     }
     deepest.into_iter().fold(0.0, f64::max)
 }
 
-/// The corrections of the touching pairs `ks` (`L` of them), lane by lane: the contact is the
-/// distance constraint C = |xa − xb| − target ≥ 0 projected with mass weights (Müller et al.
-/// 2007, eq. 9–10), then position-based Coulomb friction on the relative tangential
-/// displacement over the substep ([`Friction::correction`], Macklin et al. 2014, eq. 24).
-/// Every step is a loop over lanes with selects instead of branches, so that it compiles to
-/// vector instructions (measured about 1.25× faster than one pair at a time at 128²); the scalar
-/// remainder (`L = 1`) runs the same operations, so a pair's result does not depend on which
-/// path computed it. Lanes where neither particle can move, or the two coincide, are dropped.
-#[inline(always)]
-fn contacts<const L: usize>(
-    ks: [u32; L],
-    (a, b, target): (&[u32], &[u32], &[f64]),
-    s: State<'_>,
-    friction: Friction,
-    out: &mut Vec<Contact>,
-    deepest: &mut [f64],
-) {
-    // Plain loops rather than nested `array::from_fn`: those were not inlined, and every
-    // array made that way went through a call and a stalled store-to-load copy.
-    let mut ia = [0usize; L];
-    let mut ib = [0usize; L];
-    let mut t = [0.0; L];
-    let (mut xa, mut xb, mut pa, mut pb) =
-        ([[0.0; L]; 3], [[0.0; L]; 3], [[0.0; L]; 3], [[0.0; L]; 3]);
-    let (mut wa, mut wb) = ([0.0; L], [0.0; L]);
-    for l in 0..L {
-        let k = ks[l] as usize;
-        (ia[l], ib[l], t[l]) = (a[k] as usize, b[k] as usize, target[k]);
-        let (p, q, pp, pq) = (s.x[ia[l]], s.x[ib[l]], s.prev[ia[l]], s.prev[ib[l]]);
+/// The data of up to [`BLOCK`] touching pairs, one lane each, as struct-of-arrays; unused
+/// lanes have no mass and give no contact.
+///
+/// Gathering first and computing after, in separate loops, lets the kernel load whole
+/// vectors: loading a vector just assembled from scalar stores stalls on every load (store
+/// forwarding fails), which cost the kernel about half its time when it gathered eight pairs
+/// at a time.
+struct Block {
+    len: usize,
+    ia: [u32; BLOCK],
+    ib: [u32; BLOCK],
+    t: [f64; BLOCK],
+    xa: [[f64; BLOCK]; 3],
+    xb: [[f64; BLOCK]; 3],
+    pa: [[f64; BLOCK]; 3],
+    pb: [[f64; BLOCK]; 3],
+    wa: [f64; BLOCK],
+    wb: [f64; BLOCK],
+}
+
+impl Block {
+    const EMPTY: Self = Self {
+        len: 0,
+        ia: [0; BLOCK],
+        ib: [0; BLOCK],
+        t: [0.0; BLOCK],
+        xa: [[0.0; BLOCK]; 3],
+        xb: [[0.0; BLOCK]; 3],
+        pa: [[0.0; BLOCK]; 3],
+        pb: [[0.0; BLOCK]; 3],
+        wa: [0.0; BLOCK],
+        wb: [0.0; BLOCK],
+    };
+
+    /// Loads the pairs `ks` (at most [`BLOCK`]) of the list; the lanes after them get no mass.
+    #[inline(always)]
+    fn gather(&mut self, ks: &[u32], (a, b, target): (&[u32], &[u32], &[f64]), s: State<'_>) {
+        self.len = ks.len();
+        for (l, &k) in ks.iter().enumerate() {
+            let k = k as usize;
+            let (i, j) = (a[k], b[k]);
+            (self.ia[l], self.ib[l], self.t[l]) = (i, j, target[k]);
+            let (i, j) = (i as usize, j as usize);
+            let (p, q, pp, pq) = (s.x[i], s.x[j], s.prev[i], s.prev[j]);
+            for c in 0..3 {
+                self.xa[c][l] = p[c];
+                self.xb[c][l] = q[c];
+                self.pa[c][l] = pp[c];
+                self.pb[c][l] = pq[c];
+            }
+            self.wa[l] = s.w[i];
+            self.wb[l] = s.w[j];
+        }
+        for l in ks.len()..BLOCK {
+            self.wa[l] = 0.0;
+            self.wb[l] = 0.0;
+        }
+    }
+
+    /// The corrections of the block's pairs, lane by lane: the contact is the distance
+    /// constraint C = |xa − xb| − target ≥ 0 projected with mass weights (Müller et al. 2007,
+    /// eq. 9–10), then position-based Coulomb friction on the relative tangential
+    /// displacement over the substep ([`Friction::correction`], Macklin et al. 2014, eq. 24).
+    /// Every step is a loop over all lanes with selects instead of branches, so that it
+    /// compiles to vector instructions; a pair's result does not depend on its lane or on the
+    /// other pairs of the block. Lanes where neither particle can move, or the two coincide,
+    /// are dropped; the others are appended to `out`.
+    #[inline(always)]
+    fn contacts(&self, friction: Friction, out: &mut Vec<Contact>, deepest: &mut [f64; BLOCK]) {
+        let (xa, xb, pa, pb) = (&self.xa, &self.xb, &self.pa, &self.pb);
+        let mut d = [[0.0; BLOCK]; 3];
+        let mut d2 = [0.0; BLOCK];
         for c in 0..3 {
-            xa[c][l] = p[c];
-            xb[c][l] = q[c];
-            pa[c][l] = pp[c];
-            pb[c][l] = pq[c];
+            for l in 0..BLOCK {
+                d[c][l] = xa[c][l] - xb[c][l];
+                d2[l] += d[c][l] * d[c][l];
+            }
         }
-        wa[l] = s.w[ia[l]];
-        wb[l] = s.w[ib[l]];
-    }
-    let mut d = [[0.0; L]; 3];
-    let mut d2 = [0.0; L];
-    for c in 0..3 {
-        for l in 0..L {
-            d[c][l] = xa[c][l] - xb[c][l];
-            d2[l] += d[c][l] * d[c][l];
+        let mut depth = [0.0; BLOCK];
+        let mut valid = [false; BLOCK];
+        let mut fa = [0.0; BLOCK];
+        let mut fb = [0.0; BLOCK];
+        let mut n = [[0.0; BLOCK]; 3];
+        for l in 0..BLOCK {
+            let dist = d2[l].sqrt();
+            let sum = self.wa[l] + self.wb[l];
+            valid[l] = sum > 0.0 && dist > 1e-9;
+            let inv_dist = if valid[l] { 1.0 / dist } else { 0.0 };
+            let inv_sum = if valid[l] { 1.0 / sum } else { 0.0 };
+            depth[l] = self.t[l] - dist;
+            fa[l] = self.wa[l] * inv_sum;
+            fb[l] = self.wb[l] * inv_sum;
+            for c in 0..3 {
+                n[c][l] = d[c][l] * inv_dist;
+            }
         }
-    }
-    let mut depth = [0.0; L];
-    let mut valid = [false; L];
-    let mut fa = [0.0; L];
-    let mut fb = [0.0; L];
-    let mut n = [[0.0; L]; 3];
-    for l in 0..L {
-        let dist = d2[l].sqrt();
-        let sum = wa[l] + wb[l];
-        valid[l] = sum > 0.0 && dist > 1e-9;
-        let inv_dist = if valid[l] { 1.0 / dist } else { 0.0 };
-        let inv_sum = if valid[l] { 1.0 / sum } else { 0.0 };
-        depth[l] = t[l] - dist;
-        fa[l] = wa[l] * inv_sum;
-        fb[l] = wb[l] * inv_sum;
+        // Normal push: Δxa = +n depth wa / (wa + wb), Δxb = −n depth wb / (wa + wb).
+        let mut da = [[0.0; BLOCK]; 3];
+        let mut db = [[0.0; BLOCK]; 3];
+        let mut dot = [0.0; BLOCK];
+        let mut rel = [[0.0; BLOCK]; 3];
         for c in 0..3 {
-            n[c][l] = d[c][l] * inv_dist;
+            for l in 0..BLOCK {
+                da[c][l] = n[c][l] * (depth[l] * fa[l]);
+                db[c][l] = -n[c][l] * (depth[l] * fb[l]);
+                rel[c][l] = (xa[c][l] + da[c][l] - pa[c][l]) - (xb[c][l] + db[c][l] - pb[c][l]);
+                dot[l] += n[c][l] * rel[c][l];
+            }
         }
-    }
-    // Normal push: Δxa = +n depth wa / (wa + wb), Δxb = −n depth wb / (wa + wb).
-    let mut da = [[0.0; L]; 3];
-    let mut db = [[0.0; L]; 3];
-    let mut dot = [0.0; L];
-    let mut rel = [[0.0; L]; 3];
-    for c in 0..3 {
-        for l in 0..L {
-            da[c][l] = n[c][l] * (depth[l] * fa[l]);
-            db[c][l] = -n[c][l] * (depth[l] * fb[l]);
-            rel[c][l] = (xa[c][l] + da[c][l] - pa[c][l]) - (xb[c][l] + db[c][l] - pb[c][l]);
-            dot[l] += n[c][l] * rel[c][l];
+        let mut tangential = [[0.0; BLOCK]; 3];
+        let mut slip2 = [0.0; BLOCK];
+        for c in 0..3 {
+            for l in 0..BLOCK {
+                tangential[c][l] = rel[c][l] - n[c][l] * dot[l];
+                slip2[l] += tangential[c][l] * tangential[c][l];
+            }
         }
-    }
-    let mut tangential = [[0.0; L]; 3];
-    let mut slip2 = [0.0; L];
-    for c in 0..3 {
-        for l in 0..L {
-            tangential[c][l] = rel[c][l] - n[c][l] * dot[l];
-            slip2[l] += tangential[c][l] * tangential[c][l];
+        // Friction::correction as a factor on the tangential slip: 1 when static, the dynamic
+        // reduction μk d / |slip| (at most 1) otherwise, 0 without slip.
+        let (mu_s, mu_k) = (friction.static_coefficient, friction.dynamic_coefficient);
+        let mut factor = [0.0; BLOCK];
+        for l in 0..BLOCK {
+            let slip = slip2[l].sqrt();
+            let dynamic = (mu_k * depth[l] / slip).min(1.0);
+            let f = if slip < mu_s * depth[l] { 1.0 } else { dynamic };
+            factor[l] = if depth[l] <= 0.0 || slip <= 0.0 {
+                0.0
+            } else {
+                f
+            };
         }
-    }
-    // Friction::correction as a factor on the tangential slip: 1 when static, the dynamic
-    // reduction μk d / |slip| (at most 1) otherwise, 0 without slip.
-    let (mu_s, mu_k) = (friction.static_coefficient, friction.dynamic_coefficient);
-    let mut factor = [0.0; L];
-    for l in 0..L {
-        let slip = slip2[l].sqrt();
-        let dynamic = (mu_k * depth[l] / slip).min(1.0);
-        let f = if slip < mu_s * depth[l] { 1.0 } else { dynamic };
-        factor[l] = if depth[l] <= 0.0 || slip <= 0.0 {
-            0.0
-        } else {
-            f
-        };
-    }
-    for c in 0..3 {
-        for l in 0..L {
-            let corr = tangential[c][l] * factor[l];
-            da[c][l] = quantize(da[c][l] - corr * fa[l]);
-            db[c][l] = quantize(db[c][l] + corr * fb[l]);
+        for c in 0..3 {
+            for l in 0..BLOCK {
+                let corr = tangential[c][l] * factor[l];
+                da[c][l] = quantize(da[c][l] - corr * fa[l]);
+                db[c][l] = quantize(db[c][l] + corr * fb[l]);
+            }
         }
-    }
-    for l in 0..L {
-        if valid[l] {
-            out.push(Contact {
-                a: ia[l] as u32,
-                b: ib[l] as u32,
-                da: [da[0][l], da[1][l], da[2][l]],
-                db: [db[0][l], db[1][l], db[2][l]],
-            });
-            deepest[l] = deepest[l].max(depth[l]);
+        for l in 0..self.len {
+            if valid[l] {
+                out.push(Contact {
+                    a: self.ia[l],
+                    b: self.ib[l],
+                    da: [da[0][l], da[1][l], da[2][l]],
+                    db: [db[0][l], db[1][l], db[2][l]],
+                });
+                deepest[l] = deepest[l].max(depth[l]);
+            }
         }
     }
 }
@@ -365,7 +394,7 @@ mod tests {
         };
         let (first, contacts) = run(&pairs);
         assert!(contacts.len() > 100, "only {} contacts", contacts.len());
-        // Each pair alone (the scalar path) gives the same corrections as in a full chunk.
+        // Each pair alone (in a block of its own) gives the same corrections as among others.
         for c in &contacts {
             let alone = run(&[(c.a, c.b, 0.015)]).1;
             assert_eq!(alone.len(), 1);
