@@ -22,7 +22,9 @@ pub struct SubstepContext {
 /// iteration: project constraints, then [`SubstepHook::project`] → velocities from positions →
 /// [`SubstepHook::end_substep`]. Mass-spring projects no constraints but still calls `project`
 /// once, so contacts are handled by projection for every method.
-pub trait SubstepHook {
+///
+/// A hook is `Send`: the whole frame, hook calls included, runs on one of rayon's threads.
+pub trait SubstepHook: Send {
     /// After prediction: find contact candidates for this substep.
     fn begin_substep(&mut self, _ctx: &SubstepContext, _particles: &Particles) {}
 

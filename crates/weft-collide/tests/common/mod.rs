@@ -5,14 +5,14 @@ use weft_collide::CollisionWorld;
 use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 
 /// Runs the world, then calls `check` after every substep with the final positions.
-pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles)> {
+pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles) + Send> {
     /// The wrapped world.
     pub world: &'a mut CollisionWorld,
     /// Called at the end of every substep.
     pub check: F,
 }
 
-impl<F: FnMut(&SubstepContext, &Particles)> SubstepHook for Watch<'_, F> {
+impl<F: FnMut(&SubstepContext, &Particles) + Send> SubstepHook for Watch<'_, F> {
     fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
         self.world.begin_substep(ctx, particles);
     }
@@ -32,7 +32,7 @@ pub fn run(
     solver: &mut Solver,
     world: &mut CollisionWorld,
     frames: usize,
-    check: impl FnMut(&SubstepContext, &Particles),
+    check: impl FnMut(&SubstepContext, &Particles) + Send,
 ) {
     let mut hook = Watch { world, check };
     for frame in 0..frames {
