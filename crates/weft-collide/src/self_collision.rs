@@ -93,6 +93,9 @@ impl SelfCollisionParams {
 const MOVERS_CAP: usize = 16;
 const REANCHORED_CAP: usize = 8;
 
+/// Below this many listed pairs a sweep runs on one thread.
+const SERIAL_PAIRS: usize = 4096;
+
 /// Members per rayon task in the per-member loops.
 const MEMBER_CHUNK: usize = 4096;
 
@@ -137,8 +140,8 @@ impl Exemptions {
 const EXEMPT: f64 = -1.0;
 
 /// The pairs whose treatment is not the default (keep the mean thickness), as CSR over
-/// particles: `pairs[offsets[a]..offsets[a + 1]]` holds (b > a, target) sorted by b, with
-/// [`EXEMPT`] for exempt pairs.
+/// particles: `pairs[offsets[a]..offsets[a + 1]]` holds every (b, target) of a pair {a, b}
+/// sorted by b (so each pair is in two rows), with [`EXEMPT`] for exempt pairs.
 #[derive(Clone, Debug, Default)]
 struct Special {
     offsets: Vec<u32>,
@@ -146,24 +149,31 @@ struct Special {
 }
 
 impl Special {
-    /// What [`Exemptions::target`] gives for a < b, or [`EXEMPT`], without its searches over
-    /// the adjacency and its square roots.
-    fn target(&self, a: u32, b: u32, thickness: &[f64]) -> f64 {
+    /// Particle `a`'s row.
+    fn row(&self, a: u32) -> &[(u32, f64)] {
         let (s, e) = (
             self.offsets[a as usize] as usize,
             self.offsets[a as usize + 1] as usize,
         );
-        // Rows are short (a particle's triangle neighbours, and the few closer at rest): a
-        // forward scan beats a binary search.
-        for &(sb, target) in &self.pairs[s..e] {
-            if sb >= b {
-                if sb == b {
-                    return target;
-                }
-                break;
-            }
-        }
-        0.5 * (thickness[a as usize] + thickness[b as usize])
+        &self.pairs[s..e]
+    }
+
+    /// What [`Exemptions::target`] gives for (a, b), or [`EXEMPT`], without its searches over
+    /// the adjacency and its square roots.
+    fn target(&self, a: u32, b: u32, thickness: &[f64]) -> f64 {
+        Self::target_in(
+            self.row(a),
+            b,
+            0.5 * (thickness[a as usize] + thickness[b as usize]),
+        )
+    }
+
+    /// The target of `b` in a row, or `default`. Rows are short (a particle's triangle
+    /// neighbours, and the few closer at rest): a scan without branches beats a search.
+    #[inline(always)]
+    fn target_in(row: &[(u32, f64)], b: u32, default: f64) -> f64 {
+        row.iter()
+            .fold(default, |t, &(sb, target)| if sb == b { target } else { t })
     }
 }
 
@@ -186,6 +196,17 @@ impl PairList {
         self.a.push(a);
         self.b.push(b);
         self.target.push(target);
+    }
+
+    /// [`PairList::push`] when `target` is not [`EXEMPT`], without a branch (about one pair
+    /// in four found at a build is exempt, too many to predict).
+    #[inline(always)]
+    fn push_unless_exempt(&mut self, a: u32, b: u32, target: f64) {
+        self.push(a, b, target);
+        let len = self.a.len() - usize::from(target == EXEMPT);
+        self.a.truncate(len);
+        self.b.truncate(len);
+        self.target.truncate(len);
     }
 
     fn len(&self) -> usize {
@@ -402,16 +423,20 @@ impl SelfCollision {
             }
         });
         // Counting sort by a, then by b within each a.
+        let both: Vec<(u32, u32, f64)> = found
+            .iter()
+            .flat_map(|&(a, b, target)| [(a, b, target), (b, a, target)])
+            .collect();
         let mut offsets = vec![0u32; n + 1];
-        for &(a, _, _) in &found {
+        for &(a, _, _) in &both {
             offsets[a as usize + 1] += 1;
         }
         for i in 0..n {
             offsets[i + 1] += offsets[i];
         }
-        let mut pairs = vec![(0, 0.0); found.len()];
+        let mut pairs = vec![(0, 0.0); both.len()];
         let mut next = offsets.clone();
-        for &(a, b, target) in &found {
+        for &(a, b, target) in &both {
             pairs[next[a as usize] as usize] = (b, target);
             next[a as usize] += 1;
         }
@@ -605,11 +630,14 @@ impl SelfCollision {
         self.pairs.par_iter_mut().zip(runs).for_each(|(list, run)| {
             list.clear();
             let Some(special) = special else { return };
-            grid.for_each_pair_in(run, radius, |i, j| {
-                let (a, b) = (i.min(j), i.max(j));
-                let target = special.target(a, b, thickness);
-                if target != EXEMPT {
-                    list.push(a, b, target);
+            let mut row = Vec::new();
+            grid.for_each_row_in(run, radius, &mut row, |i, near| {
+                // The row of i once for all its partners.
+                let (own, ti) = (special.row(i), thickness[i as usize]);
+                for &j in near {
+                    let mean = 0.5 * (ti + thickness[j as usize]);
+                    let target = Special::target_in(own, j, mean);
+                    list.push_unless_exempt(i.min(j), i.max(j), target);
                 }
             });
         });
@@ -649,14 +677,25 @@ impl SelfCollision {
             prev: &p.prev_positions,
             w: &p.inv_masses,
         };
-        let deepest = lists
-            .par_iter()
-            .zip(self.contacts.par_iter_mut())
-            .map(|(list, (hits, out))| {
-                out.clear();
-                find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
-            })
-            .reduce(|| 0.0, f64::max);
+        let find = |(list, (hits, out)): (&&PairList, &mut (Vec<u32>, Vec<Contact>))| {
+            out.clear();
+            find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
+        };
+        // A few thousand pairs take less time than waking another thread.
+        let total: usize = lists.iter().map(|l| l.len()).sum();
+        let deepest = if total < SERIAL_PAIRS {
+            lists
+                .iter()
+                .zip(self.contacts.iter_mut())
+                .map(find)
+                .fold(0.0, f64::max)
+        } else {
+            lists
+                .par_iter()
+                .zip(self.contacts.par_iter_mut())
+                .map(find)
+                .reduce(|| 0.0, f64::max)
+        };
         let n = p.positions.len();
         self.sums.resize(n, DVec3::ZERO);
         self.counts.resize(n, 0);

@@ -14,7 +14,6 @@
 
 use glam::DVec3;
 use multiversion::multiversion;
-use rayon::prelude::*;
 
 use crate::friction::Friction;
 
@@ -32,9 +31,6 @@ fn quantize(v: f64) -> f64 {
 
 /// Touching pairs gathered into one block before the contact kernel runs over them.
 const BLOCK: usize = 64;
-
-/// Fewest particles per task when the corrections are summed.
-const SUM_CHUNK: usize = 2048;
 
 /// One touching pair's corrections, each a multiple of 2⁻⁴⁰ m.
 #[derive(Clone, Copy, Debug)]
@@ -244,49 +240,39 @@ impl Block {
 }
 
 /// Moves every particle with a contact in `found` (per list: scratch, contacts) by the mean
-/// of its corrections; `sums` and
-/// `counts` (one per particle, zero on entry) are scratch and zero again on return. Runs over
-/// ranges of particles on rayon's threads, each range reading every contact.
+/// of its corrections; `sums` and `counts` (one per particle, zero on entry) are scratch and
+/// zero again on return.
+///
+/// On one thread: split over particle ranges, each range had to read every contact, and two
+/// threads took longer than one (49 against 39 µs for 16,000 contacts at 128²).
 pub(crate) fn apply(
     found: &[(Vec<u32>, Vec<Contact>)],
     positions: &mut [DVec3],
     sums: &mut [DVec3],
     counts: &mut [u32],
 ) {
-    let total: usize = found.iter().map(|(_, c)| c.len()).sum();
-    if total == 0 {
+    let mut touched = false;
+    for c in found.iter().flat_map(|(_, c)| c) {
+        for (i, d) in [(c.a, &c.da), (c.b, &c.db)] {
+            counts[i as usize] += 1;
+            sums[i as usize] += DVec3::from_array(*d);
+        }
+        touched = true;
+    }
+    if !touched {
         return;
     }
-    // Enough particles per task that its scan of every contact stays a small part of it.
-    let chunk = (positions.len() / rayon::current_num_threads().max(1))
-        .max(SUM_CHUNK)
-        .max(1);
-    positions
-        .par_chunks_mut(chunk)
-        .zip(sums.par_chunks_mut(chunk))
-        .zip(counts.par_chunks_mut(chunk))
-        .enumerate()
-        .for_each(|(k, ((x, sums), counts))| {
-            let lo = k * chunk;
-            let mut add = |i: u32, d: &[f64; 3]| {
-                let j = (i as usize).wrapping_sub(lo);
-                if j < x.len() {
-                    counts[j] += 1;
-                    sums[j] += DVec3::from_array(*d);
-                }
-            };
-            for c in found.iter().flat_map(|(_, c)| c) {
-                add(c.a, &c.da);
-                add(c.b, &c.db);
-            }
-            for ((x, sum), count) in x.iter_mut().zip(sums.iter_mut()).zip(counts.iter_mut()) {
-                if *count > 0 {
-                    *x += *sum / f64::from(*count);
-                    *sum = DVec3::ZERO;
-                    *count = 0;
-                }
-            }
-        });
+    for ((x, sum), count) in positions
+        .iter_mut()
+        .zip(sums.iter_mut())
+        .zip(counts.iter_mut())
+    {
+        if *count > 0 {
+            *x += *sum / f64::from(*count);
+            *sum = DVec3::ZERO;
+            *count = 0;
+        }
+    }
 }
 
 #[cfg(test)]
