@@ -177,6 +177,51 @@ impl Special {
     }
 }
 
+/// What limits a substep's displacements (see [`SelfCollision::refresh`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Clamp<'a> {
+    /// Positions at the start of the substep.
+    pub prev: &'a [DVec3],
+    /// Inverse masses (pinned particles are left alone).
+    pub w: &'a [f64],
+}
+
+impl Clamp<'_> {
+    /// Moves particle `i` back towards its start of substep until it is at most `limit` away.
+    #[inline(always)]
+    fn apply(&self, i: usize, x: &mut DVec3, limit: f64) {
+        if self.w[i] == 0.0 {
+            return;
+        }
+        let d = *x - self.prev[i];
+        let len = d.length();
+        if len > limit {
+            *x = self.prev[i] + d * (limit / len);
+        }
+    }
+}
+
+/// One chunk's part of a list check: the box and sum of its members' displacements, and its
+/// movers (slots).
+#[derive(Clone, Debug)]
+struct Scan {
+    lo: DVec3,
+    hi: DVec3,
+    sum: DVec3,
+    movers: Vec<u32>,
+}
+
+impl Default for Scan {
+    fn default() -> Self {
+        Self {
+            lo: DVec3::splat(f64::INFINITY),
+            hi: DVec3::splat(f64::NEG_INFINITY),
+            sum: DVec3::ZERO,
+            movers: Vec::new(),
+        }
+    }
+}
+
 /// Candidate pairs as struct-of-arrays, a < b.
 #[derive(Clone, Debug, Default)]
 struct PairList {
@@ -275,6 +320,10 @@ pub(crate) struct SelfCollision {
     /// merged extra list.
     movers: Vec<u32>,
     new_pairs: Vec<(u32, u32)>,
+    /// The members' mean displacement from their anchors at the last two checks.
+    drift: [DVec3; 2],
+    /// Per chunk of particles, the last check's findings.
+    scans: Vec<Scan>,
     /// Re-anchored members (slots) by anchor, and a query's answer.
     recent: SpatialHash,
     near: Vec<u32>,
@@ -358,6 +407,8 @@ impl SelfCollision {
             updates: 0,
             movers: Vec::new(),
             new_pairs: Vec::new(),
+            drift: [DVec3::ZERO; 2],
+            scans: Vec::new(),
             recent: SpatialHash::default(),
             near: Vec::new(),
             added: PairList::default(),
@@ -469,65 +520,91 @@ impl SelfCollision {
     /// the guarantee of a fresh search every sweep. c lets a cloth that falls or is carried as
     /// a whole keep its list. The check runs before every sweep, so it also catches moves
     /// between frames (pins, grabs, edits).
-    pub(crate) fn refresh(&mut self, positions: &[DVec3], thickness: &[f64]) {
-        let Some(t) = self.built_for else {
-            return self.rebuild(positions, thickness);
-        };
-        if t <= 0.0 || self.members.is_empty() {
+    ///
+    /// With `clamp`, each member's displacement this substep is first limited to
+    /// `max_displacement` · thickness (see [`SelfCollisionParams`]), in the same pass over the
+    /// particles as the check. The check's common displacement is predicted from the last two
+    /// (any common vector keeps the invariant; a good guess leaves fewer movers), so the whole
+    /// check is one parallel pass.
+    pub(crate) fn refresh(
+        &mut self,
+        positions: &mut [DVec3],
+        thickness: &[f64],
+        clamp: Option<Clamp<'_>>,
+    ) {
+        let max = self.params.max_displacement;
+        let Some(t) = self
+            .built_for
+            .filter(|&t| t > 0.0 && !self.members.is_empty())
+        else {
+            if let Some(clamp) = clamp {
+                for (i, x) in positions.iter_mut().enumerate() {
+                    if self.slot_of[i] != u32::MAX {
+                        clamp.apply(i, x, max * thickness[i]);
+                    }
+                }
+            }
+            if self.built_for.is_none() {
+                self.rebuild(positions, thickness);
+            }
             return; // no thickness or no members: no pairs, whatever the motion
-        }
+        };
         let limit = self.limit(t);
         let limit2 = limit * limit;
-        // Per chunk of members (fixed chunks, so the sum is the same on any thread count):
-        // the box and the sum of the displacements.
-        let bounds: Vec<(DVec3, DVec3, DVec3)> = self
-            .members
-            .par_chunks(MEMBER_CHUNK)
-            .zip(self.built_at.par_chunks(MEMBER_CHUNK))
-            .map(|(members, anchors)| {
-                members.iter().zip(anchors).fold(
-                    (
-                        DVec3::splat(f64::INFINITY),
-                        DVec3::splat(f64::NEG_INFINITY),
-                        DVec3::ZERO,
-                    ),
-                    |(lo, hi, sum), (&i, x0)| {
-                        let d = positions[i as usize] - *x0;
-                        (lo.min(d), hi.max(d), sum + d)
-                    },
-                )
-            })
-            .collect();
-        let (lo, hi, sum) = bounds.iter().fold(
+        let guess = 2.0 * self.drift[0] - self.drift[1];
+        // Per fixed chunk of particles (so the sum is the same on any thread count): clamp,
+        // then the box and the sum of the members' displacements, and the movers.
+        self.scans
+            .resize_with(positions.len().div_ceil(MEMBER_CHUNK), Scan::default);
+        let (slot_of, built_at) = (&self.slot_of, &self.built_at);
+        positions
+            .par_chunks_mut(MEMBER_CHUNK)
+            .zip(self.scans.par_iter_mut())
+            .enumerate()
+            .for_each(|(k, (xs, scan))| {
+                *scan = Scan {
+                    movers: std::mem::take(&mut scan.movers),
+                    ..Scan::default()
+                };
+                scan.movers.clear();
+                for (j, x) in xs.iter_mut().enumerate() {
+                    let i = k * MEMBER_CHUNK + j;
+                    let slot = slot_of[i];
+                    if slot == u32::MAX {
+                        continue;
+                    }
+                    if let Some(clamp) = clamp {
+                        clamp.apply(i, x, max * thickness[i]);
+                    }
+                    let d = *x - built_at[slot as usize];
+                    (scan.lo, scan.hi, scan.sum) = (scan.lo.min(d), scan.hi.max(d), scan.sum + d);
+                    if (d - guess).length_squared() > limit2 {
+                        scan.movers.push(slot);
+                    }
+                }
+            });
+        let (lo, hi, sum) = self.scans.iter().fold(
             (
                 DVec3::splat(f64::INFINITY),
                 DVec3::splat(f64::NEG_INFINITY),
                 DVec3::ZERO,
             ),
-            |(lo, hi, sum), &(l, h, s)| (lo.min(l), hi.max(h), sum + s),
+            |(lo, hi, sum), s| (lo.min(s.lo), hi.max(s.hi), sum + s.sum),
         );
+        self.drift = [sum / self.members.len() as f64, self.drift[0]];
         // Every |Δᵢ − box centre| is at most the box's half-diagonal: often that settles it.
         if (0.5 * (hi - lo)).length_squared() <= limit2 {
             return;
         }
-        let c = sum / self.members.len() as f64;
-        let (members, built_at) = (&self.members, &self.built_at);
         self.movers.clear();
-        self.movers.par_extend(
-            (0..members.len())
-                .into_par_iter()
-                .with_min_len(MEMBER_CHUNK)
-                .filter(|&slot| {
-                    let d = positions[members[slot] as usize] - built_at[slot];
-                    (d - c).length_squared() > limit2
-                })
-                .map(|slot| slot as u32),
-        );
+        for scan in &self.scans {
+            self.movers.extend_from_slice(&scan.movers);
+        }
         if self.movers.len() > (self.members.len() / MOVERS_CAP).max(64) {
             return self.rebuild(positions, thickness);
         }
         if !self.movers.is_empty() {
-            self.reanchor(positions, thickness, c, t);
+            self.reanchor(positions, thickness, guess, t);
         }
     }
 
@@ -608,6 +685,7 @@ impl SelfCollision {
         self.built_at
             .extend(self.members.iter().map(|&i| positions[i as usize]));
         self.built_pos.clone_from(&self.built_at);
+        self.drift = [DVec3::ZERO; 2];
         let max_t = self
             .members
             .iter()
@@ -641,29 +719,6 @@ impl SelfCollision {
                 }
             });
         });
-    }
-
-    /// Limits each member's displacement this substep to `max_displacement` · thickness.
-    pub(crate) fn clamp_displacements(&self, p: &mut Particles, thickness: &[f64]) {
-        let max = self.params.max_displacement;
-        let slot_of = &self.slot_of;
-        p.positions
-            .par_iter_mut()
-            .with_min_len(MEMBER_CHUNK)
-            .enumerate()
-            .zip(&p.prev_positions)
-            .zip(&p.inv_masses)
-            .for_each(|(((i, x), &prev), &w)| {
-                if w == 0.0 || slot_of[i] == u32::MAX {
-                    return;
-                }
-                let limit = max * thickness[i];
-                let d = *x - prev;
-                let len = d.length();
-                if len > limit {
-                    *x = prev + d * (limit / len);
-                }
-            });
     }
 
     /// One Jacobi sweep over the touching pairs (see the module doc); returns the number of
@@ -843,7 +898,7 @@ mod tests {
         let (solver, mut x, t) = folded();
         let params = SelfCollisionParams::default();
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!(sc.rebuilds(), 1);
         let contacts = listed_contacts(&sc, &x);
         assert!(contacts.len() > 200, "only {} contacts", contacts.len());
@@ -882,7 +937,7 @@ mod tests {
         for (xi, (x0i, m)) in x.iter_mut().zip(x0.iter().zip(&moves)) {
             *xi = *x0i + *m;
         }
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!(
             (sc.rebuilds(), sc.updates()),
             (1, 0),
@@ -900,15 +955,15 @@ mod tests {
         let params = SelfCollisionParams::default();
         let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
         let limit = 0.5 * params.search_margin * SPACING;
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         // The whole cloth carried 10 half-skins away: its list still holds.
         for xi in &mut x {
             *xi += DVec3::new(10.0 * limit, -3.0 * limit, 0.0);
         }
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!((sc.rebuilds(), sc.updates()), (1, 0), "carried");
         x[100].x += 0.99 * limit;
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!(
             (sc.rebuilds(), sc.updates()),
             (1, 0),
@@ -918,7 +973,7 @@ mod tests {
         x[200] = x[300] + DVec3::new(0.0, 0.2 * SPACING, 0.0);
         x[201] = x[300] + DVec3::new(0.2 * SPACING, 0.0, 0.0);
         assert!(listed(&sc).binary_search(&(200, 300)).is_err());
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!((sc.rebuilds(), sc.updates()), (1, 1), "two movers");
         assert!(listed(&sc).binary_search(&(200, 300)).is_ok());
         assert!(listed(&sc).binary_search(&(201, 300)).is_ok());
@@ -928,12 +983,12 @@ mod tests {
         for xi in &mut x {
             *xi += DVec3::new(rand(&mut seed), rand(&mut seed), rand(&mut seed)) * (2.0 * limit);
         }
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!((sc.rebuilds(), sc.updates()), (2, 1), "shaken");
         assert_complete(&sc, &x, &t, "after the rebuild");
         // A thickness change drops the list.
         sc.invalidate();
-        sc.refresh(&x, &t);
+        sc.refresh(&mut x, &t, None);
         assert_eq!(sc.rebuilds(), 3);
     }
 
@@ -950,10 +1005,11 @@ mod tests {
         }
 
         fn project(&mut self, _: &SubstepContext, p: &mut Particles) -> usize {
-            if std::mem::take(&mut self.fresh) {
-                self.sc.clamp_displacements(p, &self.thickness);
-            }
-            self.sc.refresh(&p.positions, &self.thickness);
+            let clamp = std::mem::take(&mut self.fresh).then_some(Clamp {
+                prev: &p.prev_positions,
+                w: &p.inv_masses,
+            });
+            self.sc.refresh(&mut p.positions, &self.thickness, clamp);
             let (contacts, _) = self.sc.solve(p);
             for (x, t) in p.positions.iter_mut().zip(&self.thickness) {
                 x.y = x.y.max(*t);

@@ -15,7 +15,7 @@ use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
-use crate::self_collision::{SelfCollision, SelfCollisionParams};
+use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams};
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -150,14 +150,6 @@ impl CollisionWorld {
     /// three thicknesses (contacts are sought within two), plus 0.1 mm for the f32 AABB.
     fn search_margin(&self) -> f64 {
         3.0 * self.max_thickness + 1e-4
-    }
-
-    /// Once per substep, before the first projection: clamp, then sweep.
-    fn prepare(&mut self, p: &mut Particles) {
-        if let Some(sc) = &self.self_collision {
-            sc.clamp_displacements(p, &self.thickness);
-        }
-        self.sweep(p);
     }
 
     /// Continuous collision for fast particles: a particle whose substep path crosses a
@@ -328,15 +320,22 @@ impl SubstepHook for CollisionWorld {
     }
 
     fn project(&mut self, _ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        if std::mem::take(&mut self.fresh) {
-            self.prepare(particles);
+        // Once per substep, before the first projection: the colliders' sweep, then the
+        // self-collision's clamp (a move back along a swept path stays clear of colliders).
+        let fresh = std::mem::take(&mut self.fresh);
+        if fresh {
+            self.sweep(particles);
         }
         // Particle pairs first, colliders last: a stack of layers pressed together must not
         // end the substep pushed into the ground, while a slight overlap between layers is
         // harmless and corrected next time.
         let (self_contacts, self_depth) = match &mut self.self_collision {
             Some(sc) => {
-                sc.refresh(&particles.positions, &self.thickness);
+                let clamp = fresh.then_some(Clamp {
+                    prev: &particles.prev_positions,
+                    w: &particles.inv_masses,
+                });
+                sc.refresh(&mut particles.positions, &self.thickness, clamp);
                 sc.solve(particles)
             }
             None => (0, 0.0),
