@@ -100,6 +100,11 @@ fn self_collision(c: &mut Criterion) {
 
 /// One frame's worth of hook calls on `particles` (which do not move between substeps).
 fn hook_frame(world: &mut CollisionWorld, solver: &Solver, particles: &mut weft_solver::Particles) {
+    // Inside rayon's pool, as `Solver::step_with` runs its hooks.
+    rayon::scope(|_| hook_calls(world, solver, particles));
+}
+
+fn hook_calls(world: &mut CollisionWorld, solver: &Solver, particles: &mut weft_solver::Particles) {
     let s = solver.settings();
     let h = s.h();
     for substep in 0..s.substeps {
