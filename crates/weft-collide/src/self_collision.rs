@@ -222,6 +222,15 @@ impl Default for Scan {
     }
 }
 
+impl Scan {
+    /// Empties the findings, keeping the movers' storage.
+    fn reset(&mut self) {
+        let empty = Scan::default();
+        (self.lo, self.hi, self.sum) = (empty.lo, empty.hi, empty.sum);
+        self.movers.clear();
+    }
+}
+
 /// Candidate pairs as struct-of-arrays, a < b.
 #[derive(Clone, Debug, Default)]
 struct PairList {
@@ -533,25 +542,15 @@ impl SelfCollision {
         clamp: Option<Clamp<'_>>,
     ) {
         let max = self.params.max_displacement;
-        let Some(t) = self
+        // The list's thickness, half-skin² and predicted common displacement, unless there is
+        // no list to check (none built yet, or no thickness or members: no pairs).
+        let check = self
             .built_for
             .filter(|&t| t > 0.0 && !self.members.is_empty())
-        else {
-            if let Some(clamp) = clamp {
-                for (i, x) in positions.iter_mut().enumerate() {
-                    if self.slot_of[i] != u32::MAX {
-                        clamp.apply(i, x, max * thickness[i]);
-                    }
-                }
-            }
-            if self.built_for.is_none() {
-                self.rebuild(positions, thickness);
-            }
-            return; // no thickness or no members: no pairs, whatever the motion
-        };
-        let limit = self.limit(t);
-        let limit2 = limit * limit;
-        let guess = 2.0 * self.drift[0] - self.drift[1];
+            .map(|t| {
+                let limit = self.limit(t);
+                (t, limit * limit, 2.0 * self.drift[0] - self.drift[1])
+            });
         // Per fixed chunk of particles (so the sum is the same on any thread count): clamp,
         // then the box and the sum of the members' displacements, and the movers.
         self.scans
@@ -562,11 +561,7 @@ impl SelfCollision {
             .zip(self.scans.par_iter_mut())
             .enumerate()
             .for_each(|(k, (xs, scan))| {
-                *scan = Scan {
-                    movers: std::mem::take(&mut scan.movers),
-                    ..Scan::default()
-                };
-                scan.movers.clear();
+                scan.reset();
                 for (j, x) in xs.iter_mut().enumerate() {
                     let i = k * MEMBER_CHUNK + j;
                     let slot = slot_of[i];
@@ -576,21 +571,29 @@ impl SelfCollision {
                     if let Some(clamp) = clamp {
                         clamp.apply(i, x, max * thickness[i]);
                     }
-                    let d = *x - built_at[slot as usize];
-                    (scan.lo, scan.hi, scan.sum) = (scan.lo.min(d), scan.hi.max(d), scan.sum + d);
-                    if (d - guess).length_squared() > limit2 {
-                        scan.movers.push(slot);
+                    if let Some((_, limit2, guess)) = check {
+                        let d = *x - built_at[slot as usize];
+                        (scan.lo, scan.hi, scan.sum) =
+                            (scan.lo.min(d), scan.hi.max(d), scan.sum + d);
+                        if (d - guess).length_squared() > limit2 {
+                            scan.movers.push(slot);
+                        }
                     }
                 }
             });
-        let (lo, hi, sum) = self.scans.iter().fold(
-            (
-                DVec3::splat(f64::INFINITY),
-                DVec3::splat(f64::NEG_INFINITY),
-                DVec3::ZERO,
-            ),
-            |(lo, hi, sum), s| (lo.min(s.lo), hi.max(s.hi), sum + s.sum),
-        );
+        let Some((t, limit2, guess)) = check else {
+            if self.built_for.is_none() {
+                self.rebuild(positions, thickness);
+            }
+            return;
+        };
+        let empty = Scan::default();
+        let (lo, hi, sum) = self
+            .scans
+            .iter()
+            .fold((empty.lo, empty.hi, empty.sum), |(lo, hi, sum), s| {
+                (lo.min(s.lo), hi.max(s.hi), sum + s.sum)
+            });
         self.drift = [sum / self.members.len() as f64, self.drift[0]];
         // Every |Δᵢ − box centre| is at most the box's half-diagonal: often that settles it.
         if (0.5 * (hi - lo)).length_squared() <= limit2 {

@@ -349,7 +349,8 @@ impl CellGrid {
 }
 
 /// The first index at or after `from` whose key is at least `key` (`cells` sorted by key):
-/// exponential steps forward, then a binary search in the last step.
+/// exponential steps forward, then a binary search in the last step (which also covers a
+/// `from` already at or past `key`).
 fn gallop(cells: &[(u64, u32)], from: usize, key: u64) -> usize {
     let mut step = 1;
     let mut lo = from;
@@ -358,9 +359,6 @@ fn gallop(cells: &[(u64, u32)], from: usize, key: u64) -> usize {
         step *= 2;
     }
     let hi = (lo + step + 1).min(cells.len());
-    if lo < hi && cells[lo].0 >= key {
-        return lo;
-    }
     lo + cells[lo..hi].partition_point(|&(k, _)| k < key)
 }
 
@@ -409,15 +407,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn grid_near_query_is_exactly_the_brute_force_neighbourhood() {
-        let positions: Vec<DVec3> = (0..800)
+    /// A folded, clustered cloud of 800 points (many per cell, in negative and positive cells)
+    /// and the two thirds of them that are built into grids.
+    fn folded_cloud() -> (Vec<DVec3>, Vec<u32>) {
+        let positions = (0..800)
             .map(|i| {
                 let f = i as f64;
                 DVec3::new((f * 0.37).sin(), 0.1 * (f * 0.71).cos(), (f * 0.13).sin()) * 0.3
             })
             .collect();
-        let items: Vec<u32> = (0..800).filter(|i| i % 3 != 1).collect();
+        (positions, (0..800).filter(|i| i % 3 != 1).collect())
+    }
+
+    #[test]
+    fn grid_near_query_is_exactly_the_brute_force_neighbourhood() {
+        let (positions, items) = folded_cloud();
         let mut grid = CellGrid::new();
         grid.build(&positions, &items, 0.04);
         // At every point (built or not) and at points between them, for two radii.
@@ -446,14 +450,7 @@ mod tests {
 
     #[test]
     fn grid_pairs_are_exactly_the_brute_force_pairs_each_once() {
-        // A folded, clustered cloud: many points per cell, negative and positive cells.
-        let positions: Vec<DVec3> = (0..800)
-            .map(|i| {
-                let f = i as f64;
-                DVec3::new((f * 0.37).sin(), 0.1 * (f * 0.71).cos(), (f * 0.13).sin()) * 0.3
-            })
-            .collect();
-        let items: Vec<u32> = (0..800).filter(|i| i % 3 != 1).collect();
+        let (positions, items) = folded_cloud();
         let radius = 0.04;
         let mut grid = CellGrid::new();
         let mut moved = positions.clone();
