@@ -72,8 +72,11 @@ fn bench_one(c: &mut Criterion, group: &str, n: usize, solver: &Solver, world: &
         b.iter_batched(
             || solver.particles().clone(),
             |mut p| {
-                world.begin_substep(&ctx, &p);
-                world.project(&ctx, &mut p)
+                // Inside rayon's pool, as `Solver::step_with` calls its hooks.
+                rayon::scope(|_| {
+                    world.begin_substep(&ctx, &p);
+                    world.project(&ctx, &mut p)
+                })
             },
             BatchSize::LargeInput,
         );
