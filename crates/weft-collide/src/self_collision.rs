@@ -29,7 +29,7 @@ use weft_solver::{Particles, Solver};
 
 use crate::error::CollideError;
 use crate::friction::Friction;
-use crate::self_contact::{Contact, State, apply, find_contacts};
+use crate::self_contact::{Bins, State, apply, find_contacts};
 use crate::spatial_hash::{CellGrid, SpatialHash};
 
 /// Self-collision settings.
@@ -194,9 +194,11 @@ impl Clamp<'_> {
             return;
         }
         let d = *x - self.prev[i];
-        let len = d.length();
-        if len > limit {
-            *x = self.prev[i] + d * (limit / len);
+        // Most particles move less than the limit: compare squares, and take the root only
+        // for those that do not.
+        let len2 = d.length_squared();
+        if len2 > limit * limit {
+            *x = self.prev[i] + d * (limit / len2.sqrt());
         }
     }
 }
@@ -345,9 +347,10 @@ pub(crate) struct SelfCollision {
     /// Pairs whose treatment is not the default; found at the first list build after creation
     /// or a thickness change, `None` until then.
     special: Option<Special>,
-    /// Sweep scratch: per list, the touching pairs' indices and their contacts; per particle,
-    /// the exact sum of its corrections and their count (zero between sweeps).
-    contacts: Vec<(Vec<u32>, Vec<Contact>)>,
+    /// Sweep scratch: per list, the touching pairs' indices and their corrections binned by
+    /// particle range; per particle, the exact sum of its corrections and their count (zero
+    /// between sweeps).
+    contacts: Vec<(Vec<u32>, Bins)>,
     sums: Vec<DVec3>,
     counts: Vec<u32>,
 }
@@ -735,8 +738,9 @@ impl SelfCollision {
             prev: &p.prev_positions,
             w: &p.inv_masses,
         };
-        let find = |(list, (hits, out)): (&&PairList, &mut (Vec<u32>, Vec<Contact>))| {
-            out.clear();
+        let n = p.positions.len();
+        let find = |(list, (hits, out)): (&&PairList, &mut (Vec<u32>, Bins))| {
+            out.reset(n);
             find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
         };
         // A few thousand pairs take less time than waking another thread.
@@ -754,7 +758,6 @@ impl SelfCollision {
                 .map(find)
                 .reduce(|| 0.0, f64::max)
         };
-        let n = p.positions.len();
         self.sums.resize(n, DVec3::ZERO);
         self.counts.resize(n, 0);
         apply(
@@ -763,7 +766,7 @@ impl SelfCollision {
             &mut self.sums,
             &mut self.counts,
         );
-        let contacts = self.contacts.iter().map(|(_, c)| c.len()).sum();
+        let contacts = self.contacts.iter().map(|(_, c)| c.contacts()).sum();
         (contacts, deepest)
     }
 }
