@@ -72,6 +72,7 @@ impl Bins {
         self.contacts
     }
 
+    /// Adds particle `i`'s correction `d` to its range's bin.
     #[inline(always)]
     fn push(&mut self, i: u32, d: [f64; 3]) {
         self.bins[(i >> self.shift) as usize].push(Correction { i, d });
