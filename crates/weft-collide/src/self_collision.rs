@@ -760,13 +760,12 @@ impl SelfCollision {
         };
         self.sums.resize(n, DVec3::ZERO);
         self.counts.resize(n, 0);
-        apply(
+        let contacts = apply(
             &self.contacts,
             &mut p.positions,
             &mut self.sums,
             &mut self.counts,
         );
-        let contacts = self.contacts.iter().map(|(_, c)| c.contacts()).sum();
         (contacts, deepest)
     }
 }
@@ -953,6 +952,11 @@ mod tests {
         // The moves did bring unlisted pairs closer than R: the skin was needed.
         let closer = brute_pairs(&sc, &x, &t, |_| radius);
         assert!(closer.iter().any(|p| list.binary_search(p).is_err()));
+        // A sweep reports one contact per touching pair.
+        let touching = listed_contacts(&sc, &x).len();
+        let mut p = solver.particles().clone();
+        (p.positions, p.prev_positions) = (x.clone(), x);
+        assert_eq!(sc.solve(&mut p).0, touching);
     }
 
     #[test]

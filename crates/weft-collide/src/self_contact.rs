@@ -67,11 +67,6 @@ impl Bins {
         self.contacts = 0;
     }
 
-    /// Contacts found since the last reset.
-    pub(crate) fn contacts(&self) -> usize {
-        self.contacts
-    }
-
     /// Adds particle `i`'s correction `d` to its range's bin.
     #[inline(always)]
     fn push(&mut self, i: u32, d: [f64; 3]) {
@@ -282,8 +277,8 @@ type Range<'a> = (usize, ((&'a mut [DVec3], &'a mut [DVec3]), &'a mut [u32]));
 const SERIAL_CONTACTS: usize = 2048;
 
 /// Moves every particle with a contact in `found` (per list: scratch, corrections) by the
-/// mean of its corrections; `sums` and `counts` (one per particle, zero on entry) are scratch
-/// and zero again on return.
+/// mean of its corrections, and returns the number of contacts; `sums` and `counts` (one per
+/// particle, zero on entry) are scratch and zero again on return.
 ///
 /// Particle range by particle range, each range reading only its own bin of every list, so
 /// the ranges run on rayon's threads without sharing a particle (one thread applying all
@@ -293,15 +288,13 @@ pub(crate) fn apply(
     positions: &mut [DVec3],
     sums: &mut [DVec3],
     counts: &mut [u32],
-) {
+) -> usize {
     let contacts: usize = found.iter().map(|(_, b)| b.contacts).sum();
-    let Some((_, first)) = found.first() else {
-        return;
-    };
     if contacts == 0 {
-        return;
+        return 0;
     }
-    let span = 1 << first.shift;
+    // The ranges every list was binned by (reset for this particle count).
+    let span = 1 << Bins::shift_for(positions.len());
     let range = |(k, ((xs, ss), cs)): Range<'_>| {
         let start = k * span;
         for (_, bins) in found {
@@ -334,6 +327,7 @@ pub(crate) fn apply(
             .enumerate()
             .for_each(range);
     }
+    contacts
 }
 
 #[cfg(test)]
@@ -442,7 +436,7 @@ mod tests {
             (moved, out)
         };
         let (first, all) = run(&pairs);
-        assert!(all.contacts() > 100, "only {} contacts", all.contacts());
+        assert!(all.contacts > 100, "only {} contacts", all.contacts);
         // The corrections of each pair alone (in a block of its own) are those it gets among
         // the others, bit for bit.
         let sorted = |bins: &Bins| -> Vec<Correction> {
@@ -453,7 +447,7 @@ mod tests {
         let mut alone = Vec::new();
         for &pair in &pairs {
             let found = run(&[pair]).1;
-            assert!(found.contacts() <= 1);
+            assert!(found.contacts <= 1);
             alone.extend(sorted(&found));
         }
         alone.sort_by_key(|c| (c.i, c.d.map(f64::to_bits)));
