@@ -117,6 +117,7 @@ fn main() {
         search_margin: a
             .margin
             .unwrap_or(SelfCollisionParams::default().search_margin),
+        adaptive_margin: a.margin.is_none(),
         ..SelfCollisionParams::default()
     };
     for name in &a.scenes {

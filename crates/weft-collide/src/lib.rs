@@ -16,6 +16,7 @@ pub mod scenarios;
 mod self_collision;
 mod self_contact;
 mod shape;
+mod skin;
 mod spatial_hash;
 mod tessellate;
 mod world;

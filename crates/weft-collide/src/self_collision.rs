@@ -30,7 +30,8 @@ use weft_solver::{Particles, Solver};
 use crate::error::CollideError;
 use crate::friction::Friction;
 use crate::self_contact::{Bins, State, apply, find_contacts};
-use crate::spatial_hash::{CellGrid, SpatialHash};
+use crate::skin::{Change, Skin};
+use crate::spatial_hash::CellGrid;
 
 /// Self-collision settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,8 +46,13 @@ pub struct SelfCollisionParams {
     /// The candidate list's skin, as a fraction of the thickness: pairs up to
     /// thickness · (1 + search_margin) apart are listed, and the list is kept until a particle
     /// strays half the margin. It changes only the cost, never the result: 0 searches anew
-    /// whenever anything moved.
+    /// whenever anything moved. With `adaptive_margin`, the skin starts here and then follows
+    /// the motion.
     pub search_margin: f64,
+    /// Whether the skin adapts to the motion: thin at rest, thick while the cloth folds or
+    /// slides, one step at a time between 0.25 and 1.0 (see `skin.rs`). Like the skin itself,
+    /// it changes only the cost.
+    pub adaptive_margin: bool,
 }
 
 impl Default for SelfCollisionParams {
@@ -55,6 +61,7 @@ impl Default for SelfCollisionParams {
             friction: Friction::new(0.3, 0.2),
             max_displacement: 0.45,
             search_margin: 0.5,
+            adaptive_margin: true,
         }
     }
 }
@@ -269,6 +276,21 @@ impl PairList {
         self.a.len()
     }
 
+    /// Keeps the pairs for which `keep(a, b, target)` holds, in order.
+    fn retain(&mut self, mut keep: impl FnMut(u32, u32, f64) -> bool) {
+        let mut n = 0;
+        for k in 0..self.a.len() {
+            let (a, b, target) = (self.a[k], self.b[k], self.target[k]);
+            self.a[n] = a;
+            self.b[n] = b;
+            self.target[n] = target;
+            n += usize::from(keep(a, b, target));
+        }
+        self.a.truncate(n);
+        self.b.truncate(n);
+        self.target.truncate(n);
+    }
+
     /// Index of (a, b), or where it would go, in a list sorted by (a, b).
     fn position(&self, a: u32, b: u32) -> Result<usize, usize> {
         let (mut lo, mut hi) = (0, self.a.len());
@@ -305,6 +327,8 @@ impl PairList {
 #[derive(Clone, Debug)]
 pub(crate) struct SelfCollision {
     params: SelfCollisionParams,
+    /// The list's skin now.
+    skin: Skin,
     /// Participating particles, ascending.
     members: Vec<u32>,
     exempt: Exemptions,
@@ -335,9 +359,12 @@ pub(crate) struct SelfCollision {
     drift: [DVec3; 2],
     /// Per chunk of particles, the last check's findings.
     scans: Vec<Scan>,
-    /// Re-anchored members (slots) by anchor, and a query's answer.
-    recent: SpatialHash,
+    /// Re-anchored members (slots) by anchor, and a query's answer; the movers' anchors, and
+    /// their order by cell, for the grid's queries.
+    recent: CellGrid,
     near: Vec<u32>,
+    near_points: Vec<DVec3>,
+    near_order: Vec<(u64, u32)>,
     added: PairList,
     merged: PairList,
     /// Largest member thickness the list was built for; `None` when there is no list.
@@ -401,6 +428,7 @@ impl SelfCollision {
         let adjacency = neighbours.iter().map(|&(_, b)| b).collect();
         Ok(Self {
             params,
+            skin: Skin::new(params.search_margin, params.adaptive_margin),
             members,
             exempt: Exemptions {
                 rest: solver.particles().positions.clone(),
@@ -421,8 +449,10 @@ impl SelfCollision {
             new_pairs: Vec::new(),
             drift: [DVec3::ZERO; 2],
             scans: Vec::new(),
-            recent: SpatialHash::default(),
+            recent: CellGrid::new(),
             near: Vec::new(),
+            near_points: Vec::new(),
+            near_order: Vec::new(),
             added: PairList::default(),
             merged: PairList::default(),
             built_for: None,
@@ -511,12 +541,12 @@ impl SelfCollision {
 
     /// The list radius R for largest thickness `t` (m).
     fn radius(&self, t: f64) -> f64 {
-        t * (1.0 + self.params.search_margin)
+        t * (1.0 + self.skin.margin())
     }
 
     /// How far a member may stray from its anchor for thickness `t` (m): half the skin.
     fn limit(&self, t: f64) -> f64 {
-        0.5 * self.params.search_margin * t
+        0.5 * self.skin.margin() * t
     }
 
     /// Makes sure the list holds every pair that may touch at `positions`.
@@ -538,12 +568,21 @@ impl SelfCollision {
     /// particles as the check. The check's common displacement is predicted from the last two
     /// (any common vector keeps the invariant; a good guess leaves fewer movers), so the whole
     /// check is one parallel pass.
+    ///
+    /// First, the work the last sweep did counts towards the skin's choice (see
+    /// [`crate::skin`]): a thicker skin drops the list, to be rebuilt below; a thinner one
+    /// filters it down, before the check runs against the thinner skin's limit.
     pub(crate) fn refresh(
         &mut self,
         positions: &mut [DVec3],
         thickness: &[f64],
         clamp: Option<Clamp<'_>>,
     ) {
+        match self.skin.record(self.pair_count()) {
+            Change::Keep => {}
+            Change::Grow => self.built_for = None,
+            Change::Shrink => self.shrink(),
+        }
         let max = self.params.max_displacement;
         // The list's thickness, half-skin² and predicted common displacement, unless there is
         // no list to check (none built yet, or no thickness or members: no pairs).
@@ -629,28 +668,41 @@ impl SelfCollision {
             return self.rebuild(positions, thickness);
         }
         self.updates += 1;
+        self.skin.reanchored(self.movers.len());
         let radius = self.radius(t);
         let r2 = radius * radius;
-        self.recent.reset(radius);
-        self.recent.build(&self.built_at, &self.reanchored);
+        self.recent.build(&self.built_at, &self.reanchored, radius);
         let new_pairs = &mut self.new_pairs;
         new_pairs.clear();
-        for &m in &self.movers {
-            let (x0, id) = (self.built_at[m as usize], self.members[m as usize]);
-            let pair = |j: u32| (id.min(j), id.max(j));
-            // Members never re-anchored sit in the grid at their anchors.
-            self.grid.for_each_near(x0, radius, |j| {
-                if j != id && !self.is_reanchored[self.slot_of[j as usize] as usize] {
-                    new_pairs.push(pair(j));
+        // Members never re-anchored sit in the grid at their anchors.
+        self.near_points.clear();
+        self.near_points
+            .extend(self.movers.iter().map(|&m| self.built_at[m as usize]));
+        let (members, slot_of, is_reanchored) = (&self.members, &self.slot_of, &self.is_reanchored);
+        let movers = &self.movers;
+        self.grid.for_each_near_all(
+            &self.near_points,
+            radius,
+            (&mut self.near_order, &mut self.near),
+            |k, j| {
+                let id = members[movers[k] as usize];
+                if j != id && !is_reanchored[slot_of[j as usize] as usize] {
+                    new_pairs.push((id.min(j), id.max(j)));
                 }
-            });
-            self.recent.query(x0, radius, &mut self.near);
-            for &r in &self.near {
-                if r != m && self.built_at[r as usize].distance_squared(x0) <= r2 {
-                    new_pairs.push(pair(self.members[r as usize]));
+            },
+        );
+        // Re-anchored members, at their anchors in `recent`.
+        self.recent.for_each_near_all(
+            &self.near_points,
+            radius,
+            (&mut self.near_order, &mut self.near),
+            |k, r| {
+                if r != movers[k] {
+                    let (id, j) = (members[movers[k] as usize], members[r as usize]);
+                    new_pairs.push((id.min(j), id.max(j)));
                 }
-            }
-        }
+            },
+        );
         new_pairs.sort_unstable();
         new_pairs.dedup();
         let Some(special) = &self.special else {
@@ -725,6 +777,46 @@ impl SelfCollision {
                 }
             });
         });
+        self.skin.built(self.members.len(), self.pair_count());
+    }
+
+    /// Lists for the (thinner) skin's radius R: keeps in `pairs` those whose positions at the
+    /// build are within R, the grid's test replayed (what a build at R would list), moves to
+    /// `extra` the others whose anchors are within R (a member re-anchored since the build is
+    /// nearer its partner now), and keeps in `extra` those whose anchors are within R. Every
+    /// non-exempt pair whose anchors are within R stays listed, and none twice. Rare (at most
+    /// once per epoch): serial.
+    fn shrink(&mut self) {
+        let Some(t) = self.built_for else { return };
+        let radius = self.radius(t);
+        let r2 = radius * radius;
+        let slot_of = &self.slot_of;
+        let near = |anchors: &[DVec3], a: u32, b: u32| {
+            let (sa, sb) = (slot_of[a as usize], slot_of[b as usize]);
+            anchors[sa as usize].distance_squared(anchors[sb as usize]) <= r2
+        };
+        let moved = &mut self.added;
+        moved.clear();
+        for list in &mut self.pairs {
+            list.retain(|a, b, target| {
+                let built = near(&self.built_pos, a, b);
+                if !built && near(&self.built_at, a, b) {
+                    moved.push(a, b, target);
+                }
+                built
+            });
+        }
+        self.extra.retain(|a, b, _| near(&self.built_at, a, b));
+        if !moved.a.is_empty() {
+            let mut order: Vec<usize> = (0..moved.len()).collect();
+            order.sort_unstable_by_key(|&k| (moved.a[k], moved.b[k]));
+            let mut by_pair = PairList::default();
+            for k in order {
+                by_pair.push(moved.a[k], moved.b[k], moved.target[k]);
+            }
+            self.extra.merge_into(&by_pair, &mut self.merged);
+            std::mem::swap(&mut self.extra, &mut self.merged);
+        }
     }
 
     /// One Jacobi sweep over the touching pairs (see the module doc); returns the number of
@@ -774,6 +866,7 @@ impl SelfCollision {
 mod tests {
     use super::*;
     use crate::scenarios::self_fold;
+    use crate::skin::STEPS;
     use weft_solver::{
         ClothParams, Forces, GridDesc, Mass, Method, Orientation, Settings, SolverBuilder,
         SubstepContext, SubstepHook,
@@ -1028,12 +1121,10 @@ mod tests {
         }
     }
 
-    fn fold_with(search_margin: f64) -> (Vec<DVec3>, u64, u64) {
+    /// The self-fold scenario, 90 frames, with `params`: final positions, rebuilds, partial
+    /// updates and changes of skin.
+    fn fold_with(params: SelfCollisionParams) -> (Vec<DVec3>, u64, u64, u64) {
         let (mut solver, _) = self_fold(Method::Xpbd, 10, 30).expect("scenario");
-        let params = SelfCollisionParams {
-            search_margin,
-            ..SelfCollisionParams::default()
-        };
         let sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
         let thickness = vec![solver.cloths()[0].thickness; solver.particles().len()];
         let mut hook = Hook {
@@ -1048,25 +1139,100 @@ mod tests {
             solver.particles().positions.clone(),
             hook.sc.rebuilds(),
             hook.sc.updates(),
+            hook.sc.skin.changes(),
         )
     }
 
     #[test]
     fn skin_list_folds_exactly_like_a_search_before_every_sweep() {
         // No skin: any motion at all rebuilds the list, i.e. a fresh search every sweep.
-        let (every, sweeps, _) = fold_with(0.0);
-        let (skin, rebuilds, updates) = fold_with(SelfCollisionParams::default().search_margin);
-        assert!(updates > 0, "no partial update was exercised");
+        let (every, sweeps, _, _) = fold_with(SelfCollisionParams {
+            search_margin: 0.0,
+            adaptive_margin: false,
+            ..SelfCollisionParams::default()
+        });
         assert_eq!(sweeps, 90 * 10, "a fresh search every sweep");
-        assert!(
-            4 * rebuilds < 3 * sweeps,
-            "{rebuilds} rebuilds in {sweeps} sweeps"
-        );
-        let differ = every
+        // A fixed skin, and the adaptive one (the default), which must change along the way.
+        let fixed = SelfCollisionParams {
+            adaptive_margin: false,
+            ..SelfCollisionParams::default()
+        };
+        for params in [fixed, SelfCollisionParams::default()] {
+            let (skin, rebuilds, updates, changes) = fold_with(params);
+            assert!(updates > 0, "no partial update was exercised");
+            assert!(
+                4 * rebuilds < 3 * sweeps,
+                "{rebuilds} rebuilds in {sweeps} sweeps"
+            );
+            assert_eq!(
+                changes > 0,
+                params.adaptive_margin,
+                "{changes} changes of skin"
+            );
+            let differ = every
+                .iter()
+                .zip(&skin)
+                .filter(|(a, b)| a.to_array() != b.to_array())
+                .count();
+            assert_eq!(differ, 0, "{differ} particles differ");
+        }
+    }
+
+    #[test]
+    fn a_thinner_skin_keeps_every_pair_whose_anchors_are_within_its_radius_once() {
+        let (solver, mut x, t) = folded();
+        let params = SelfCollisionParams {
+            adaptive_margin: false,
+            ..SelfCollisionParams::default()
+        };
+        let mut sc = SelfCollision::new(&solver, &[0], params).expect("self-collision");
+        sc.refresh(&mut x, &t, None);
+        let (r_old, r_new) = (sc.radius(SPACING), SPACING * (1.0 + STEPS[0]));
+        // A pair the build listed between the two radii; its first particle moves past the
+        // limit to within one thickness of the second, so it is re-anchored there: the thinner
+        // skin must keep that pair, now from `extra`.
+        let list = listed(&sc);
+        let &(a, b) = list
             .iter()
-            .zip(&skin)
-            .filter(|(a, b)| a.to_array() != b.to_array())
-            .count();
-        assert_eq!(differ, 0, "{differ} particles differ");
+            .find(|&&(a, b)| {
+                let d = x[a as usize].distance(x[b as usize]);
+                d > 1.1 * r_new && d <= r_old
+            })
+            .expect("a pair between the radii");
+        let to_b = x[b as usize] - x[a as usize];
+        x[a as usize] += to_b * (1.0 - 0.9 * SPACING / to_b.length());
+        sc.refresh(&mut x, &t, None);
+        assert_eq!((sc.rebuilds(), sc.updates()), (1, 1));
+        let in_pairs = |sc: &SelfCollision| {
+            sc.pairs
+                .iter()
+                .any(|l| (0..l.len()).any(|k| (l.a[k], l.b[k]) == (a, b)))
+        };
+        assert!(in_pairs(&sc));
+        sc.skin = Skin::new(STEPS[0], false);
+        sc.shrink();
+        assert!(
+            !in_pairs(&sc),
+            "the build's test at the thinner radius drops it"
+        );
+        assert!(
+            sc.extra.position(a, b).is_ok(),
+            "its anchors keep it listed"
+        );
+        // Exactly the non-exempt pairs whose anchors are within the new radius, or whose
+        // positions at the build were (`whole` asserts none is listed twice).
+        let listed = listed(&sc);
+        let anchors: Vec<DVec3> = (0..x.len())
+            .map(|i| sc.built_at[sc.slot_of[i] as usize])
+            .collect();
+        let built: Vec<DVec3> = (0..x.len())
+            .map(|i| sc.built_pos[sc.slot_of[i] as usize])
+            .collect();
+        let mut expected = brute_pairs(&sc, &anchors, &t, |_| r_new * (1.0 + 1e-12));
+        expected.extend(brute_pairs(&sc, &built, &t, |_| r_new * (1.0 + 1e-12)));
+        expected.sort_unstable();
+        expected.dedup();
+        assert_eq!(listed, expected);
+        assert_complete(&sc, &x, &t, "after shrinking");
     }
 }

@@ -165,6 +165,20 @@ fn cell_key(p: DVec3, inv_spacing: f64) -> u64 {
 /// As key offsets from (x, y, z) to (x + dx, y + dy, z − 1).
 const COLUMNS: [u64; 4] = [Y - 1, X - Y - 1, X - 1, X + Y - 1];
 
+/// All nine neighbour columns (dx, dy ∈ −1..=1) in key order, as key offsets from
+/// (x − 1, y − 1, z − 1) to (x + dx, y + dy, z − 1).
+const NEAR_COLUMNS: [u64; 9] = [
+    0,
+    Y,
+    2 * Y,
+    X,
+    X + Y,
+    X + 2 * Y,
+    2 * X,
+    2 * X + Y,
+    2 * X + 2 * Y,
+];
+
 impl CellGrid {
     /// An empty grid.
     pub(crate) fn new() -> Self {
@@ -223,32 +237,54 @@ impl CellGrid {
         runs
     }
 
-    /// Calls `f(i)` for every built item at most `radius` (≤ spacing) from `p`, in key order.
+    /// Calls `f(k, i)` for every query point `points[k]` and every built item `i` at most
+    /// `radius` (≤ spacing) from it. `order` and `row` are scratch.
     ///
-    /// The nine neighbour columns (x + dx, y + dy, z − 1..=z + 1) come in key order: one binary
-    /// search finds the first, and each next one is found by galloping forward from the last
-    /// (Bentley and Yao 1976), a few steps instead of a search over the whole grid.
-    pub(crate) fn for_each_near(&self, p: DVec3, radius: f64, mut f: impl FnMut(u32)) {
+    /// The queries are taken in key order, so that the start of each of the nine neighbour
+    /// columns (x + dx, y + dy, z − 1..=z + 1) only moves forward from one query to the next:
+    /// one cursor per column gallops on from where it stopped (Bentley and Yao 1976). A batch
+    /// of queries then costs a few steps each, where a search per query from scratch would
+    /// cross the grid nine times.
+    pub(crate) fn for_each_near_all(
+        &self,
+        points: &[DVec3],
+        radius: f64,
+        (order, row): (&mut Vec<(u64, u32)>, &mut Vec<u32>),
+        mut f: impl FnMut(usize, u32),
+    ) {
         assert!(
             radius <= self.spacing,
             "query radius {radius} exceeds the cell size {}",
             self.spacing
         );
         let r2 = radius * radius;
-        let key = cell_key(p, 1.0 / self.spacing);
-        let cells = &self.sorted;
-        let mut at = 0;
-        for column in [key - X - Y, key - X, key - X + Y, key - Y, key, key + Y]
-            .into_iter()
-            .chain([key + X - Y, key + X, key + X + Y])
-        {
-            let (lo, hi) = (column - 1, column + 1);
-            at = gallop(cells, at, lo);
-            while at < cells.len() && cells[at].0 <= hi {
-                if self.positions[at].distance_squared(p) <= r2 {
-                    f(cells[at].1);
+        let inv = 1.0 / self.spacing;
+        order.clear();
+        order.extend(
+            points
+                .iter()
+                .enumerate()
+                .map(|(k, &p)| (cell_key(p, inv), k as u32)),
+        );
+        order.sort_unstable();
+        let (cells, pos) = (&self.sorted, &self.positions);
+        let mut cursors = [0usize; NEAR_COLUMNS.len()];
+        for &(key, k) in order.iter() {
+            let p = points[k as usize];
+            // Cell coordinates are at least 1, so the lowest column start does not wrap.
+            let base = key - X - Y - 1;
+            row.clear();
+            for (cursor, offset) in cursors.iter_mut().zip(NEAR_COLUMNS) {
+                let lo = base + offset;
+                *cursor = gallop(cells, *cursor, lo);
+                let mut end = *cursor;
+                while end < cells.len() && cells[end].0 <= lo + 2 {
+                    end += 1;
                 }
-                at += 1;
+                near_into(row, p, r2, &cells[*cursor..end], &pos[*cursor..end]);
+            }
+            for &i in row.iter() {
+                f(k as usize, i);
             }
         }
     }
@@ -425,19 +461,23 @@ mod tests {
         let mut grid = CellGrid::new();
         grid.build(&positions, &items, 0.04);
         // At every point (built or not) and at points between them, for two radii.
-        let probes = positions
+        let probes: Vec<DVec3> = positions
             .iter()
             .copied()
-            .chain(positions.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+            .chain(positions.windows(2).map(|w| 0.5 * (w[0] + w[1])))
+            .collect();
         let mut total = 0;
-        for p in probes {
-            for radius in [0.04, 0.015] {
-                let mut found = Vec::new();
-                grid.for_each_near(p, radius, |i| found.push(i));
+        let mut scratch = (Vec::new(), Vec::new());
+        for radius in [0.04, 0.015] {
+            let mut found = vec![Vec::new(); probes.len()];
+            grid.for_each_near_all(&probes, radius, (&mut scratch.0, &mut scratch.1), |k, i| {
+                found[k].push(i)
+            });
+            for (p, mut found) in probes.iter().zip(found) {
                 let mut brute: Vec<u32> = items
                     .iter()
                     .copied()
-                    .filter(|&i| positions[i as usize].distance_squared(p) <= radius * radius)
+                    .filter(|&i| positions[i as usize].distance_squared(*p) <= radius * radius)
                     .collect();
                 brute.sort_unstable();
                 total += found.len();

@@ -115,6 +115,7 @@ impl Scene {
                 friction: Friction::new(sc.static_friction, sc.dynamic_friction),
                 max_displacement: sc.max_displacement,
                 search_margin: sc.search_margin,
+                adaptive_margin: sc.adaptive_search_margin,
             };
             world
                 .enable_self_collision(solver, &self_cloths, params)

@@ -126,3 +126,40 @@ fn edit_distance(a: &str, b: &str) -> usize {
     }
     row[b.len()]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::DirFiles;
+
+    const CLOTH: &str = "[cloth.c]\nresolution = [4, 4]\nsize = [1.0, 1.0]\n\n";
+
+    fn self_collision(section: &str) -> Result<Scene, SceneErrors> {
+        let text = format!("{CLOTH}[self_collision]\n{section}");
+        from_text("s.toml", &text, &[], &DirFiles(".".into()))
+    }
+
+    #[test]
+    fn the_search_margin_adapts_unless_the_scene_fixes_it() {
+        let spec = |scene: Scene| scene.self_collision.expect("self-collision on");
+        let default = spec(self_collision("").expect("valid"));
+        assert_eq!(
+            (default.search_margin, default.adaptive_search_margin),
+            (0.5, true)
+        );
+        let fixed = spec(
+            self_collision("search_margin = 0.3\nadaptive_search_margin = false\n").expect("valid"),
+        );
+        assert_eq!(
+            (fixed.search_margin, fixed.adaptive_search_margin),
+            (0.3, false)
+        );
+        let err = self_collision("adaptive_search_margin = 2\n")
+            .expect_err("not a boolean")
+            .to_string();
+        assert!(
+            err.contains("s.toml") && err.contains("adaptive_search_margin"),
+            "{err}"
+        );
+    }
+}

@@ -256,6 +256,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
             dynamic_friction: s.dynamic_friction,
             max_displacement: s.max_displacement,
             search_margin: s.search_margin,
+            adaptive_search_margin: s.adaptive_search_margin,
         })
     });
     c.errors.is_empty().then_some(ResolvedParts {

@@ -128,6 +128,8 @@ pub struct SelfCollisionSpec {
     pub max_displacement: f64,
     /// Extra search radius as a fraction of thickness.
     pub search_margin: f64,
+    /// Whether the search margin follows the cloth's motion.
+    pub adaptive_search_margin: bool,
 }
 
 /// A validated scene.

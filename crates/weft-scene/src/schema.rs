@@ -669,9 +669,13 @@ pub struct SelfCollisionSection {
     /// Largest per-substep displacement as a fraction of thickness.
     #[serde(default = "default_max_displacement")]
     pub max_displacement: f64,
-    /// Extra candidate search radius as a fraction of thickness.
+    /// Extra candidate search radius as a fraction of thickness (the starting one, when
+    /// `adaptive_search_margin` is on).
     #[serde(default = "default_search_margin")]
     pub search_margin: f64,
+    /// Whether the search margin follows the cloth's motion (changes cost only).
+    #[serde(default = "yes")]
+    pub adaptive_search_margin: bool,
 }
 
 fn yes() -> bool {
