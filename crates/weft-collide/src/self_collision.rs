@@ -31,7 +31,7 @@ use crate::error::CollideError;
 use crate::friction::Friction;
 use crate::self_contact::{Bins, State, apply, find_contacts};
 use crate::skin::{Change, Skin};
-use crate::spatial_hash::CellGrid;
+use crate::spatial_hash::{CellGrid, Queries};
 
 /// Self-collision settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -359,12 +359,12 @@ pub(crate) struct SelfCollision {
     drift: [DVec3; 2],
     /// Per chunk of particles, the last check's findings.
     scans: Vec<Scan>,
-    /// Re-anchored members (slots) by anchor, and a query's answer; the movers' anchors, and
-    /// their order by cell, for the grid's queries.
+    /// Re-anchored members (slots) by anchor, in cells of the grid's size; the movers'
+    /// anchors, sorted once by cell for both grids' queries; a query's answer.
     recent: CellGrid,
-    near: Vec<u32>,
     near_points: Vec<DVec3>,
-    near_order: Vec<(u64, u32)>,
+    near_queries: Queries,
+    near: Vec<u32>,
     added: PairList,
     merged: PairList,
     /// Largest member thickness the list was built for; `None` when there is no list.
@@ -452,7 +452,7 @@ impl SelfCollision {
             recent: CellGrid::new(),
             near: Vec::new(),
             near_points: Vec::new(),
-            near_order: Vec::new(),
+            near_queries: Queries::default(),
             added: PairList::default(),
             merged: PairList::default(),
             built_for: None,
@@ -671,19 +671,22 @@ impl SelfCollision {
         self.skin.reanchored(self.movers.len());
         let radius = self.radius(t);
         let r2 = radius * radius;
-        self.recent.build(&self.built_at, &self.reanchored, radius);
+        let spacing = self.grid.spacing();
+        self.recent.build(&self.built_at, &self.reanchored, spacing);
         let new_pairs = &mut self.new_pairs;
         new_pairs.clear();
         // Members never re-anchored sit in the grid at their anchors.
         self.near_points.clear();
         self.near_points
             .extend(self.movers.iter().map(|&m| self.built_at[m as usize]));
+        self.near_queries.sort(&self.near_points, spacing);
         let (members, slot_of, is_reanchored) = (&self.members, &self.slot_of, &self.is_reanchored);
         let movers = &self.movers;
         self.grid.for_each_near_all(
             &self.near_points,
+            &self.near_queries,
             radius,
-            (&mut self.near_order, &mut self.near),
+            &mut self.near,
             |k, j| {
                 let id = members[movers[k] as usize];
                 if j != id && !is_reanchored[slot_of[j as usize] as usize] {
@@ -694,8 +697,9 @@ impl SelfCollision {
         // Re-anchored members, at their anchors in `recent`.
         self.recent.for_each_near_all(
             &self.near_points,
+            &self.near_queries,
             radius,
-            (&mut self.near_order, &mut self.near),
+            &mut self.near,
             |k, r| {
                 if r != movers[k] {
                     let (id, j) = (members[movers[k] as usize], members[r as usize]);

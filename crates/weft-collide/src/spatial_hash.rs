@@ -179,6 +179,31 @@ const NEAR_COLUMNS: [u64; 9] = [
     2 * X + 2 * Y,
 ];
 
+/// Query points in cell order for [`CellGrid::for_each_near_all`], for every grid of one cell
+/// size: sorted once, they serve several grids.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Queries {
+    spacing: f64,
+    /// (cell key, index of the point) in key order.
+    order: Vec<(u64, u32)>,
+}
+
+impl Queries {
+    /// Sorts `points` by their cell of size `spacing` (m).
+    pub(crate) fn sort(&mut self, points: &[DVec3], spacing: f64) {
+        self.spacing = spacing;
+        let inv = 1.0 / spacing;
+        self.order.clear();
+        self.order.extend(
+            points
+                .iter()
+                .enumerate()
+                .map(|(k, &p)| (cell_key(p, inv), k as u32)),
+        );
+        self.order.sort_unstable();
+    }
+}
+
 impl CellGrid {
     /// An empty grid.
     pub(crate) fn new() -> Self {
@@ -237,8 +262,14 @@ impl CellGrid {
         runs
     }
 
+    /// Cell size of the last build (m).
+    pub(crate) fn spacing(&self) -> f64 {
+        self.spacing
+    }
+
     /// Calls `f(k, i)` for every query point `points[k]` and every built item `i` at most
-    /// `radius` (≤ spacing) from it. `order` and `row` are scratch.
+    /// `radius` (≤ spacing) from it; `queries` are the points sorted for this grid's cell size.
+    /// `row` is scratch.
     ///
     /// The queries are taken in key order, so that the start of each of the nine neighbour
     /// columns (x + dx, y + dy, z − 1..=z + 1) only moves forward from one query to the next:
@@ -248,8 +279,9 @@ impl CellGrid {
     pub(crate) fn for_each_near_all(
         &self,
         points: &[DVec3],
+        queries: &Queries,
         radius: f64,
-        (order, row): (&mut Vec<(u64, u32)>, &mut Vec<u32>),
+        row: &mut Vec<u32>,
         mut f: impl FnMut(usize, u32),
     ) {
         assert!(
@@ -257,19 +289,14 @@ impl CellGrid {
             "query radius {radius} exceeds the cell size {}",
             self.spacing
         );
-        let r2 = radius * radius;
-        let inv = 1.0 / self.spacing;
-        order.clear();
-        order.extend(
-            points
-                .iter()
-                .enumerate()
-                .map(|(k, &p)| (cell_key(p, inv), k as u32)),
+        assert_eq!(
+            queries.spacing, self.spacing,
+            "queries sorted for another cell size"
         );
-        order.sort_unstable();
+        let r2 = radius * radius;
         let (cells, pos) = (&self.sorted, &self.positions);
         let mut cursors = [0usize; NEAR_COLUMNS.len()];
-        for &(key, k) in order.iter() {
+        for &(key, k) in &queries.order {
             let p = points[k as usize];
             // Cell coordinates are at least 1, so the lowest column start does not wrap.
             let base = key - X - Y - 1;
@@ -277,10 +304,7 @@ impl CellGrid {
             for (cursor, offset) in cursors.iter_mut().zip(NEAR_COLUMNS) {
                 let lo = base + offset;
                 *cursor = gallop(cells, *cursor, lo);
-                let mut end = *cursor;
-                while end < cells.len() && cells[end].0 <= lo + 2 {
-                    end += 1;
-                }
+                let end = column_end(cells, *cursor, lo + 2);
                 near_into(row, p, r2, &cells[*cursor..end], &pos[*cursor..end]);
             }
             for &i in row.iter() {
@@ -362,11 +386,7 @@ impl CellGrid {
                 while *cursor < n && cells[*cursor].0 < lo {
                     *cursor += 1;
                 }
-                let mut end = *cursor;
-                while end < n && cells[end].0 <= lo + 2 {
-                    end += 1;
-                }
-                runs[k + 1] = (*cursor, end);
+                runs[k + 1] = (*cursor, column_end(cells, *cursor, lo + 2));
             }
             for x in s..e {
                 let px = pos[x];
@@ -382,6 +402,16 @@ impl CellGrid {
             s = e;
         }
     }
+}
+
+/// The first index at or after `from` whose key exceeds `last` (a column's cells run to
+/// `last`; they are few, so a linear scan).
+fn column_end(cells: &[(u64, u32)], from: usize, last: u64) -> usize {
+    let mut end = from;
+    while end < cells.len() && cells[end].0 <= last {
+        end += 1;
+    }
+    end
 }
 
 /// The first index at or after `from` whose key is at least `key` (`cells` sorted by key):
@@ -467,12 +497,11 @@ mod tests {
             .chain(positions.windows(2).map(|w| 0.5 * (w[0] + w[1])))
             .collect();
         let mut total = 0;
-        let mut scratch = (Vec::new(), Vec::new());
+        let (mut queries, mut row) = (Queries::default(), Vec::new());
+        queries.sort(&probes, grid.spacing());
         for radius in [0.04, 0.015] {
             let mut found = vec![Vec::new(); probes.len()];
-            grid.for_each_near_all(&probes, radius, (&mut scratch.0, &mut scratch.1), |k, i| {
-                found[k].push(i)
-            });
+            grid.for_each_near_all(&probes, &queries, radius, &mut row, |k, i| found[k].push(i));
             for (p, mut found) in probes.iter().zip(found) {
                 let mut brute: Vec<u32> = items
                     .iter()
