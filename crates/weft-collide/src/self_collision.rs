@@ -359,7 +359,8 @@ pub(crate) struct SelfCollision {
     drift: [DVec3; 2],
     /// Per chunk of particles, the last check's findings.
     scans: Vec<Scan>,
-    /// Re-anchored members (slots) by anchor, in cells of the grid's size; the movers'
+    /// Re-anchored members (slots) by anchor, in cells of the grid's size (built at the first
+    /// re-anchoring after a build, then updated with each re-anchoring's movers); the movers'
     /// anchors, sorted once by cell for both grids' queries; a query's answer.
     recent: CellGrid,
     near_points: Vec<DVec3>,
@@ -656,6 +657,7 @@ impl SelfCollision {
     /// Re-anchors `movers` at xᵢ − c and lists their pairs within R of the new anchors (see
     /// [`SelfCollision::refresh`]); rebuilds instead once many members have been re-anchored.
     fn reanchor(&mut self, positions: &[DVec3], thickness: &[f64], c: DVec3, t: f64) {
+        let before = self.reanchored.len();
         for &m in &self.movers {
             let m = m as usize;
             self.built_at[m] = positions[self.members[m] as usize] - c;
@@ -672,7 +674,16 @@ impl SelfCollision {
         let radius = self.radius(t);
         let r2 = radius * radius;
         let spacing = self.grid.spacing();
-        self.recent.build(&self.built_at, &self.reanchored, spacing);
+        if before == 0 {
+            self.recent.build(&self.built_at, &self.reanchored, spacing);
+        } else {
+            // Movers re-anchored before leave their old cells; the others keep their places.
+            let mut new_ones = self.reanchored[before..].to_vec();
+            new_ones.sort_unstable();
+            self.recent.update(&self.built_at, &self.movers, |m| {
+                new_ones.binary_search(&m).is_err()
+            });
+        }
         let new_pairs = &mut self.new_pairs;
         new_pairs.clear();
         // Members never re-anchored sit in the grid at their anchors.
@@ -1085,13 +1096,25 @@ mod tests {
         assert!(listed(&sc).binary_search(&(200, 300)).is_ok());
         assert!(listed(&sc).binary_search(&(201, 300)).is_ok());
         assert_complete(&sc, &x, &t, "after re-anchoring");
+        // 200 jumps again (re-anchored a second time) and 202 for the first time: the grid of
+        // re-anchored members, updated in place, holds each once at its anchor.
+        x[200] = x[300] + DVec3::new(0.0, -0.2 * SPACING, 0.0);
+        x[202] = x[300] + DVec3::new(-0.2 * SPACING, 0.0, 0.0);
+        sc.refresh(&mut x, &t, None);
+        assert_eq!((sc.rebuilds(), sc.updates()), (1, 2), "re-anchored again");
+        assert_eq!(sc.reanchored.len(), 3);
+        let mut fresh = CellGrid::new();
+        fresh.build(&sc.built_at, &sc.reanchored, sc.grid.spacing());
+        assert_eq!(sc.recent.entries(), fresh.entries());
+        assert!(listed(&sc).binary_search(&(202, 300)).is_ok());
+        assert_complete(&sc, &x, &t, "after re-anchoring again");
         // Everything shaken by half a skin: a full rebuild.
         let mut seed = 3;
         for xi in &mut x {
             *xi += DVec3::new(rand(&mut seed), rand(&mut seed), rand(&mut seed)) * (2.0 * limit);
         }
         sc.refresh(&mut x, &t, None);
-        assert_eq!((sc.rebuilds(), sc.updates()), (2, 1), "shaken");
+        assert_eq!((sc.rebuilds(), sc.updates()), (2, 2), "shaken");
         assert_complete(&sc, &x, &t, "after the rebuild");
         // A thickness change drops the list.
         sc.invalidate();

@@ -137,6 +137,12 @@ pub(crate) struct CellGrid {
     sorted: Vec<(u64, u32)>,
     /// Positions in key order.
     positions: Vec<DVec3>,
+    /// Scratch of [`CellGrid::update`]: the moved items' keys, the old order and positions,
+    /// and a flag per item leaving its place (all false between calls).
+    fresh: Vec<(u64, u32)>,
+    old: Vec<(u64, u32)>,
+    old_positions: Vec<DVec3>,
+    leaving: Vec<bool>,
 }
 
 /// Bits per cell coordinate in a cell key.
@@ -235,6 +241,79 @@ impl CellGrid {
                 .with_min_len(PAR_MIN)
                 .map(|&(_, i)| positions[i as usize]),
         );
+    }
+
+    /// Moves `moved` (items, each given once) to their cells at `positions`: those already in
+    /// the grid (for which `present` holds) leave their old cells, and every other item keeps
+    /// its place. The result is the grid [`CellGrid::build`] would give for the union at the
+    /// same positions, for the cost of sorting `moved` and one merge.
+    pub(crate) fn update(
+        &mut self,
+        positions: &[DVec3],
+        moved: &[u32],
+        present: impl Fn(u32) -> bool,
+    ) {
+        let inv = 1.0 / self.spacing;
+        let mut fresh = std::mem::take(&mut self.fresh);
+        fresh.clear();
+        fresh.extend(
+            moved
+                .iter()
+                .map(|&i| (cell_key(positions[i as usize], inv), i)),
+        );
+        fresh.sort_unstable();
+        // The old order and positions, swapped out into the scratch buffers.
+        let (mut old, mut old_pos) = (
+            std::mem::take(&mut self.old),
+            std::mem::take(&mut self.old_positions),
+        );
+        std::mem::swap(&mut old, &mut self.sorted);
+        std::mem::swap(&mut old_pos, &mut self.positions);
+        self.sorted.clear();
+        self.positions.clear();
+        // The moved items that were present leave their old places.
+        let top = moved.iter().map(|&i| i as usize + 1).max().unwrap_or(0);
+        if self.leaving.len() < top {
+            self.leaving.resize(top, false);
+        }
+        for &i in moved {
+            self.leaving[i as usize] = present(i);
+        }
+        let leaving = &self.leaving;
+        let stays = |i: u32| !leaving.get(i as usize).copied().unwrap_or(false);
+        let (mut a, mut b) = (0, 0);
+        loop {
+            while a < old.len() && !stays(old[a].1) {
+                a += 1;
+            }
+            let take_old = match (old.get(a), fresh.get(b)) {
+                (Some(o), Some(f)) => o < f,
+                (Some(_), None) => true,
+                (None, Some(_)) => false,
+                (None, None) => break,
+            };
+            if take_old {
+                self.sorted.push(old[a]);
+                self.positions.push(old_pos[a]);
+                a += 1;
+            } else {
+                self.sorted.push(fresh[b]);
+                self.positions.push(positions[fresh[b].1 as usize]);
+                b += 1;
+            }
+        }
+        for &i in moved {
+            self.leaving[i as usize] = false;
+        }
+        (self.fresh, self.old, self.old_positions) = (fresh, old, old_pos);
+        // The items are no longer those of a build: the next build sorts afresh.
+        self.items.clear();
+    }
+
+    /// The (cell key, item) entries in key order and their positions.
+    #[cfg(test)]
+    pub(crate) fn entries(&self) -> (&[(u64, u32)], &[DVec3]) {
+        (&self.sorted, &self.positions)
     }
 
     /// Splits the sorted items into about `parts` runs of whole cells, for
@@ -515,6 +594,43 @@ mod tests {
             }
         }
         assert!(total > 5000, "too sparse a test: {total}");
+    }
+
+    #[test]
+    fn an_updated_grid_is_the_grid_built_anew() {
+        let (mut positions, items) = folded_cloud();
+        let spacing = 0.04;
+        let mut grid = CellGrid::new();
+        grid.build(&positions, &[], spacing);
+        let mut present = vec![false; positions.len()];
+        let mut seed = 3u64;
+        let mut next = |m: usize| {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 33) as usize % m
+        };
+        for round in 0..20 {
+            // Some items already in the grid and some new ones move.
+            let mut moved: Vec<u32> = (0..1 + next(200))
+                .map(|_| items[next(items.len())])
+                .collect();
+            moved.sort_unstable();
+            moved.dedup();
+            for &i in &moved {
+                positions[i as usize].x += 0.03 * (next(100) as f64 / 50.0 - 1.0);
+            }
+            grid.update(&positions, &moved, |i| present[i as usize]);
+            for &i in &moved {
+                present[i as usize] = true;
+            }
+            let union: Vec<u32> = (0..positions.len() as u32)
+                .filter(|&i| present[i as usize])
+                .collect();
+            let mut fresh = CellGrid::new();
+            fresh.build(&positions, &union, spacing);
+            assert_eq!(grid.sorted, fresh.sorted, "round {round}");
+            assert_eq!(grid.positions, fresh.positions, "round {round}");
+        }
+        assert!(present.iter().filter(|&&p| p).count() > 400);
     }
 
     #[test]
