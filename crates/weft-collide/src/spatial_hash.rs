@@ -156,13 +156,23 @@ const X: u64 = 1 << (2 * BITS);
 /// order and a neighbour's key is the key ± 1, ± Y, ± X. Clamping is 1-Lipschitz: cells that
 /// are neighbours stay neighbours (or merge), so no close pair is lost; only points more than
 /// 2²⁰ cells from the origin share border cells.
+///
+/// The floor is taken in integers (truncate, then step down where that rounded up): without
+/// SSE4.1 in the baseline target, `f64::floor` is a call into libm, which made keys most of a
+/// grid build (10 ns a point). A NaN coordinate truncates to 0: such points gather in one cell.
+#[inline]
 fn cell_key(p: DVec3, inv_spacing: f64) -> u64 {
-    let c = (p * inv_spacing).floor();
-    let half = f64::from(1u32 << (BITS - 1));
-    let max = f64::from((1u32 << BITS) - 2);
-    // NaN clamps to NaN and `as` turns it into 0: such points gather in one cell.
-    let k = |v: f64| (v + half).clamp(1.0, max) as u64;
-    (k(c.x) << (2 * BITS)) | (k(c.y) << BITS) | k(c.z)
+    let half = 1i64 << (BITS - 1);
+    let max = (1i64 << BITS) - 2;
+    let k = |v: f64| {
+        let v = v * inv_spacing;
+        // `as` truncates towards zero and saturates; exact below 2⁵³, and above every f64
+        // is an integer already.
+        let t = v as i64;
+        let floor = t.saturating_sub(i64::from(t as f64 > v));
+        floor.saturating_add(half).clamp(1, max) as u64
+    };
+    (k(p.x) << (2 * BITS)) | (k(p.y) << BITS) | k(p.z)
 }
 
 /// Neighbour columns (dx, dy) after a cell's own in key order, each visited over
@@ -594,6 +604,60 @@ mod tests {
             }
         }
         assert!(total > 5000, "too sparse a test: {total}");
+    }
+
+    #[test]
+    fn cell_keys_floor_like_f64_floor() {
+        // The key as first written, with `f64::floor`.
+        let reference = |p: DVec3, inv: f64| {
+            let c = (p * inv).floor();
+            let half = f64::from(1u32 << (BITS - 1));
+            let max = f64::from((1u32 << BITS) - 2);
+            let k = |v: f64| (v + half).clamp(1.0, max) as u64;
+            (k(c.x) << (2 * BITS)) | (k(c.y) << BITS) | k(c.z)
+        };
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -0.5,
+            1.0 - f64::EPSILON,
+            -1.0 + f64::EPSILON,
+            -f64::MIN_POSITIVE,
+            1e15 + 0.5,
+            -1e15 - 0.5,
+            2e6,
+            -2e6,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut seed = 9u64;
+        for _ in 0..10_000 {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let r = (seed >> 11) as f64 / (1u64 << 53) as f64;
+            values.push((r - 0.5) * 200.0);
+        }
+        for inv in [1.0, 37.5, 1.0 / 0.0071] {
+            for &v in &values {
+                for p in [
+                    DVec3::new(v, 0.3, -0.2),
+                    DVec3::new(0.1, v, 7.0),
+                    DVec3::new(-3.0, 2.0, v),
+                ] {
+                    assert_eq!(cell_key(p, inv), reference(p, inv), "{p} at {inv}");
+                }
+            }
+        }
+        // NaN coordinates share one cell.
+        let nan = DVec3::new(f64::NAN, 0.0, 0.0);
+        assert_eq!(
+            cell_key(nan, 2.0),
+            cell_key(DVec3::new(f64::NAN, 0.1, 0.2), 2.0)
+        );
     }
 
     #[test]
