@@ -605,6 +605,10 @@ impl SelfCollision {
             .enumerate()
             .for_each(|(k, (xs, scan))| {
                 scan.reset();
+                // In locals, not through `scan`: the movers' pushes would otherwise make the
+                // compiler store and reload the three sums at every particle.
+                let (mut lo, mut hi, mut sum) = (scan.lo, scan.hi, scan.sum);
+                let movers = &mut scan.movers;
                 for (j, x) in xs.iter_mut().enumerate() {
                     let i = k * MEMBER_CHUNK + j;
                     let slot = slot_of[i];
@@ -616,13 +620,13 @@ impl SelfCollision {
                     }
                     if let Some((_, limit2, guess)) = check {
                         let d = *x - built_at[slot as usize];
-                        (scan.lo, scan.hi, scan.sum) =
-                            (scan.lo.min(d), scan.hi.max(d), scan.sum + d);
+                        (lo, hi, sum) = (lo.min(d), hi.max(d), sum + d);
                         if (d - guess).length_squared() > limit2 {
-                            scan.movers.push(slot);
+                            movers.push(slot);
                         }
                     }
                 }
+                (scan.lo, scan.hi, scan.sum) = (lo, hi, sum);
             });
         let Some((t, limit2, guess)) = check else {
             if self.built_for.is_none() {
