@@ -394,7 +394,8 @@ impl CellGrid {
                 let lo = base + offset;
                 *cursor = gallop(cells, *cursor, lo);
                 let end = column_end(cells, *cursor, lo + 2);
-                near_into(row, p, r2, &cells[*cursor..end], &pos[*cursor..end]);
+                let items = cells[*cursor..end].iter().map(|&(_, i)| i);
+                near_into(row, p, r2, items, &pos[*cursor..end]);
             }
             for &i in row.iter() {
                 f(k as usize, i);
@@ -433,9 +434,12 @@ impl CellGrid {
     /// With `radius` ≤ spacing two such points lie in the same or neighbouring cells. Walking
     /// the cells in key order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
     /// form one contiguous run whose start only moves forward, so one cursor per column finds
-    /// it without any search after the first cell. The distance tests do not branch: about
-    /// one candidate in four is a partner, a branch there was mispredicted on every fourth
-    /// test and took most of a rebuild's time.
+    /// it without any search after the first cell. Each cell's candidates are copied together
+    /// once, so that a point tests them in one pass rather than one per column: a sheet lying
+    /// across the cells obliquely has a few candidates in each column, and a pass per column
+    /// cost more than its tests. The distance tests do not branch: about one candidate in four
+    /// is a partner, a branch there was mispredicted on every fourth test and took most of a
+    /// rebuild's time.
     pub(crate) fn for_each_row_in(
         &self,
         run: Range<usize>,
@@ -457,6 +461,7 @@ impl CellGrid {
                 *cursor = cells.partition_point(|&(k, _)| k < first + offset);
             }
         }
+        let (mut ids, mut near_pos) = (Vec::new(), Vec::new());
         let mut s = run.start;
         while s < run.end {
             let c = cells[s].0;
@@ -469,21 +474,31 @@ impl CellGrid {
             while y < n && cells[y].0 == c + 1 {
                 y += 1;
             }
-            let mut runs = [(e, y); 1 + COLUMNS.len()];
-            for (k, (cursor, offset)) in cursors.iter_mut().zip(COLUMNS).enumerate() {
+            // The cell's candidates gathered once, in key order (the cell and the cell above
+            // are contiguous), so that each point tests those after it in one pass.
+            ids.clear();
+            near_pos.clear();
+            ids.extend(cells[s..y].iter().map(|&(_, i)| i));
+            near_pos.extend_from_slice(&pos[s..y]);
+            for (cursor, offset) in cursors.iter_mut().zip(COLUMNS) {
                 let lo = c + offset;
                 while *cursor < n && cells[*cursor].0 < lo {
                     *cursor += 1;
                 }
-                runs[k + 1] = (*cursor, column_end(cells, *cursor, lo + 2));
+                let end = column_end(cells, *cursor, lo + 2);
+                ids.extend(cells[*cursor..end].iter().map(|&(_, i)| i));
+                near_pos.extend_from_slice(&pos[*cursor..end]);
             }
             for x in s..e {
-                let px = pos[x];
+                let from = x - s + 1;
                 row.clear();
-                near_into(row, px, r2, &cells[x + 1..e], &pos[x + 1..e]);
-                for &(from, to) in &runs {
-                    near_into(row, px, r2, &cells[from..to], &pos[from..to]);
-                }
+                near_into(
+                    row,
+                    pos[x],
+                    r2,
+                    ids[from..].iter().copied(),
+                    &near_pos[from..],
+                );
                 if !row.is_empty() {
                     f(cells[x].1, row);
                 }
@@ -517,15 +532,21 @@ fn gallop(cells: &[(u64, u32)], from: usize, key: u64) -> usize {
     lo + cells[lo..hi].partition_point(|&(k, _)| k < key)
 }
 
-/// Appends to `row` the items of `cells` whose position (in `pos`) is at most √`r2` from `p`,
-/// without a branch per item.
+/// Appends to `row` the `items` whose position (in `pos`, one each) is at most √`r2` from
+/// `p`, without a branch per item.
 #[inline(always)]
-fn near_into(row: &mut Vec<u32>, p: DVec3, r2: f64, cells: &[(u64, u32)], pos: &[DVec3]) {
+fn near_into(
+    row: &mut Vec<u32>,
+    p: DVec3,
+    r2: f64,
+    items: impl ExactSizeIterator<Item = u32>,
+    pos: &[DVec3],
+) {
     let start = row.len();
-    row.resize(start + cells.len(), 0);
+    row.resize(start + items.len(), 0);
     let out = &mut row[start..];
     let mut n = 0;
-    for (&(_, item), q) in cells.iter().zip(pos) {
+    for (item, q) in items.zip(pos) {
         out[n] = item;
         n += usize::from(p.distance_squared(*q) <= r2);
     }
