@@ -25,6 +25,7 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use rustc_hash::FxHashSet;
 use weft_solver::{Particles, Solver};
 
 use crate::error::CollideError;
@@ -290,37 +291,12 @@ impl PairList {
         self.b.truncate(n);
         self.target.truncate(n);
     }
+}
 
-    /// Index of (a, b), or where it would go, in a list sorted by (a, b).
-    fn position(&self, a: u32, b: u32) -> Result<usize, usize> {
-        let (mut lo, mut hi) = (0, self.a.len());
-        while lo < hi {
-            let mid = (lo + hi) / 2;
-            match (self.a[mid], self.b[mid]).cmp(&(a, b)) {
-                std::cmp::Ordering::Less => lo = mid + 1,
-                std::cmp::Ordering::Greater => hi = mid,
-                std::cmp::Ordering::Equal => return Ok(mid),
-            }
-        }
-        Err(lo)
-    }
-
-    /// Both sorted lists in one, sorted (they share no pair), into `out`.
-    fn merge_into(&self, other: &PairList, out: &mut PairList) {
-        out.clear();
-        let (mut i, mut j) = (0, 0);
-        while i < self.a.len() || j < other.a.len() {
-            let take_self = j == other.a.len()
-                || (i < self.a.len() && (self.a[i], self.b[i]) < (other.a[j], other.b[j]));
-            if take_self {
-                out.push(self.a[i], self.b[i], self.target[i]);
-                i += 1;
-            } else {
-                out.push(other.a[j], other.b[j], other.target[j]);
-                j += 1;
-            }
-        }
-    }
+/// A pair (a < b) as one key.
+#[inline(always)]
+fn pair_key(a: u32, b: u32) -> u64 {
+    (u64::from(a) << 32) | u64::from(b)
 }
 
 /// Self-collision state: member particles, rest data, and the Verlet list of candidate pairs.
@@ -347,13 +323,16 @@ pub(crate) struct SelfCollision {
     is_reanchored: Vec<bool>,
     /// Member slot of each particle (`u32::MAX` for non-members).
     slot_of: Vec<u32>,
-    /// Pairs added for re-anchored members since the last full build (not in `pairs`), sorted.
+    /// Pairs added for re-anchored members since the last full build (not in `pairs`), in the
+    /// order they were added, and the same pairs as keys ([`pair_key`]) to look them up.
     extra: PairList,
+    in_extra: FxHashSet<u64>,
     /// Partial updates (re-anchoring a few members) so far.
     updates: u64,
-    /// Scratch: members that moved past the limit; pairs found for them; pairs to add; the
-    /// merged extra list.
+    /// Scratch: members that moved past the limit, a flag per slot for them (false between
+    /// re-anchorings), and the pairs found for them.
     movers: Vec<u32>,
+    is_mover: Vec<bool>,
     new_pairs: Vec<(u32, u32)>,
     /// The members' mean displacement from their anchors at the last two checks.
     drift: [DVec3; 2],
@@ -366,8 +345,6 @@ pub(crate) struct SelfCollision {
     near_points: Vec<DVec3>,
     near_queries: Queries,
     near: Vec<u32>,
-    added: PairList,
-    merged: PairList,
     /// Largest member thickness the list was built for; `None` when there is no list.
     built_for: Option<f64>,
     /// Lists built so far.
@@ -445,8 +422,10 @@ impl SelfCollision {
             is_reanchored: Vec::new(),
             slot_of,
             extra: PairList::default(),
+            in_extra: FxHashSet::default(),
             updates: 0,
             movers: Vec::new(),
+            is_mover: Vec::new(),
             new_pairs: Vec::new(),
             drift: [DVec3::ZERO; 2],
             scans: Vec::new(),
@@ -454,8 +433,6 @@ impl SelfCollision {
             near: Vec::new(),
             near_points: Vec::new(),
             near_queries: Queries::default(),
-            added: PairList::default(),
-            merged: PairList::default(),
             built_for: None,
             rebuilds: 0,
             special: None,
@@ -695,8 +672,12 @@ impl SelfCollision {
         self.near_points
             .extend(self.movers.iter().map(|&m| self.built_at[m as usize]));
         self.near_queries.sort(&self.near_points, spacing);
+        self.is_mover.resize(self.members.len(), false);
+        for &m in &self.movers {
+            self.is_mover[m as usize] = true;
+        }
         let (members, slot_of, is_reanchored) = (&self.members, &self.slot_of, &self.is_reanchored);
-        let movers = &self.movers;
+        let (movers, is_mover) = (&self.movers, &self.is_mover);
         self.grid.for_each_near_all(
             &self.near_points,
             &self.near_queries,
@@ -709,42 +690,41 @@ impl SelfCollision {
                 }
             },
         );
-        // Re-anchored members, at their anchors in `recent`.
+        // Re-anchored members, at their anchors in `recent`. Two movers find each other
+        // (the distance test is symmetric): the pair is kept from the lower slot's query, so
+        // that no pair is found twice.
         self.recent.for_each_near_all(
             &self.near_points,
             &self.near_queries,
             radius,
             &mut self.near,
             |k, r| {
-                if r != movers[k] {
-                    let (id, j) = (members[movers[k] as usize], members[r as usize]);
+                let m = movers[k];
+                if r != m && (m < r || !is_mover[r as usize]) {
+                    let (id, j) = (members[m as usize], members[r as usize]);
                     new_pairs.push((id.min(j), id.max(j)));
                 }
             },
         );
-        new_pairs.sort_unstable();
-        new_pairs.dedup();
+        for &m in &self.movers {
+            self.is_mover[m as usize] = false;
+        }
         let Some(special) = &self.special else {
             return self.rebuild(positions, thickness);
         };
-        let added = &mut self.added;
-        added.clear();
-        for &(a, b) in new_pairs.iter() {
+        for &(a, b) in &self.new_pairs {
             let (sa, sb) = (self.slot_of[a as usize], self.slot_of[b as usize]);
             // Listed at the build (the grid's test, replayed), or added since.
             let built =
                 self.built_pos[sa as usize].distance_squared(self.built_pos[sb as usize]) <= r2;
-            if built || self.extra.position(a, b).is_ok() {
+            if built || self.in_extra.contains(&pair_key(a, b)) {
                 continue;
             }
             let target = special.target(a, b, thickness);
             if target != EXEMPT {
-                added.push(a, b, target);
+                self.extra.push(a, b, target);
+                self.in_extra.insert(pair_key(a, b));
             }
-        }
-        if !added.a.is_empty() {
-            self.extra.merge_into(added, &mut self.merged);
-            std::mem::swap(&mut self.extra, &mut self.merged);
         }
     }
 
@@ -758,6 +738,7 @@ impl SelfCollision {
         self.reanchored.clear();
         self.is_reanchored.resize(self.members.len(), false);
         self.extra.clear();
+        self.in_extra.clear();
         self.built_at.clear();
         self.built_at
             .extend(self.members.iter().map(|&i| positions[i as usize]));
@@ -814,28 +795,22 @@ impl SelfCollision {
             let (sa, sb) = (slot_of[a as usize], slot_of[b as usize]);
             anchors[sa as usize].distance_squared(anchors[sb as usize]) <= r2
         };
-        let moved = &mut self.added;
-        moved.clear();
+        // Pairs of the build's lists are not in `extra`: the moved ones can join it as they
+        // are.
+        let extra = &mut self.extra;
+        extra.retain(|a, b, _| near(&self.built_at, a, b));
         for list in &mut self.pairs {
             list.retain(|a, b, target| {
                 let built = near(&self.built_pos, a, b);
                 if !built && near(&self.built_at, a, b) {
-                    moved.push(a, b, target);
+                    extra.push(a, b, target);
                 }
                 built
             });
         }
-        self.extra.retain(|a, b, _| near(&self.built_at, a, b));
-        if !moved.a.is_empty() {
-            let mut order: Vec<usize> = (0..moved.len()).collect();
-            order.sort_unstable_by_key(|&k| (moved.a[k], moved.b[k]));
-            let mut by_pair = PairList::default();
-            for k in order {
-                by_pair.push(moved.a[k], moved.b[k], moved.target[k]);
-            }
-            self.extra.merge_into(&by_pair, &mut self.merged);
-            std::mem::swap(&mut self.extra, &mut self.merged);
-        }
+        self.in_extra.clear();
+        self.in_extra
+            .extend(extra.a.iter().zip(&extra.b).map(|(&a, &b)| pair_key(a, b)));
     }
 
     /// One Jacobi sweep over the touching pairs (see the module doc); returns the number of
@@ -940,6 +915,11 @@ mod tests {
 
     /// The whole list (`pairs` and `extra`), sorted by (a, b); asserts no pair is listed twice.
     fn whole(sc: &SelfCollision) -> PairList {
+        // The keys of the extra pairs are exactly its pairs.
+        let keys: FxHashSet<u64> = (0..sc.extra.len())
+            .map(|k| pair_key(sc.extra.a[k], sc.extra.b[k]))
+            .collect();
+        assert_eq!(keys, sc.in_extra, "the extra pairs' keys are not its pairs");
         let mut all: Vec<(u32, u32, f64)> = sc
             .pairs
             .iter()
@@ -1247,7 +1227,7 @@ mod tests {
             "the build's test at the thinner radius drops it"
         );
         assert!(
-            sc.extra.position(a, b).is_ok(),
+            (0..sc.extra.len()).any(|k| (sc.extra.a[k], sc.extra.b[k]) == (a, b)),
             "its anchors keep it listed"
         );
         // Exactly the non-exempt pairs whose anchors are within the new radius, or whose
