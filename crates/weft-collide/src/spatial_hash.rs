@@ -255,8 +255,9 @@ impl CellGrid {
 
     /// Moves `moved` (items, each given once) to their cells at `positions`: those already in
     /// the grid (for which `present` holds) leave their old cells, and every other item keeps
-    /// its place. The result is the grid [`CellGrid::build`] would give for the union at the
-    /// same positions, for the cost of sorting `moved` and one merge.
+    /// its place. When the others have not moved since they were placed, the result is the
+    /// grid [`CellGrid::build`] would give for the union at `positions`, for the cost of
+    /// sorting `moved` and one merge.
     pub(crate) fn update(
         &mut self,
         positions: &[DVec3],
