@@ -14,10 +14,6 @@ use std::ops::Range;
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Fewest items per rayon task in the grid's parallel loops (smaller ones cost more to hand
-/// to another thread than to do).
-const PAR_MIN: usize = 2048;
-
 /// Points bucketed by hashed grid cell.
 #[derive(Clone, Debug, Default)]
 pub struct SpatialHash {
@@ -125,14 +121,9 @@ impl SpatialHash {
 }
 
 /// Points sorted by grid cell (x, then y, then z) for [`CellGrid::for_each_pair`].
-///
-/// The order is kept from one build to the next: points move little between builds, so the
-/// sort starts from nearly sorted input (Rust's stable sort merges the runs it finds).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct CellGrid {
     spacing: f64,
-    /// The items of the last build, to know whether the kept order is still a permutation.
-    items: Vec<u32>,
     /// (cell key, item) in key order.
     sorted: Vec<(u64, u32)>,
     /// Positions in key order.
@@ -143,6 +134,90 @@ pub(crate) struct CellGrid {
     old: Vec<(u64, u32)>,
     old_positions: Vec<DVec3>,
     leaving: Vec<bool>,
+    /// Scratch of [`CellGrid::build`]'s radix sort: (compact key, index) and its copy.
+    radix: Vec<u64>,
+    radix_copy: Vec<u64>,
+}
+
+/// Fewest items per rayon task in the grid's parallel loops (smaller ones cost more to hand
+/// to another thread than to do).
+const PAR_MIN: usize = 2048;
+
+/// Bits of a digit of [`CellGrid::build`]'s radix sort.
+const DIGIT: u32 = 11;
+
+/// Sorts `v` stably by its high 32 bits, of which only the low `bits` may be set: a
+/// least-significant-digit radix sort, one counting pass and one scatter per [`DIGIT`] bits
+/// (Knuth, TAOCP vol. 3, §5.2.5). `copy` is scratch.
+fn radix_sort(v: &mut Vec<u64>, copy: &mut Vec<u64>, bits: u32) {
+    copy.resize(v.len(), 0);
+    let mut shift = 32;
+    while shift < 32 + bits {
+        let digit = |x: u64| ((x >> shift) & ((1 << DIGIT) - 1)) as usize;
+        let mut start = [0usize; 1 << DIGIT];
+        for &x in v.iter() {
+            start[digit(x)] += 1;
+        }
+        let mut sum = 0;
+        for s in &mut start {
+            (*s, sum) = (sum, sum + *s);
+        }
+        for &x in v.iter() {
+            let d = digit(x);
+            copy[start[d]] = x;
+            start[d] += 1;
+        }
+        std::mem::swap(v, copy);
+        shift += DIGIT;
+    }
+}
+
+/// Keys made compact to the box of the cells in use: a cell's offsets from the box's lowest
+/// cell, packed x, y, z with just the bits each needs, so that they sort as the keys do.
+#[derive(Clone, Copy, Debug)]
+struct Compact {
+    lo: [u64; 3],
+    /// Shifts of x and y in the compact key (z is not shifted).
+    shift: [u32; 2],
+    /// Bits of the compact key.
+    bits: u32,
+}
+
+impl Compact {
+    /// The packing for `keys`, or `None` when it needs more than 32 bits.
+    fn of(keys: impl Iterator<Item = u64>) -> Option<Self> {
+        let (mut lo, mut hi) = ([u64::MAX; 3], [0u64; 3]);
+        for key in keys {
+            for (axis, v) in Self::fields(key).into_iter().enumerate() {
+                lo[axis] = lo[axis].min(v);
+                hi[axis] = hi[axis].max(v);
+            }
+        }
+        let width = |a: usize| {
+            (hi[a].saturating_sub(lo[a]))
+                .checked_ilog2()
+                .map_or(0, |b| b + 1)
+        };
+        let (wx, wy, wz) = (width(0), width(1), width(2));
+        let bits = wx + wy + wz;
+        (bits <= 32).then_some(Self {
+            lo,
+            shift: [wy + wz, wz],
+            bits,
+        })
+    }
+
+    /// A key's x, y and z cell coordinates.
+    fn fields(key: u64) -> [u64; 3] {
+        let mask = (1 << BITS) - 1;
+        [key >> (2 * BITS), (key >> BITS) & mask, key & mask]
+    }
+
+    /// The compact form of `key` (a key of the cells the packing was made for).
+    fn apply(&self, key: u64) -> u64 {
+        let [x, y, z] = Self::fields(key);
+        ((x - self.lo[0]) << self.shift[0]) | ((y - self.lo[1]) << self.shift[1]) | (z - self.lo[2])
+    }
 }
 
 /// Bits per cell coordinate in a cell key.
@@ -157,20 +232,24 @@ const X: u64 = 1 << (2 * BITS);
 /// are neighbours stay neighbours (or merge), so no close pair is lost; only points more than
 /// 2²⁰ cells from the origin share border cells.
 ///
-/// The floor is taken in integers (truncate, then step down where that rounded up): without
-/// SSE4.1 in the baseline target, `f64::floor` is a call into libm, which made keys most of a
-/// grid build (10 ns a point). A NaN coordinate truncates to 0: such points gather in one cell.
+/// The floor is taken without `f64::floor`, a call into libm on the baseline x86-64 target,
+/// and without converting an integer back to a float (whose false dependency on the target
+/// register chained every key): the coordinate is clamped to ±2²¹ cells (beyond which every
+/// key component is clamped anyway), rounded to an integer by adding and subtracting
+/// 1.5 · 2⁵² (exact there: the unit in the last place is 1; Rust never reassociates the two),
+/// and stepped down where that rounded up. A NaN coordinate converts to 0: such points
+/// gather in one cell.
 #[inline]
 fn cell_key(p: DVec3, inv_spacing: f64) -> u64 {
+    const LIMIT: f64 = (1u64 << (BITS)) as f64;
+    const ROUND: f64 = 1.5 * (1u64 << 52) as f64;
     let half = 1i64 << (BITS - 1);
     let max = (1i64 << BITS) - 2;
     let k = |v: f64| {
-        let v = v * inv_spacing;
-        // `as` truncates towards zero and saturates; exact below 2⁵³, and above every f64
-        // is an integer already.
-        let t = v as i64;
-        let floor = t.saturating_sub(i64::from(t as f64 > v));
-        floor.saturating_add(half).clamp(1, max) as u64
+        let v = (v * inv_spacing).clamp(-LIMIT, LIMIT);
+        let r = (v + ROUND) - ROUND;
+        let floor = if r > v { r - 1.0 } else { r };
+        (floor as i64 + half).clamp(1, max) as u64
     };
     (k(p.x) << (2 * BITS)) | (k(p.y) << BITS) | k(p.z)
 }
@@ -227,30 +306,67 @@ impl CellGrid {
     }
 
     /// Sorts `items` (indices into `positions`) by their cell of size `spacing` (m), then by
-    /// index. Keys and the sort run on rayon's threads; the order is a function of the
-    /// positions alone.
+    /// index; the order is a function of the positions alone.
+    ///
+    /// Keys are computed in the items' order. When the items ascend and the cells in use fit a
+    /// 32-bit compact key ([`Compact`]), a stable radix sort on it ([`radix_sort`]: equal cells
+    /// keep the items' order) replaces a comparison sort of the (key, item) entries: for a
+    /// 128² curtain or drape mid-fall the grid took 347–434 µs on one thread and 172–216 µs
+    /// on two, now 204–240 µs and 146–191 µs.
     pub(crate) fn build(&mut self, positions: &[DVec3], items: &[u32], spacing: f64) {
         self.spacing = spacing;
-        if self.items != items {
-            self.items.clear();
-            self.items.extend_from_slice(items);
-            self.sorted.clear();
-            self.sorted.extend(items.iter().map(|&i| (0, i)));
-        }
         let inv = 1.0 / spacing;
-        self.sorted
+        let mut fresh = std::mem::take(&mut self.fresh);
+        // Keys and positions on rayon's threads: besides the time, each thread then has the
+        // positions it will search in its own cache.
+        fresh.resize(items.len(), (0, 0));
+        fresh
             .par_iter_mut()
+            .zip(items.par_iter())
             .with_min_len(PAR_MIN)
-            .for_each(|(key, i)| *key = cell_key(positions[*i as usize], inv));
-        // Keys are unique with their item, so an unstable sort gives the one sorted order.
-        self.sorted.par_sort_unstable();
-        self.positions.clear();
-        self.positions.par_extend(
-            self.sorted
-                .par_iter()
-                .with_min_len(PAR_MIN)
-                .map(|&(_, i)| positions[i as usize]),
-        );
+            .for_each(|(out, &i)| *out = (cell_key(positions[i as usize], inv), i));
+        let ascending = items.windows(2).all(|w| w[0] < w[1]);
+        let compact = if ascending && items.len() <= u32::MAX as usize {
+            Compact::of(fresh.iter().map(|&(key, _)| key))
+        } else {
+            None
+        };
+        self.sorted.clear();
+        match compact {
+            Some(compact) => {
+                let (mut src, mut dst) = (
+                    std::mem::take(&mut self.radix),
+                    std::mem::take(&mut self.radix_copy),
+                );
+                src.clear();
+                src.extend(
+                    fresh
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &(key, _))| (compact.apply(key) << 32) | k as u64),
+                );
+                radix_sort(&mut src, &mut dst, compact.bits);
+                self.sorted.resize(src.len(), (0, 0));
+                self.sorted
+                    .par_iter_mut()
+                    .zip(src.par_iter())
+                    .with_min_len(PAR_MIN)
+                    .for_each(|(out, &v)| *out = fresh[(v & 0xffff_ffff) as usize]);
+                (self.radix, self.radix_copy) = (src, dst);
+            }
+            None => {
+                // Keys are unique with their item, so an unstable sort gives the one order.
+                fresh.sort_unstable();
+                self.sorted.extend_from_slice(&fresh);
+            }
+        }
+        self.fresh = fresh;
+        self.positions.resize(self.sorted.len(), DVec3::ZERO);
+        self.positions
+            .par_iter_mut()
+            .zip(self.sorted.par_iter())
+            .with_min_len(PAR_MIN)
+            .for_each(|(out, &(_, i))| *out = positions[i as usize]);
     }
 
     /// Moves `moved` (items, each given once) to their cells at `positions`: those already in
@@ -317,8 +433,6 @@ impl CellGrid {
             self.leaving[i as usize] = false;
         }
         (self.fresh, self.old, self.old_positions) = (fresh, old, old_pos);
-        // The items are no longer those of a build: the next build sorts afresh.
-        self.items.clear();
     }
 
     /// The (cell key, item) entries in key order and their positions.
@@ -652,6 +766,12 @@ mod tests {
             -1e15 - 0.5,
             2e6,
             -2e6,
+            2_097_151.5,
+            2_097_152.0,
+            -2_097_152.0,
+            -2_097_152.5,
+            1_048_575.5,
+            -1_048_576.5,
             1e300,
             -1e300,
             f64::INFINITY,
@@ -680,6 +800,52 @@ mod tests {
             cell_key(nan, 2.0),
             cell_key(DVec3::new(f64::NAN, 0.1, 0.2), 2.0)
         );
+    }
+
+    #[test]
+    fn a_build_sorts_by_cell_then_item_whichever_sort_it_takes() {
+        let (mut positions, items) = folded_cloud();
+        let spacing = 0.01;
+        let expected = |positions: &[DVec3], items: &[u32]| {
+            let mut e: Vec<(u64, u32)> = items
+                .iter()
+                .map(|&i| (cell_key(positions[i as usize], 1.0 / spacing), i))
+                .collect();
+            e.sort_unstable();
+            e
+        };
+        let mut grid = CellGrid::new();
+        let check = |grid: &mut CellGrid, positions: &[DVec3], items: &[u32], radix: bool| {
+            let compact = Compact::of(
+                items
+                    .iter()
+                    .map(|&i| cell_key(positions[i as usize], 100.0)),
+            );
+            let ascending = items.windows(2).all(|w| w[0] < w[1]);
+            assert_eq!(compact.is_some() && ascending, radix, "the case tested");
+            grid.build(positions, items, spacing);
+            let e = expected(positions, items);
+            assert_eq!(grid.sorted, e);
+            let at: Vec<DVec3> = e.iter().map(|&(_, i)| positions[i as usize]).collect();
+            assert_eq!(grid.positions, at);
+        };
+        // Radix: ascending items in a small box (several digits' worth of cells).
+        check(&mut grid, &positions, &items, true);
+        assert!(
+            Compact::of(grid.sorted.iter().map(|&(k, _)| k))
+                .expect("a compact packing")
+                .bits
+                > DIGIT
+        );
+        // All in one cell: no pass at all, the items' order.
+        let one = vec![DVec3::splat(0.001); positions.len()];
+        check(&mut grid, &one, &items, true);
+        // Items out of order, and cells spread wider than 32 bits: the comparison sort.
+        let mut shuffled = items.clone();
+        shuffled.reverse();
+        check(&mut grid, &positions, &shuffled, false);
+        positions[items[3] as usize] = DVec3::new(5e3, -5e3, 5e3);
+        check(&mut grid, &positions, &items, false);
     }
 
     #[test]
