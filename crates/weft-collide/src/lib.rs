@@ -19,6 +19,8 @@ mod shape;
 mod skin;
 mod spatial_hash;
 mod tessellate;
+#[cfg(test)]
+mod test_rand;
 mod world;
 
 pub use collider::{Collider, ColliderDesc, SurfacePoint};

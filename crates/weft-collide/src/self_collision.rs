@@ -861,18 +861,11 @@ mod tests {
     use super::*;
     use crate::scenarios::self_fold;
     use crate::skin::STEPS;
+    use crate::test_rand::rand;
     use weft_solver::{
         ClothParams, Forces, GridDesc, Mass, Method, Orientation, Settings, SolverBuilder,
         SubstepContext, SubstepHook,
     };
-
-    /// A deterministic pseudo-random number in [−1, 1) (64-bit LCG, Knuth's MMIX constants).
-    fn rand(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
 
     const N: usize = 24;
     const SPACING: f64 = 0.01;

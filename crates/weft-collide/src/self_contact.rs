@@ -333,14 +333,7 @@ pub(crate) fn apply(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A deterministic pseudo-random number in [−1, 1) (64-bit LCG, Knuth's MMIX constants).
-    fn rand(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
+    use crate::test_rand::rand;
 
     /// Sweeps the pairs (`a`, `b`, target) once and returns the new positions.
     fn sweep(pairs: &[(u32, u32, f64)], x: &[DVec3], prev: &[DVec3], w: &[f64]) -> Vec<DVec3> {

@@ -671,6 +671,7 @@ fn near_into(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rand::rand;
 
     #[test]
     fn query_finds_every_point_within_radius() {
@@ -778,11 +779,7 @@ mod tests {
             f64::NEG_INFINITY,
         ];
         let mut seed = 9u64;
-        for _ in 0..10_000 {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            let r = (seed >> 11) as f64 / (1u64 << 53) as f64;
-            values.push((r - 0.5) * 200.0);
-        }
+        values.extend((0..10_000).map(|_| rand(&mut seed) * 100.0));
         for inv in [1.0, 37.5, 1.0 / 0.0071] {
             for &v in &values {
                 for p in [
@@ -856,10 +853,8 @@ mod tests {
         grid.build(&positions, &[], spacing);
         let mut present = vec![false; positions.len()];
         let mut seed = 3u64;
-        let mut next = |m: usize| {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            (seed >> 33) as usize % m
-        };
+        // A pseudo-random index below m.
+        let mut next = |m: usize| ((rand(&mut seed) + 1.0) * 0.5 * m as f64) as usize % m;
         for round in 0..20 {
             // Some items already in the grid and some new ones move.
             let mut moved: Vec<u32> = (0..1 + next(200))
