@@ -829,21 +829,16 @@ impl SelfCollision {
             out.reset(n);
             find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
         };
-        // A few thousand pairs take less time than waking another thread.
+        // A few thousand pairs take less time than waking another thread: below that, the
+        // lists are not split among threads.
         let total: usize = lists.iter().map(|l| l.len()).sum();
-        let deepest = if total < SERIAL_PAIRS {
-            lists
-                .iter()
-                .zip(self.contacts.iter_mut())
-                .map(find)
-                .fold(0.0, f64::max)
-        } else {
-            lists
-                .par_iter()
-                .zip(self.contacts.par_iter_mut())
-                .map(find)
-                .reduce(|| 0.0, f64::max)
-        };
+        let serial = if total < SERIAL_PAIRS { usize::MAX } else { 1 };
+        let deepest = lists
+            .par_iter()
+            .zip(self.contacts.par_iter_mut())
+            .with_min_len(serial)
+            .map(find)
+            .reduce(|| 0.0, f64::max);
         self.sums.resize(n, DVec3::ZERO);
         self.counts.resize(n, 0);
         let contacts = apply(

@@ -312,21 +312,19 @@ pub(crate) fn apply(
             }
         }
     };
-    if contacts < SERIAL_CONTACTS {
-        positions
-            .chunks_mut(span)
-            .zip(sums.chunks_mut(span))
-            .zip(counts.chunks_mut(span))
-            .enumerate()
-            .for_each(range);
+    // Below SERIAL_CONTACTS the ranges are not split among threads: all run on this one.
+    let serial = if contacts < SERIAL_CONTACTS {
+        usize::MAX
     } else {
-        positions
-            .par_chunks_mut(span)
-            .zip(sums.par_chunks_mut(span))
-            .zip(counts.par_chunks_mut(span))
-            .enumerate()
-            .for_each(range);
-    }
+        1
+    };
+    positions
+        .par_chunks_mut(span)
+        .zip(sums.par_chunks_mut(span))
+        .zip(counts.par_chunks_mut(span))
+        .enumerate()
+        .with_min_len(serial)
+        .for_each(range);
     contacts
 }
 
