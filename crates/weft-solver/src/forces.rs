@@ -5,6 +5,7 @@ use rayon::prelude::*;
 
 use crate::error::ParamError;
 use crate::particles::Particles;
+use crate::solver::CHUNK;
 
 /// Per-triangle aerodynamic drag and lift coefficients.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,8 +99,8 @@ impl Forces {
         let gravity = self.gravity;
         // Per particle, in parallel (each result depends on that particle alone).
         accel
-            .par_chunks_mut(1024)
-            .zip(p.velocities.par_chunks(1024))
+            .par_chunks_mut(CHUNK)
+            .zip(p.velocities.par_chunks(CHUNK))
             .for_each(|(a, v)| {
                 for (a, v) in a.iter_mut().zip(v) {
                     *a = gravity + wind.drag * (wind.velocity - *v);

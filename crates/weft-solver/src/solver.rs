@@ -71,9 +71,10 @@ pub struct Solver {
     frame: u64,
 }
 
-/// Particles per parallel task in the general loop's per-particle passes. Each particle's
-/// update reads only its own state, so results do not depend on the thread count.
-const CHUNK: usize = 1024;
+/// Particles per parallel task in the general loop's per-particle passes (and the external
+/// accelerations'). Each particle's update reads only its own state, so results do not depend
+/// on the thread count.
+pub(crate) const CHUNK: usize = 1024;
 
 impl Solver {
     #[allow(clippy::too_many_arguments)]
