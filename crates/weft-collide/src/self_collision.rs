@@ -2,8 +2,15 @@
 //!
 //! Each particle is a sphere of radius thickness / 2, so two particles are kept a thickness
 //! apart (Müller, "Ten Minute Physics" #11; Macklin et al. 2014, §5 for particle contacts).
-//! Pairs that share a triangle are left to the cloth's own constraints, and pairs that were
-//! closer than a thickness at rest are only kept at their rest distance.
+//! Pairs of one cloth that lie within π t / 2 of each other at rest (t the largest
+//! thickness), or share a triangle, are left to the cloth's own constraints: where a sheet t
+//! thick folds onto itself, the layers touch across half a circle of diameter t, so two points
+//! facing each other across a fold lie at least π t / 2 apart along the cloth. Nearer pairs can
+//! only touch by compressing the cloth, which its stretch and shear constraints resist. (Like
+//! NVIDIA Flex's self-collide filter, which ignores pairs closer than the particle radius at
+//! rest; a cloth whose rest shape brings distant parts that close should be split into
+//! several cloths, whose pairs are never exempt.) The grid search itself leaves these pairs
+//! out, so a single layer lists none of its own neighbours.
 //!
 //! Candidate pairs live in a Verlet ("skin") list (Verlet 1967; Allen & Tildesley, "Computer
 //! Simulation of Liquids", §5.3): every non-exempt pair at most R = t (1 + m) apart when the
@@ -107,81 +114,65 @@ const SERIAL_PAIRS: usize = 4096;
 /// Members per rayon task in the per-member loops.
 const MEMBER_CHUNK: usize = 4096;
 
-/// What decides each pair's treatment: cloths, rest positions and triangle adjacency.
+/// Cloth length a sheet `t` thick folds over when its two layers touch, as a multiple of
+/// `t`: its mid-surface bends through half a circle of diameter `t`, π t / 2 long.
+const FOLD: f64 = std::f64::consts::FRAC_PI_2;
+
+/// What decides whether a pair is exempt: the members' rest positions and cloths.
+///
+/// A pair is exempt when both particles belong to one cloth and lie at most
+/// [`Exemptions::apart`] apart at rest. The test runs on tags (see [`Exemptions::tag`]): the
+/// rest positions with each cloth moved away from the others, so that one distance test,
+/// inside the grid's search, both leaves exempt pairs out and keeps every pair of two cloths.
 #[derive(Clone, Debug)]
 struct Exemptions {
     /// Rest positions (global index; only members are meaningful).
     rest: Vec<DVec3>,
     /// Cloth of each particle (global index).
     cloth: Vec<u32>,
-    /// CSR: particles sharing a triangle with particle `i` are
-    /// `adjacency[offsets[i]..offsets[i + 1]]`, sorted.
-    offsets: Vec<u32>,
-    adjacency: Vec<u32>,
+    /// The longest triangle edge at rest (m).
+    longest_edge: f64,
+    /// The largest extent of the members' rest box (m).
+    extent: f64,
+    /// Every particle's tag, for the distance in `tags_for` (NaN before the first).
+    tags: Vec<DVec3>,
+    tags_for: f64,
 }
 
 impl Exemptions {
-    /// Whether `a` and `b` share a triangle.
-    fn adjacent(&self, a: u32, b: u32) -> bool {
-        let (s, e) = (self.offsets[a as usize], self.offsets[a as usize + 1]);
-        self.adjacency[s as usize..e as usize]
-            .binary_search(&b)
-            .is_ok()
+    /// The rest distance up to which a pair of one cloth is exempt for largest thickness `t`:
+    /// the longer of [`FOLD`] · t and the longest edge (so that every pair sharing a triangle
+    /// is), with a margin of 10⁻⁶ for rounding.
+    fn apart(&self, t: f64) -> f64 {
+        (FOLD * t).max(self.longest_edge) * (1.0 + 1e-6)
     }
 
-    /// The distance pair `(a, b)` must keep, or `None` if it is exempt.
-    fn target(&self, a: u32, b: u32, thickness: &[f64]) -> Option<f64> {
-        if self.adjacent(a, b) {
-            return None;
-        }
-        let t = 0.5 * (thickness[a as usize] + thickness[b as usize]);
-        if self.cloth[a as usize] == self.cloth[b as usize] {
-            let rest = self.rest[a as usize].distance(self.rest[b as usize]);
-            Some(t.min(rest))
-        } else {
-            Some(t)
-        }
-    }
-}
-
-/// Marks an exempt pair in [`Special`].
-const EXEMPT: f64 = -1.0;
-
-/// The pairs whose treatment is not the default (keep the mean thickness), as CSR over
-/// particles: `pairs[offsets[a]..offsets[a + 1]]` holds every (b, target) of a pair {a, b}
-/// sorted by b (so each pair is in two rows), with [`EXEMPT`] for exempt pairs.
-#[derive(Clone, Debug, Default)]
-struct Special {
-    offsets: Vec<u32>,
-    pairs: Vec<(u32, f64)>,
-}
-
-impl Special {
-    /// Particle `a`'s row.
-    fn row(&self, a: u32) -> &[(u32, f64)] {
-        let (s, e) = (
-            self.offsets[a as usize] as usize,
-            self.offsets[a as usize + 1] as usize,
-        );
-        &self.pairs[s..e]
-    }
-
-    /// What [`Exemptions::target`] gives for (a, b), or [`EXEMPT`], without its searches over
-    /// the adjacency and its square roots.
-    fn target(&self, a: u32, b: u32, thickness: &[f64]) -> f64 {
-        Self::target_in(
-            self.row(a),
-            b,
-            0.5 * (thickness[a as usize] + thickness[b as usize]),
-        )
-    }
-
-    /// The target of `b` in a row, or `default`. Rows are short (a particle's triangle
-    /// neighbours, and the few closer at rest): a scan without branches beats a search.
+    /// Particle `i`'s tag for exemption distance `apart`: its rest position moved along x by
+    /// its cloth's index times one rest extent and twice `apart`, so that two cloths' tags are
+    /// always more than `apart` apart.
     #[inline(always)]
-    fn target_in(row: &[(u32, f64)], b: u32, default: f64) -> f64 {
-        row.iter()
-            .fold(default, |t, &(sb, target)| if sb == b { target } else { t })
+    fn tag(&self, i: usize, apart: f64) -> DVec3 {
+        let gap = self.extent + 2.0 * apart;
+        let mut tag = self.rest[i];
+        tag.x += f64::from(self.cloth[i]) * gap;
+        tag
+    }
+
+    /// The distance pair `(a, b)` must keep (their mean thickness), or `None` if it is exempt
+    /// for exemption distance `apart`.
+    fn target(&self, a: u32, b: u32, thickness: &[f64], apart: f64) -> Option<f64> {
+        let (a, b) = (a as usize, b as usize);
+        (self.tag(a, apart).distance_squared(self.tag(b, apart)) > apart * apart)
+            .then(|| 0.5 * (thickness[a] + thickness[b]))
+    }
+
+    /// Every particle's tag for exemption distance `apart` (made once per distance).
+    fn tags(&mut self, apart: f64) -> &[DVec3] {
+        if self.tags_for != apart {
+            self.tags = (0..self.rest.len()).map(|i| self.tag(i, apart)).collect();
+            self.tags_for = apart;
+        }
+        &self.tags
     }
 }
 
@@ -262,17 +253,6 @@ impl PairList {
         self.target.push(target);
     }
 
-    /// [`PairList::push`] when `target` is not [`EXEMPT`], without a branch (about one pair
-    /// in four found at a build is exempt, too many to predict).
-    #[inline(always)]
-    fn push_unless_exempt(&mut self, a: u32, b: u32, target: f64) {
-        self.push(a, b, target);
-        let len = self.a.len() - usize::from(target == EXEMPT);
-        self.a.truncate(len);
-        self.b.truncate(len);
-        self.target.truncate(len);
-    }
-
     fn len(&self) -> usize {
         self.a.len()
     }
@@ -349,9 +329,8 @@ pub(crate) struct SelfCollision {
     built_for: Option<f64>,
     /// Lists built so far.
     rebuilds: u64,
-    /// Pairs whose treatment is not the default; found at the first list build after creation
-    /// or a thickness change, `None` until then.
-    special: Option<Special>,
+    /// The exemption distance of the list (see [`Exemptions::apart`]).
+    apart: f64,
     /// Sweep scratch: per list, the touching pairs' indices and their corrections binned by
     /// particle range; per particle, the exact sum of its corrections and their count (zero
     /// between sweeps).
@@ -370,7 +349,8 @@ impl SelfCollision {
         params.validate()?;
         let n = solver.particles().len();
         let mut cloth = vec![u32::MAX; n];
-        let mut neighbours: Vec<(u32, u32)> = Vec::new();
+        let rest = &solver.particles().positions;
+        let mut longest_edge = 0.0f64;
         let mut members = Vec::new();
         for &c in cloths {
             let info = solver.cloths().get(c).ok_or(CollideError::NoSuchCloth {
@@ -383,36 +363,33 @@ impl SelfCollision {
             }
             for t in &info.triangles {
                 for k in 0..3 {
-                    let (a, b) = (t[k], t[(k + 1) % 3]);
-                    neighbours.extend([(a, b), (b, a)]);
+                    let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                    longest_edge = longest_edge.max(rest[a].distance(rest[b]));
                 }
             }
         }
         members.sort_unstable();
         members.dedup();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for &i in &members {
+            (lo, hi) = (lo.min(rest[i as usize]), hi.max(rest[i as usize]));
+        }
+        let extent = (hi - lo).max_element().max(0.0);
         let mut slot_of = vec![u32::MAX; n];
         for (slot, &i) in members.iter().enumerate() {
             slot_of[i as usize] = slot as u32;
         }
-        neighbours.sort_unstable();
-        neighbours.dedup();
-        let mut offsets = vec![0u32; n + 1];
-        for &(a, _) in &neighbours {
-            offsets[a as usize + 1] += 1;
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        let adjacency = neighbours.iter().map(|&(_, b)| b).collect();
         Ok(Self {
             params,
             skin: Skin::new(params.search_margin, params.adaptive_margin),
             members,
             exempt: Exemptions {
-                rest: solver.particles().positions.clone(),
+                rest: rest.clone(),
                 cloth,
-                offsets,
-                adjacency,
+                longest_edge,
+                extent,
+                tags: Vec::new(),
+                tags_for: f64::NAN,
             },
             grid: CellGrid::new(),
             pairs: Vec::new(),
@@ -435,16 +412,26 @@ impl SelfCollision {
             near_queries: Queries::default(),
             built_for: None,
             rebuilds: 0,
-            special: None,
+            apart: 0.0,
             contacts: Vec::new(),
             sums: vec![DVec3::ZERO; n],
             counts: vec![0; n],
         })
     }
 
-    /// The distance pair `(a, b)` must keep, or `None` if it is exempt.
+    /// The distance pair `(a, b)` must keep, or `None` if it is exempt (see
+    /// [`Exemptions::apart`]).
     pub(crate) fn target(&self, a: u32, b: u32, thickness: &[f64]) -> Option<f64> {
-        self.exempt.target(a, b, thickness)
+        let apart = match self.built_for {
+            Some(_) => self.apart,
+            None => self.exempt.apart(
+                self.members
+                    .iter()
+                    .map(|&i| thickness[i as usize])
+                    .fold(0.0f64, f64::max),
+            ),
+        };
+        self.exempt.target(a, b, thickness, apart)
     }
 
     /// Lists built so far.
@@ -465,56 +452,6 @@ impl SelfCollision {
     /// Drops the list (thickness changed): the next [`SelfCollision::refresh`] rebuilds it.
     pub(crate) fn invalidate(&mut self) {
         self.built_for = None;
-        self.special = None;
-    }
-
-    /// Finds the pairs whose treatment is not the default: those sharing a triangle (exempt)
-    /// and those closer at rest than their mean thickness (kept at their rest distance), i.e.
-    /// every pair for which [`Exemptions::target`] is not `Some(mean thickness)`.
-    fn find_special(&mut self, thickness: &[f64], max_t: f64) -> Special {
-        let n = thickness.len();
-        let exempt = &self.exempt;
-        let mut found = Vec::new();
-        for &a in &self.members {
-            let (s, e) = (exempt.offsets[a as usize], exempt.offsets[a as usize + 1]);
-            for &b in &exempt.adjacency[s as usize..e as usize] {
-                if b > a {
-                    found.push((a, b, EXEMPT));
-                }
-            }
-        }
-        // Closer at rest than the mean thickness ≤ max_t.
-        self.grid.build(&exempt.rest, &self.members, max_t);
-        self.grid.for_each_pair(max_t, |i, j| {
-            let (a, b) = (i.min(j), i.max(j));
-            let mean = 0.5 * (thickness[a as usize] + thickness[b as usize]);
-            match exempt.target(a, b, thickness) {
-                Some(target) if target != mean => found.push((a, b, target)),
-                _ => {} // exempt pairs are in already; the others take the default
-            }
-        });
-        // Counting sort by a, then by b within each a.
-        let both: Vec<(u32, u32, f64)> = found
-            .iter()
-            .flat_map(|&(a, b, target)| [(a, b, target), (b, a, target)])
-            .collect();
-        let mut offsets = vec![0u32; n + 1];
-        for &(a, _, _) in &both {
-            offsets[a as usize + 1] += 1;
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut pairs = vec![(0, 0.0); both.len()];
-        let mut next = offsets.clone();
-        for &(a, b, target) in &both {
-            pairs[next[a as usize] as usize] = (b, target);
-            next[a as usize] += 1;
-        }
-        for w in offsets.windows(2) {
-            pairs[w[0] as usize..w[1] as usize].sort_unstable_by_key(|&(b, _)| b);
-        }
-        Special { offsets, pairs }
     }
 
     /// The list radius R for largest thickness `t` (m).
@@ -709,21 +646,18 @@ impl SelfCollision {
         for &m in &self.movers {
             self.is_mover[m as usize] = false;
         }
-        let Some(special) = &self.special else {
-            return self.rebuild(positions, thickness);
-        };
         for &(a, b) in &self.new_pairs {
             let (sa, sb) = (self.slot_of[a as usize], self.slot_of[b as usize]);
             // Listed at the build (the grid's test, replayed), or added since.
             let built =
                 self.built_pos[sa as usize].distance_squared(self.built_pos[sb as usize]) <= r2;
-            if built || self.in_extra.contains(&pair_key(a, b)) {
+            if built {
                 continue;
             }
-            let target = special.target(a, b, thickness);
-            if target != EXEMPT {
+            if let Some(target) = self.exempt.target(a, b, thickness, self.apart)
+                && self.in_extra.insert(pair_key(a, b))
+            {
                 self.extra.push(a, b, target);
-                self.in_extra.insert(pair_key(a, b));
             }
         }
     }
@@ -754,26 +688,22 @@ impl SelfCollision {
         if max_t <= 0.0 {
             return;
         }
-        if self.special.is_none() {
-            self.special = Some(self.find_special(thickness, max_t));
-        }
+        self.apart = self.exempt.apart(max_t);
         let radius = self.radius(max_t);
         self.grid.build(positions, &self.members, radius);
+        self.grid.tag(self.exempt.tags(self.apart));
         // A few runs per thread balance the load; the runs change nothing but the cost.
         let runs = self.grid.cell_runs(4 * rayon::current_num_threads());
         self.pairs.resize_with(runs.len(), PairList::default);
-        let (grid, special) = (&self.grid, self.special.as_ref());
+        let (grid, apart) = (&self.grid, self.apart);
         self.pairs.par_iter_mut().zip(runs).for_each(|(list, run)| {
             list.clear();
-            let Some(special) = special else { return };
             let mut row = Vec::new();
-            grid.for_each_row_in(run, radius, &mut row, |i, near| {
-                // The row of i once for all its partners.
-                let (own, ti) = (special.row(i), thickness[i as usize]);
+            // Exempt pairs are left out by the search itself.
+            grid.for_each_row_in(run, radius, Some(apart), &mut row, |i, near| {
+                let ti = thickness[i as usize];
                 for &j in near {
-                    let mean = 0.5 * (ti + thickness[j as usize]);
-                    let target = Special::target_in(own, j, mean);
-                    list.push_unless_exempt(i.min(j), i.max(j), target);
+                    list.push(i.min(j), i.max(j), 0.5 * (ti + thickness[j as usize]));
                 }
             });
         });
@@ -1233,5 +1163,88 @@ mod tests {
         expected.dedup();
         assert_eq!(listed, expected);
         assert_complete(&sc, &x, &t, "after shrinking");
+    }
+
+    #[test]
+    fn exempt_pairs_are_those_of_one_cloth_within_a_fold_length_at_rest() {
+        // Two cloths with the same rest positions. Cells of 1 × 0.6 spacing: pairs one column
+        // and two rows apart, 1.562 spacings, lie just within the fold length (1.571).
+        let n = 12;
+        let mesh = GridDesc {
+            resolution: (n, n),
+            size: (SPACING * (n - 1) as f64, 0.6 * SPACING * (n - 1) as f64),
+            center: DVec3::ZERO,
+            orientation: Orientation::Horizontal,
+            mass: Mass::Total(0.1),
+            pins: vec![],
+        }
+        .build()
+        .expect("grid");
+        let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("builder");
+        for name in ["lower", "upper"] {
+            b.add_cloth(name, &mesh, ClothParams::default(), SPACING)
+                .expect("cloth");
+        }
+        let solver = b.build();
+        let rest = solver.particles().positions.clone();
+        let count = rest.len();
+        let t = vec![SPACING; count];
+        // A skin of 1.1 thickness: R = 2.1 t reaches same-cloth pairs beyond the fold length
+        // (2 t apart) and leaves none on its border.
+        let params = SelfCollisionParams {
+            search_margin: 1.1,
+            adaptive_margin: false,
+            ..SelfCollisionParams::default()
+        };
+        let mut sc = SelfCollision::new(&solver, &[0, 1], params).expect("self-collision");
+        let cloth = |i: usize| i / (n * n);
+        let mut shares_triangle = vec![false; count * count];
+        for info in solver.cloths() {
+            for tri in &info.triangles {
+                for k in 0..3 {
+                    let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
+                    shares_triangle[a * count + b] = true;
+                    shares_triangle[b * count + a] = true;
+                }
+            }
+        }
+        let fold = std::f64::consts::FRAC_PI_2 * SPACING;
+        let (mut exempt, mut kept_same) = (0, 0);
+        for a in 0..count {
+            for b in a + 1..count {
+                let target = sc.target(a as u32, b as u32, &t);
+                let rest_distance = rest[a].distance(rest[b]);
+                if cloth(a) != cloth(b) {
+                    assert_eq!(target, Some(SPACING), "two cloths' pair ({a}, {b})");
+                } else if shares_triangle[a * count + b] || rest_distance < 0.999 * fold {
+                    assert_eq!(target, None, "({a}, {b}), {rest_distance} m apart at rest");
+                    exempt += 1;
+                } else if rest_distance > 1.001 * fold {
+                    assert_eq!(target, Some(SPACING), "({a}, {b})");
+                    kept_same += 1;
+                }
+            }
+        }
+        assert!(
+            exempt > 500 && kept_same > 10_000,
+            "{exempt} exempt, {kept_same} kept"
+        );
+        // The list built with the cloths at their rest places: every pair of the two cloths
+        // within R (the rest places coincide), and none of one cloth within the fold length.
+        let mut x = rest.clone();
+        sc.refresh(&mut x, &t, None);
+        let radius = 2.1 * SPACING;
+        let list = listed(&sc);
+        assert_eq!(list, brute_pairs(&sc, &x, &t, |_| radius * (1.0 + 1e-12)));
+        assert!(
+            list.iter()
+                .any(|&(a, b)| cloth(a as usize) == cloth(b as usize))
+        );
+        assert!(list.iter().any(|&(a, b)| a as usize + n * n == b as usize));
+        assert!(
+            list.iter()
+                .all(|&(a, b)| cloth(a as usize) != cloth(b as usize)
+                    || rest[a as usize].distance(rest[b as usize]) > fold)
+        );
     }
 }

@@ -120,8 +120,9 @@ impl CollisionWorld {
         self.self_collision = None;
     }
 
-    /// Whether particles `a` and `b` are exempt from self-collision (share a triangle), or
-    /// `None` when self-collision is off.
+    /// The distance self-collision keeps particles `a` and `b` apart, `None` inside when the
+    /// pair is exempt (one cloth, within π/2 thickness at rest), or `None` when
+    /// self-collision is off.
     pub fn self_collision_target(&self, a: u32, b: u32) -> Option<Option<f64>> {
         self.self_collision
             .as_ref()
