@@ -12,6 +12,7 @@
 use std::ops::Range;
 
 use glam::DVec3;
+use multiversion::multiversion;
 use rayon::prelude::*;
 
 /// Points bucketed by hashed grid cell.
@@ -600,7 +601,7 @@ impl CellGrid {
                 *cursor = cells.partition_point(|&(k, _)| k < first + offset);
             }
         }
-        let (mut ids, mut near_pos, mut near_tags) = (Vec::new(), Vec::new(), Vec::new());
+        let mut near = Candidates::default();
         let mut s = run.start;
         while s < run.end {
             let c = cells[s].0;
@@ -615,40 +616,26 @@ impl CellGrid {
             }
             // The cell's candidates gathered once, in key order (the cell and the cell above
             // are contiguous), so that each point tests those after it in one pass.
-            ids.clear();
-            near_pos.clear();
-            near_tags.clear();
-            ids.extend(cells[s..y].iter().map(|&(_, i)| i));
-            near_pos.extend_from_slice(&pos[s..y]);
-            if apart2.is_some() {
-                near_tags.extend_from_slice(&tags[s..y]);
-            }
+            near.clear();
+            let tagged = apart2.is_some();
+            near.extend(&cells[s..y], &pos[s..y], tagged.then(|| &tags[s..y]));
             for (cursor, offset) in cursors.iter_mut().zip(COLUMNS) {
                 let lo = c + offset;
                 while *cursor < n && cells[*cursor].0 < lo {
                     *cursor += 1;
                 }
                 let end = column_end(cells, *cursor, lo + 2);
-                ids.extend(cells[*cursor..end].iter().map(|&(_, i)| i));
-                near_pos.extend_from_slice(&pos[*cursor..end]);
-                if apart2.is_some() {
-                    near_tags.extend_from_slice(&tags[*cursor..end]);
-                }
+                let range = *cursor..end;
+                near.extend(
+                    &cells[range.clone()],
+                    &pos[range.clone()],
+                    tagged.then(|| &tags[range]),
+                );
             }
             for x in s..e {
-                let from = x - s + 1;
                 row.clear();
-                let ids = ids[from..].iter().copied();
-                match apart2 {
-                    None => near_into(row, pos[x], r2, ids, &near_pos[from..]),
-                    Some(apart2) => near_apart_into(
-                        row,
-                        (pos[x], tags[x]),
-                        (r2, apart2),
-                        ids,
-                        (&near_pos[from..], &near_tags[from..]),
-                    ),
-                }
+                let tag = apart2.map(|a| (tags[x], a));
+                near.within(x - s + 1, pos[x], r2, tag, row);
                 if !row.is_empty() {
                     f(cells[x].1, row);
                 }
@@ -703,25 +690,113 @@ fn near_into(
     row.truncate(start + n);
 }
 
-/// [`near_into`] for the items whose tag (in `tags`, one each) is also more than √`apart2`
-/// from `tag`.
-#[inline(always)]
-fn near_apart_into(
-    row: &mut Vec<u32>,
-    (p, tag): (DVec3, DVec3),
-    (r2, apart2): (f64, f64),
-    items: impl ExactSizeIterator<Item = u32>,
-    (pos, tags): (&[DVec3], &[DVec3]),
-) {
-    let start = row.len();
-    row.resize(start + items.len(), 0);
-    let out = &mut row[start..];
-    let mut n = 0;
-    for ((item, q), t) in items.zip(pos).zip(tags) {
-        out[n] = item;
-        n += usize::from((p.distance_squared(*q) <= r2) & (tag.distance_squared(*t) > apart2));
+/// A cell's candidates for [`CellGrid::for_each_row_in`]: items, positions and tags as
+/// struct-of-arrays, so that the distance tests run as vector operations.
+#[derive(Default)]
+struct Candidates {
+    ids: Vec<u32>,
+    pos: [Vec<f64>; 3],
+    tags: [Vec<f64>; 3],
+    /// Scratch: whether each candidate passed.
+    keep: Vec<u8>,
+}
+
+impl Candidates {
+    fn clear(&mut self) {
+        self.ids.clear();
+        self.pos
+            .iter_mut()
+            .chain(&mut self.tags)
+            .for_each(Vec::clear);
     }
-    row.truncate(start + n);
+
+    /// Appends the items of `cells` at `pos` (with their `tags`, when tagged).
+    fn extend(&mut self, cells: &[(u64, u32)], pos: &[DVec3], tags: Option<&[DVec3]>) {
+        self.ids.extend(cells.iter().map(|&(_, i)| i));
+        for (c, out) in self.pos.iter_mut().enumerate() {
+            out.extend(pos.iter().map(|p| p[c]));
+        }
+        if let Some(tags) = tags {
+            for (c, out) in self.tags.iter_mut().enumerate() {
+                out.extend(tags.iter().map(|t| t[c]));
+            }
+        }
+    }
+
+    /// Appends to `row` the candidates from index `from` on that lie at most √`r2` from `p`,
+    /// and, with `tag` = Some((q, apart2)), whose tag lies more than √apart2 from q.
+    fn within(
+        &mut self,
+        from: usize,
+        p: DVec3,
+        r2: f64,
+        tag: Option<(DVec3, f64)>,
+        row: &mut Vec<u32>,
+    ) {
+        let len = self.ids.len().saturating_sub(from);
+        self.keep.resize(len, 0);
+        fn at(v: &[Vec<f64>; 3], from: usize) -> [&[f64]; 3] {
+            [&v[0][from..], &v[1][from..], &v[2][from..]]
+        }
+        match tag {
+            None => mark_near(&mut self.keep, at(&self.pos, from), p.to_array(), r2),
+            Some((q, apart2)) => mark_near_apart(
+                &mut self.keep,
+                (at(&self.pos, from), at(&self.tags, from)),
+                (p.to_array(), q.to_array()),
+                (r2, apart2),
+            ),
+        }
+        // Compaction without a branch per candidate (about one in four passes).
+        let start = row.len();
+        row.resize(start + len, 0);
+        let out = &mut row[start..];
+        let mut n = 0;
+        for (&id, &k) in self.ids[from..].iter().zip(&self.keep) {
+            out[n] = id;
+            n += usize::from(k);
+        }
+        row.truncate(start + n);
+    }
+}
+
+/// `keep[k]` = whether point k of `pos` (struct-of-arrays) lies at most √`r2` from `p`.
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
+    "x86_64+avx2+fma",
+    "aarch64+neon"
+))]
+fn mark_near(keep: &mut [u8], pos: [&[f64]; 3], p: [f64; 3], r2: f64) {
+    let n = keep.len();
+    let (xs, ys, zs) = (&pos[0][..n], &pos[1][..n], &pos[2][..n]);
+    for k in 0..n {
+        let (dx, dy, dz) = (xs[k] - p[0], ys[k] - p[1], zs[k] - p[2]);
+        keep[k] = u8::from(dx * dx + dy * dy + dz * dz <= r2);
+    }
+}
+
+/// [`mark_near`] for the points whose tag (in `tags`) also lies more than √`apart2` from `q`.
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
+    "x86_64+avx2+fma",
+    "aarch64+neon"
+))]
+fn mark_near_apart(
+    keep: &mut [u8],
+    (pos, tags): ([&[f64]; 3], [&[f64]; 3]),
+    (p, q): ([f64; 3], [f64; 3]),
+    (r2, apart2): (f64, f64),
+) {
+    let n = keep.len();
+    let (xs, ys, zs) = (&pos[0][..n], &pos[1][..n], &pos[2][..n]);
+    let (ts, us, vs) = (&tags[0][..n], &tags[1][..n], &tags[2][..n]);
+    for k in 0..n {
+        let (dx, dy, dz) = (xs[k] - p[0], ys[k] - p[1], zs[k] - p[2]);
+        let (ex, ey, ez) = (ts[k] - q[0], us[k] - q[1], vs[k] - q[2]);
+        let near = dx * dx + dy * dy + dz * dz <= r2;
+        let apart = ex * ex + ey * ey + ez * ez > apart2;
+        keep[k] = u8::from(near & apart);
+    }
 }
 
 #[cfg(test)]
