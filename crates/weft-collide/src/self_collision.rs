@@ -798,10 +798,12 @@ mod tests {
     /// An N×N cloth of thickness = spacing (flat at rest), and positions accordion-folded in
     /// layers of 4 rows 0.9 thickness apart, every particle jittered by up to 0.3 thickness:
     /// a random folded configuration.
-    fn folded() -> (Solver, Vec<DVec3>, Vec<f64>) {
+    /// A solver with `cloths` horizontal `n`×`n` sheets of `size` (m) at the same rest place,
+    /// each SPACING thick.
+    fn sheets(cloths: usize, n: usize, size: (f64, f64)) -> Solver {
         let mesh = GridDesc {
-            resolution: (N, N),
-            size: (SPACING * (N - 1) as f64, SPACING * (N - 1) as f64),
+            resolution: (n, n),
+            size,
             center: DVec3::ZERO,
             orientation: Orientation::Horizontal,
             mass: Mass::Total(0.1),
@@ -810,9 +812,16 @@ mod tests {
         .build()
         .expect("grid");
         let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("builder");
-        b.add_cloth("cloth", &mesh, ClothParams::default(), SPACING)
-            .expect("cloth");
-        let solver = b.build();
+        for k in 0..cloths {
+            b.add_cloth(format!("cloth {k}"), &mesh, ClothParams::default(), SPACING)
+                .expect("cloth");
+        }
+        b.build()
+    }
+
+    fn folded() -> (Solver, Vec<DVec3>, Vec<f64>) {
+        let side = SPACING * (N - 1) as f64;
+        let solver = sheets(1, N, (side, side));
         let mut seed = 7;
         let mut x = solver.particles().positions.clone();
         for j in 0..N {
@@ -1170,22 +1179,8 @@ mod tests {
         // Two cloths with the same rest positions. Cells of 1 × 0.6 spacing: pairs one column
         // and two rows apart, 1.562 spacings, lie just within the fold length (1.571).
         let n = 12;
-        let mesh = GridDesc {
-            resolution: (n, n),
-            size: (SPACING * (n - 1) as f64, 0.6 * SPACING * (n - 1) as f64),
-            center: DVec3::ZERO,
-            orientation: Orientation::Horizontal,
-            mass: Mass::Total(0.1),
-            pins: vec![],
-        }
-        .build()
-        .expect("grid");
-        let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("builder");
-        for name in ["lower", "upper"] {
-            b.add_cloth(name, &mesh, ClothParams::default(), SPACING)
-                .expect("cloth");
-        }
-        let solver = b.build();
+        let side = SPACING * (n - 1) as f64;
+        let solver = sheets(2, n, (side, 0.6 * side));
         let rest = solver.particles().positions.clone();
         let count = rest.len();
         let t = vec![SPACING; count];
