@@ -329,8 +329,6 @@ pub(crate) struct SelfCollision {
     built_for: Option<f64>,
     /// Lists built so far.
     rebuilds: u64,
-    /// The exemption distance of the list (see [`Exemptions::apart`]).
-    apart: f64,
     /// Sweep scratch: per list, the touching pairs' indices and their corrections binned by
     /// particle range; per particle, the exact sum of its corrections and their count (zero
     /// between sweeps).
@@ -412,7 +410,6 @@ impl SelfCollision {
             near_queries: Queries::default(),
             built_for: None,
             rebuilds: 0,
-            apart: 0.0,
             contacts: Vec::new(),
             sums: vec![DVec3::ZERO; n],
             counts: vec![0; n],
@@ -422,16 +419,18 @@ impl SelfCollision {
     /// The distance pair `(a, b)` must keep, or `None` if it is exempt (see
     /// [`Exemptions::apart`]).
     pub(crate) fn target(&self, a: u32, b: u32, thickness: &[f64]) -> Option<f64> {
-        let apart = match self.built_for {
-            Some(_) => self.apart,
-            None => self.exempt.apart(
-                self.members
-                    .iter()
-                    .map(|&i| thickness[i as usize])
-                    .fold(0.0f64, f64::max),
-            ),
-        };
-        self.exempt.target(a, b, thickness, apart)
+        let t = self
+            .built_for
+            .unwrap_or_else(|| self.max_thickness(thickness));
+        self.exempt.target(a, b, thickness, self.exempt.apart(t))
+    }
+
+    /// The largest member thickness (m), 0 without members.
+    fn max_thickness(&self, thickness: &[f64]) -> f64 {
+        self.members
+            .iter()
+            .map(|&i| thickness[i as usize])
+            .fold(0.0f64, f64::max)
     }
 
     /// Lists built so far.
@@ -473,7 +472,7 @@ impl SelfCollision {
     /// anchor added, which keeps the invariant; when there are many, the list is rebuilt. Then
     /// |Δᵢ − c| ≤ m t / 2 for every member, so |Δₐ − Δᵦ| ≤ m t and, by the triangle
     /// inequality, |x⁰ₐ − x⁰ᵦ| ≤ |xₐ − xᵦ| + m t: every pair within t now is listed. Every
-    /// target is at most t (the mean of two thicknesses, or less), so no contact is missing —
+    /// target is at most t (the mean of two thicknesses), so no contact is missing —
     /// the guarantee of a fresh search every sweep. c lets a cloth that falls or is carried as
     /// a whole keep its list. The check runs before every sweep, so it also catches moves
     /// between frames (pins, grabs, edits).
@@ -589,7 +588,7 @@ impl SelfCollision {
         }
         self.updates += 1;
         self.skin.reanchored(self.movers.len());
-        let radius = self.radius(t);
+        let (radius, apart) = (self.radius(t), self.exempt.apart(t));
         let r2 = radius * radius;
         let spacing = self.grid.spacing();
         if before == 0 {
@@ -654,7 +653,7 @@ impl SelfCollision {
             if built {
                 continue;
             }
-            if let Some(target) = self.exempt.target(a, b, thickness, self.apart)
+            if let Some(target) = self.exempt.target(a, b, thickness, apart)
                 && self.in_extra.insert(pair_key(a, b))
             {
                 self.extra.push(a, b, target);
@@ -678,29 +677,25 @@ impl SelfCollision {
             .extend(self.members.iter().map(|&i| positions[i as usize]));
         self.built_pos.clone_from(&self.built_at);
         self.drift = [DVec3::ZERO; 2];
-        let max_t = self
-            .members
-            .iter()
-            .map(|&i| thickness[i as usize])
-            .fold(0.0f64, f64::max);
+        let max_t = self.max_thickness(thickness);
         self.built_for = Some(max_t);
         self.pairs.iter_mut().for_each(PairList::clear);
         if max_t <= 0.0 {
             return;
         }
-        self.apart = self.exempt.apart(max_t);
+        let apart = self.exempt.apart(max_t);
         let radius = self.radius(max_t);
         self.grid.build(positions, &self.members, radius);
-        self.grid.tag(self.exempt.tags(self.apart));
+        self.grid.tag(self.exempt.tags(apart));
         // A few runs per thread balance the load; the runs change nothing but the cost.
         let runs = self.grid.cell_runs(4 * rayon::current_num_threads());
         self.pairs.resize_with(runs.len(), PairList::default);
-        let (grid, apart) = (&self.grid, self.apart);
+        let grid = &self.grid;
         self.pairs.par_iter_mut().zip(runs).for_each(|(list, run)| {
             list.clear();
             let mut row = Vec::new();
             // Exempt pairs are left out by the search itself.
-            grid.for_each_row_in(run, radius, Some(apart), &mut row, |i, near| {
+            grid.for_each_row_in(run, radius, apart, &mut row, |i, near| {
                 let ti = thickness[i as usize];
                 for &j in near {
                     list.push(i.min(j), i.max(j), 0.5 * (ti + thickness[j as usize]));

@@ -129,7 +129,7 @@ pub(crate) struct CellGrid {
     sorted: Vec<(u64, u32)>,
     /// Positions in key order.
     positions: Vec<DVec3>,
-    /// Each item's tag in key order (see [`CellGrid::tag`]); empty when untagged.
+    /// Each item's tag in key order (see [`CellGrid::tag`]); empty until tagged after a build.
     tags: Vec<DVec3>,
     /// Scratch of [`CellGrid::update`]: the moved items' keys, the old order and positions,
     /// and a flag per item leaving its place (all false between calls).
@@ -374,7 +374,7 @@ impl CellGrid {
     }
 
     /// Gives each item of the last build its tag `tags[item]`, a second point that
-    /// [`CellGrid::for_each_row_in`] can require pairs to be apart in. Untagged by a build.
+    /// [`CellGrid::for_each_row_in`] requires pairs to be apart in. A build drops the tags.
     pub(crate) fn tag(&mut self, tags: &[DVec3]) {
         self.tags.resize(self.sorted.len(), DVec3::ZERO);
         self.tags
@@ -535,11 +535,11 @@ impl CellGrid {
     }
 
     /// Calls `f(i, j)` once for every unordered pair {i, j} of built items at most `radius`
-    /// apart (`radius` must not exceed the spacing); which comes first, and the order of the
-    /// calls, depend on the positions alone.
+    /// apart (`radius` must not exceed the spacing) whose tags are more than `apart` apart;
+    /// which comes first, and the order of the calls, depend on the positions alone.
     #[cfg(test)]
-    pub(crate) fn for_each_pair(&self, radius: f64, f: impl FnMut(u32, u32)) {
-        self.for_each_pair_in(0..self.sorted.len(), radius, f);
+    pub(crate) fn for_each_pair(&self, radius: f64, apart: f64, f: impl FnMut(u32, u32)) {
+        self.for_each_pair_in(0..self.sorted.len(), radius, apart, f);
     }
 
     /// [`CellGrid::for_each_pair`] for the pairs whose first point (in key order) lies in
@@ -550,10 +550,11 @@ impl CellGrid {
         &self,
         run: Range<usize>,
         radius: f64,
+        apart: f64,
         mut f: impl FnMut(u32, u32),
     ) {
         let mut row = Vec::new();
-        self.for_each_row_in(run, radius, None, &mut row, |i, near| {
+        self.for_each_row_in(run, radius, apart, &mut row, |i, near| {
             for &j in near {
                 f(i, j);
             }
@@ -562,8 +563,8 @@ impl CellGrid {
 
     /// [`CellGrid::for_each_pair_in`] one point at a time: calls `f(i, near)` for each point
     /// `i` of `run` with a partner, `near` being its partners that come after it in key
-    /// order (so that each pair comes once). With `apart` = Some(d), only partners whose tags
-    /// are more than d apart count (the grid must be tagged). `row` is scratch.
+    /// order (so that each pair comes once). Only partners whose tags are more than `apart`
+    /// from i's count (the grid must be tagged). `row` is scratch.
     ///
     /// With `radius` ≤ spacing two such points lie in the same or neighbouring cells. Walking
     /// the cells in key order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
@@ -578,7 +579,7 @@ impl CellGrid {
         &self,
         run: Range<usize>,
         radius: f64,
-        apart: Option<f64>,
+        apart: f64,
         row: &mut Vec<u32>,
         mut f: impl FnMut(u32, &[u32]),
     ) {
@@ -587,12 +588,8 @@ impl CellGrid {
             "pair radius {radius} exceeds the cell size {}",
             self.spacing
         );
-        assert!(
-            apart.is_none() || self.tags.len() == self.sorted.len(),
-            "the grid is not tagged"
-        );
-        let r2 = radius * radius;
-        let apart2 = apart.map(|d| d * d);
+        assert_eq!(self.tags.len(), self.sorted.len(), "the grid is not tagged");
+        let (r2, apart2) = (radius * radius, apart * apart);
         let (cells, pos, tags) = (&self.sorted, &self.positions, &self.tags);
         let n = cells.len();
         let mut cursors = [0usize; COLUMNS.len()];
@@ -617,8 +614,7 @@ impl CellGrid {
             // The cell's candidates gathered once, in key order (the cell and the cell above
             // are contiguous), so that each point tests those after it in one pass.
             near.clear();
-            let tagged = apart2.is_some();
-            near.extend(&cells[s..y], &pos[s..y], tagged.then(|| &tags[s..y]));
+            near.extend(&cells[s..y], &pos[s..y], &tags[s..y]);
             for (cursor, offset) in cursors.iter_mut().zip(COLUMNS) {
                 let lo = c + offset;
                 while *cursor < n && cells[*cursor].0 < lo {
@@ -626,16 +622,11 @@ impl CellGrid {
                 }
                 let end = column_end(cells, *cursor, lo + 2);
                 let range = *cursor..end;
-                near.extend(
-                    &cells[range.clone()],
-                    &pos[range.clone()],
-                    tagged.then(|| &tags[range]),
-                );
+                near.extend(&cells[range.clone()], &pos[range.clone()], &tags[range]);
             }
             for x in s..e {
                 row.clear();
-                let tag = apart2.map(|a| (tags[x], a));
-                near.within(x - s + 1, pos[x], r2, tag, row);
+                near.within(x - s + 1, (pos[x], tags[x]), (r2, apart2), row);
                 if !row.is_empty() {
                     f(cells[x].1, row);
                 }
@@ -710,27 +701,23 @@ impl Candidates {
             .for_each(Vec::clear);
     }
 
-    /// Appends the items of `cells` at `pos` (with their `tags`, when tagged).
-    fn extend(&mut self, cells: &[(u64, u32)], pos: &[DVec3], tags: Option<&[DVec3]>) {
+    /// Appends the items of `cells` at `pos` with their `tags`.
+    fn extend(&mut self, cells: &[(u64, u32)], pos: &[DVec3], tags: &[DVec3]) {
         self.ids.extend(cells.iter().map(|&(_, i)| i));
-        for (c, out) in self.pos.iter_mut().enumerate() {
-            out.extend(pos.iter().map(|p| p[c]));
-        }
-        if let Some(tags) = tags {
-            for (c, out) in self.tags.iter_mut().enumerate() {
-                out.extend(tags.iter().map(|t| t[c]));
+        for (soa, points) in [(&mut self.pos, pos), (&mut self.tags, tags)] {
+            for (c, out) in soa.iter_mut().enumerate() {
+                out.extend(points.iter().map(|p| p[c]));
             }
         }
     }
 
-    /// Appends to `row` the candidates from index `from` on that lie at most √`r2` from `p`,
-    /// and, with `tag` = Some((q, apart2)), whose tag lies more than √apart2 from q.
+    /// Appends to `row` the candidates from index `from` on that lie at most √r2 from `p` and
+    /// whose tag lies more than √apart2 from `tag`.
     fn within(
         &mut self,
         from: usize,
-        p: DVec3,
-        r2: f64,
-        tag: Option<(DVec3, f64)>,
+        (p, tag): (DVec3, DVec3),
+        (r2, apart2): (f64, f64),
         row: &mut Vec<u32>,
     ) {
         let len = self.ids.len().saturating_sub(from);
@@ -738,15 +725,12 @@ impl Candidates {
         fn at(v: &[Vec<f64>; 3], from: usize) -> [&[f64]; 3] {
             [&v[0][from..], &v[1][from..], &v[2][from..]]
         }
-        match tag {
-            None => mark_near(&mut self.keep, at(&self.pos, from), p.to_array(), r2),
-            Some((q, apart2)) => mark_near_apart(
-                &mut self.keep,
-                (at(&self.pos, from), at(&self.tags, from)),
-                (p.to_array(), q.to_array()),
-                (r2, apart2),
-            ),
-        }
+        mark_near_apart(
+            &mut self.keep,
+            (at(&self.pos, from), at(&self.tags, from)),
+            (p.to_array(), tag.to_array()),
+            (r2, apart2),
+        );
         // Compaction without a branch per candidate (about one in four passes).
         let start = row.len();
         row.resize(start + len, 0);
@@ -760,22 +744,8 @@ impl Candidates {
     }
 }
 
-/// `keep[k]` = whether point k of `pos` (struct-of-arrays) lies at most √`r2` from `p`.
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
-    "x86_64+avx2+fma",
-    "aarch64+neon"
-))]
-fn mark_near(keep: &mut [u8], pos: [&[f64]; 3], p: [f64; 3], r2: f64) {
-    let n = keep.len();
-    let (xs, ys, zs) = (&pos[0][..n], &pos[1][..n], &pos[2][..n]);
-    for k in 0..n {
-        let (dx, dy, dz) = (xs[k] - p[0], ys[k] - p[1], zs[k] - p[2]);
-        keep[k] = u8::from(dx * dx + dy * dy + dz * dz <= r2);
-    }
-}
-
-/// [`mark_near`] for the points whose tag (in `tags`) also lies more than √`apart2` from `q`.
+/// `keep[k]` = whether point k of `pos` lies at most √`r2` from `p` and its tag (in `tags`)
+/// more than √`apart2` from `q` (both struct-of-arrays).
 #[multiversion(targets(
     "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
     "x86_64+avx2+fma",
@@ -849,7 +819,7 @@ mod tests {
         let mut found = Vec::new();
         for run in grid.cell_runs(5) {
             let mut row = Vec::new();
-            grid.for_each_row_in(run, radius, Some(apart), &mut row, |i, near| {
+            grid.for_each_row_in(run, radius, apart, &mut row, |i, near| {
                 found.extend(near.iter().map(|&j| (i.min(j), i.max(j))));
             });
         }
@@ -1058,13 +1028,19 @@ mod tests {
     fn grid_pairs_are_exactly_the_brute_force_pairs_each_once() {
         let (positions, items) = folded_cloud();
         let radius = 0.04;
+        // Tags 1 m apart from each other: no pair is left out by them.
+        let (apart, tags): (f64, Vec<DVec3>) = (
+            0.5,
+            (0..positions.len()).map(|i| DVec3::X * i as f64).collect(),
+        );
         let mut grid = CellGrid::new();
         let mut moved = positions.clone();
         // Twice: the second build starts from the first one's order.
         for round in 0..2 {
             grid.build(&moved, &items, radius);
+            grid.tag(&tags);
             let mut found = Vec::new();
-            grid.for_each_pair(radius, |i, j| found.push((i.min(j), i.max(j))));
+            grid.for_each_pair(radius, apart, |i, j| found.push((i.min(j), i.max(j))));
             // Split into runs of cells, the runs find the same pairs, each once.
             for parts in [2, 7, 64] {
                 let mut split = Vec::new();
@@ -1072,7 +1048,9 @@ mod tests {
                 assert!(runs.windows(2).all(|w| w[0].end == w[1].start));
                 assert_eq!((runs[0].start, runs[runs.len() - 1].end), (0, items.len()));
                 for run in runs {
-                    grid.for_each_pair_in(run, radius, |i, j| split.push((i.min(j), i.max(j))));
+                    grid.for_each_pair_in(run, radius, apart, |i, j| {
+                        split.push((i.min(j), i.max(j)))
+                    });
                 }
                 split.sort_unstable();
                 let mut whole = found.clone();
