@@ -365,23 +365,13 @@ impl CellGrid {
             }
         }
         self.fresh = fresh;
-        self.positions.resize(self.sorted.len(), DVec3::ZERO);
-        self.positions
-            .par_iter_mut()
-            .zip(self.sorted.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(out, &(_, i))| *out = positions[i as usize]);
+        in_key_order(&mut self.positions, &self.sorted, positions);
     }
 
     /// Gives each item of the last build its tag `tags[item]`, a second point that
     /// [`CellGrid::for_each_row_in`] requires pairs to be apart in. A build drops the tags.
     pub(crate) fn tag(&mut self, tags: &[DVec3]) {
-        self.tags.resize(self.sorted.len(), DVec3::ZERO);
-        self.tags
-            .par_iter_mut()
-            .zip(self.sorted.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(out, &(_, i))| *out = tags[i as usize]);
+        in_key_order(&mut self.tags, &self.sorted, tags);
     }
 
     /// Moves `moved` (items, each given once) to their cells at `positions`: those already in
@@ -634,6 +624,15 @@ impl CellGrid {
             s = e;
         }
     }
+}
+
+/// Fills `out` with `values[item]` for each (key, item) of `sorted`, on rayon's threads.
+fn in_key_order(out: &mut Vec<DVec3>, sorted: &[(u64, u32)], values: &[DVec3]) {
+    out.resize(sorted.len(), DVec3::ZERO);
+    out.par_iter_mut()
+        .zip(sorted.par_iter())
+        .with_min_len(PAR_MIN)
+        .for_each(|(out, &(_, i))| *out = values[i as usize]);
 }
 
 /// The first index at or after `from` whose key exceeds `last` (a column's cells run to
