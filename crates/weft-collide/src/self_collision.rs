@@ -790,9 +790,6 @@ mod tests {
     const N: usize = 24;
     const SPACING: f64 = 0.01;
 
-    /// An N×N cloth of thickness = spacing (flat at rest), and positions accordion-folded in
-    /// layers of 4 rows 0.9 thickness apart, every particle jittered by up to 0.3 thickness:
-    /// a random folded configuration.
     /// A solver with `cloths` horizontal `n`×`n` sheets of `size` (m) at the same rest place,
     /// each SPACING thick.
     fn sheets(cloths: usize, n: usize, size: (f64, f64)) -> Solver {
@@ -814,6 +811,9 @@ mod tests {
         b.build()
     }
 
+    /// An N×N cloth of thickness = spacing (flat at rest), and positions accordion-folded in
+    /// layers of 4 rows 0.9 thickness apart, every particle jittered by up to 0.3 thickness:
+    /// a random folded configuration.
     fn folded() -> (Solver, Vec<DVec3>, Vec<f64>) {
         let side = SPACING * (N - 1) as f64;
         let solver = sheets(1, N, (side, side));
