@@ -7,7 +7,10 @@
 //! cloth falls, folds and settles. Frames `--warmup`..`--warmup + --frames` (dt = 1/60 s,
 //! 10 substeps × 1 iteration, XPBD) are reported: the median self-collision time per frame,
 //! and, stepped from the window's first state without any hook (the fused frame), the median
-//! constraint solve per frame; then their ratio.
+//! constraint solve per frame; then their ratio. Last, the mean per frame of each part of the
+//! self-collision hook (its own clocks, [`weft_collide::SelfCollisionTimes`]) and its ratio to
+//! the median solve: the list's upkeep (check, rebuilds, re-anchoring) and the sweeps (finding
+//! and applying contacts).
 //!
 //! `cargo run --release -p weft-collide --example self_collision_cost -- [--scene curtain|drape]
 //! [--frames F] [--warmup W] [--n N] [--margin M]`. Set `RAYON_NUM_THREADS` to choose the
@@ -128,6 +131,8 @@ fn main() {
         let start = solver.clone();
         let lists = |h: &Split| h.own.self_collision_lists().unwrap();
         let (r0, u0, _) = lists(&hook);
+        let times = |h: &Split| h.own.self_collision_times().unwrap();
+        let t0 = times(&hook);
         let mut own = Vec::new();
         let mut contacts = 0;
         for _ in 0..a.frames {
@@ -137,6 +142,7 @@ fn main() {
             contacts = contacts.max(hook.own.stats().self_contacts);
         }
         let (r1, u1, len) = lists(&hook);
+        let t1 = times(&hook);
         let mut bare = start.clone();
         let solve: Vec<f64> = (0..a.frames)
             .map(|_| {
@@ -162,6 +168,30 @@ fn main() {
             "  median per frame: self-collision {own:.3} ms, constraint solve {solve:.3} ms; \
              ratio {:.2}",
             own / solve
+        );
+        // Mean per frame of each part over the window, and against the median solve.
+        let frames = a.frames as f64;
+        let per_frame = |now: Duration, then: Duration| (now - then).as_secs_f64() * 1e3 / frames;
+        let parts = [
+            ("check", per_frame(t1.check, t0.check)),
+            ("rebuild", per_frame(t1.rebuild, t0.rebuild)),
+            ("re-anchor", per_frame(t1.reanchor, t0.reanchor)),
+            ("find", per_frame(t1.find, t0.find)),
+            ("apply", per_frame(t1.apply, t0.apply)),
+        ];
+        let line: Vec<String> = parts
+            .iter()
+            .map(|(name, ms)| format!("{name} {ms:.3} ({:.2})", ms / solve))
+            .collect();
+        let (upkeep, sweep) = (
+            parts[..3].iter().map(|p| p.1).sum::<f64>(),
+            parts[3..].iter().map(|p| p.1).sum::<f64>(),
+        );
+        println!(
+            "  mean per frame, ms (÷ solve): {}; upkeep {upkeep:.3} ({:.2}), sweep {sweep:.3} ({:.2})",
+            line.join(", "),
+            upkeep / solve,
+            sweep / solve
         );
     }
 }

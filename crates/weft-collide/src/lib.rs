@@ -21,6 +21,7 @@ mod spatial_hash;
 mod tessellate;
 #[cfg(test)]
 mod test_rand;
+mod times;
 mod world;
 
 pub use collider::{Collider, ColliderDesc, SurfacePoint};
@@ -32,6 +33,7 @@ pub use self_collision::SelfCollisionParams;
 pub use shape::{CompoundPart, ShapeDesc};
 pub use spatial_hash::SpatialHash;
 pub use tessellate::{HALF_SPACE_EXTENT, Tessellation, tessellate_shape};
+pub use times::SelfCollisionTimes;
 pub use world::{CollisionWorld, ContactStats};
 
 /// Re-export of parry, so users name the same shape types.

@@ -30,6 +30,8 @@
 //! listed pair that is not touching does nothing), and both the pair search and the sweep run
 //! in parallel.
 
+use std::time::Instant;
+
 use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
@@ -40,6 +42,7 @@ use crate::friction::Friction;
 use crate::self_contact::{Bins, State, apply, find_contacts};
 use crate::skin::{Change, Skin};
 use crate::spatial_hash::{CellGrid, Queries};
+use crate::times::SelfCollisionTimes;
 
 /// Self-collision settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -335,6 +338,8 @@ pub(crate) struct SelfCollision {
     contacts: Vec<(Vec<u32>, Bins)>,
     sums: Vec<DVec3>,
     counts: Vec<u32>,
+    /// Time spent in each part so far.
+    times: SelfCollisionTimes,
 }
 
 impl SelfCollision {
@@ -413,6 +418,7 @@ impl SelfCollision {
             contacts: Vec::new(),
             sums: vec![DVec3::ZERO; n],
             counts: vec![0; n],
+            times: SelfCollisionTimes::default(),
         })
     }
 
@@ -441,6 +447,11 @@ impl SelfCollision {
     /// Partial updates (a few members re-anchored) so far.
     pub(crate) fn updates(&self) -> u64 {
         self.updates
+    }
+
+    /// Time spent in each part so far.
+    pub(crate) fn times(&self) -> SelfCollisionTimes {
+        self.times
     }
 
     /// Candidate pairs in the current list.
@@ -492,6 +503,15 @@ impl SelfCollision {
         thickness: &[f64],
         clamp: Option<Clamp<'_>>,
     ) {
+        let (start, before) = (Instant::now(), self.times.upkeep());
+        self.check(positions, thickness, clamp);
+        // The builds and partial updates inside have counted their own time.
+        let inside = self.times.upkeep() - before;
+        self.times.check += start.elapsed().saturating_sub(inside);
+    }
+
+    /// [`SelfCollision::refresh`] without its clock.
+    fn check(&mut self, positions: &mut [DVec3], thickness: &[f64], clamp: Option<Clamp<'_>>) {
         match self.skin.record(self.pair_count()) {
             Change::Keep => {}
             Change::Grow => self.built_for = None,
@@ -574,6 +594,15 @@ impl SelfCollision {
     /// Re-anchors `movers` at xᵢ − c and lists their pairs within R of the new anchors (see
     /// [`SelfCollision::refresh`]); rebuilds instead once many members have been re-anchored.
     fn reanchor(&mut self, positions: &[DVec3], thickness: &[f64], c: DVec3, t: f64) {
+        let (start, built) = (Instant::now(), self.times.rebuild);
+        self.reanchor_movers(positions, thickness, c, t);
+        // A rebuild instead has counted its own time.
+        let inside = self.times.rebuild - built;
+        self.times.reanchor += start.elapsed().saturating_sub(inside);
+    }
+
+    /// [`SelfCollision::reanchor`] without its clock.
+    fn reanchor_movers(&mut self, positions: &[DVec3], thickness: &[f64], c: DVec3, t: f64) {
         let before = self.reanchored.len();
         for &m in &self.movers {
             let m = m as usize;
@@ -664,6 +693,13 @@ impl SelfCollision {
     /// Builds the list at `positions`: pairs from the grid, run by run on rayon's threads,
     /// with their targets.
     fn rebuild(&mut self, positions: &[DVec3], thickness: &[f64]) {
+        let start = Instant::now();
+        self.build(positions, thickness);
+        self.times.rebuild += start.elapsed();
+    }
+
+    /// [`SelfCollision::rebuild`] without its clock.
+    fn build(&mut self, positions: &[DVec3], thickness: &[f64]) {
         self.rebuilds += 1;
         for &r in &self.reanchored {
             self.is_reanchored[r as usize] = false;
@@ -741,6 +777,7 @@ impl SelfCollision {
     /// One Jacobi sweep over the touching pairs (see the module doc); returns the number of
     /// contacts and the deepest overlap (m). Call [`SelfCollision::refresh`] first.
     pub(crate) fn solve(&mut self, p: &mut Particles) -> (usize, f64) {
+        let start = Instant::now();
         let lists: Vec<&PairList> = self.pairs.iter().chain([&self.extra]).collect();
         self.contacts.resize_with(lists.len(), Default::default);
         let friction = self.params.friction;
@@ -764,6 +801,8 @@ impl SelfCollision {
             .with_min_len(serial)
             .map(find)
             .reduce(|| 0.0, f64::max);
+        let found = Instant::now();
+        self.times.find += found - start;
         self.sums.resize(n, DVec3::ZERO);
         self.counts.resize(n, 0);
         let contacts = apply(
@@ -772,6 +811,7 @@ impl SelfCollision {
             &mut self.sums,
             &mut self.counts,
         );
+        self.times.apply += found.elapsed();
         (contacts, deepest)
     }
 }

@@ -16,6 +16,7 @@ use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams};
+use crate::times::SelfCollisionTimes;
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -135,6 +136,12 @@ impl CollisionWorld {
         self.self_collision
             .as_ref()
             .map(|s| (s.rebuilds(), s.updates(), s.pair_count()))
+    }
+
+    /// Wall-clock time spent in each part of self-collision since it was turned on, or `None`
+    /// when it is off.
+    pub fn self_collision_times(&self) -> Option<SelfCollisionTimes> {
+        self.self_collision.as_ref().map(SelfCollision::times)
     }
 
     /// Per-particle thickness (m).
