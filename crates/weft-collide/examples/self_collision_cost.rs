@@ -19,9 +19,13 @@
 
 use std::time::{Duration, Instant};
 
+use weft_collide::SelfCollisionParams;
 use weft_collide::scenarios;
-use weft_collide::{CollisionWorld, SelfCollisionParams};
-use weft_solver::{Method, Particles, Solver, SubstepContext, SubstepHook};
+use weft_solver::{Method, Solver};
+
+#[path = "../tests/common/split.rs"]
+mod split;
+use split::Split;
 
 struct Args {
     scenes: Vec<String>,
@@ -54,58 +58,17 @@ fn args() -> Args {
     a
 }
 
-/// Self-collision and colliders as two hooks, self-collision first (as inside one world),
-/// with the time spent in the self-collision one.
-struct Split {
-    own: CollisionWorld,
-    colliders: CollisionWorld,
-    spent: Duration,
-}
-
-impl SubstepHook for Split {
-    fn begin_substep(&mut self, ctx: &SubstepContext, p: &Particles) {
-        let t = Instant::now();
-        self.own.begin_substep(ctx, p);
-        self.spent += t.elapsed();
-        self.colliders.begin_substep(ctx, p);
-    }
-
-    fn project(&mut self, ctx: &SubstepContext, p: &mut Particles) -> usize {
-        let t = Instant::now();
-        let own = self.own.project(ctx, p);
-        self.spent += t.elapsed();
-        own + self.colliders.project(ctx, p)
-    }
-
-    fn end_substep(&mut self, ctx: &SubstepContext, p: &mut Particles) {
-        let t = Instant::now();
-        self.own.end_substep(ctx, p);
-        self.spent += t.elapsed();
-        self.colliders.end_substep(ctx, p);
-    }
-}
-
 /// The scene's solver and its split hook: `curtain` is [`scenarios::curtain_fold`] (a curtain
 /// folding onto itself in layers on the ground), `drape` an n × n sheet dropped on the sphere
 /// ([`scenarios::sphere_drop`]) with self-collision on.
 fn scene(name: &str, n: usize, params: SelfCollisionParams) -> (Solver, Split) {
-    let (solver, mut colliders) = match name {
+    let (solver, colliders) = match name {
         "curtain" => scenarios::curtain_fold(Method::Xpbd, n).unwrap(),
         "drape" => scenarios::sphere_drop(Method::Xpbd, n).unwrap(),
         _ => panic!("unknown scene {name}"),
     };
-    colliders.disable_self_collision();
-    let mut own = CollisionWorld::new(&solver);
-    own.enable_self_collision(&solver, &[0], params).unwrap();
-    let spent = Duration::ZERO;
-    (
-        solver,
-        Split {
-            own,
-            colliders,
-            spent,
-        },
-    )
+    let split = Split::new(&solver, colliders, params).unwrap();
+    (solver, split)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -1,5 +1,8 @@
-//! Shared test helpers: a hook that wraps the collision world and checks every substep.
+//! Shared test helpers: a hook that wraps the collision world and checks every substep, and
+//! (`split`) a scene's self-collision timed in a world of its own.
 #![allow(dead_code)]
+
+pub mod split;
 
 use weft_collide::CollisionWorld;
 use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
