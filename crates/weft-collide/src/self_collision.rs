@@ -332,10 +332,10 @@ pub(crate) struct SelfCollision {
     built_for: Option<f64>,
     /// Lists built so far.
     rebuilds: u64,
-    /// Sweep scratch: per list, the touching pairs' indices and their corrections binned by
+    /// Sweep scratch: per list, the corrections of its touching pairs binned by
     /// particle range; per particle, the exact sum of its corrections and their count (zero
     /// between sweeps).
-    contacts: Vec<(Vec<u32>, Bins)>,
+    contacts: Vec<Bins>,
     sums: Vec<DVec3>,
     counts: Vec<u32>,
     /// Time spent in each part so far.
@@ -787,9 +787,9 @@ impl SelfCollision {
             w: &p.inv_masses,
         };
         let n = p.positions.len();
-        let find = |(list, (hits, out)): (&&PairList, &mut (Vec<u32>, Bins))| {
+        let find = |(list, out): (&&PairList, &mut Bins)| {
             out.reset(n);
-            find_contacts((&list.a, &list.b, &list.target), state, friction, hits, out)
+            find_contacts((&list.a, &list.b, &list.target), state, friction, out)
         };
         // A few thousand pairs take less time than waking another thread: below that, the
         // lists are not split among threads.

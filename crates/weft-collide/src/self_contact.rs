@@ -85,9 +85,12 @@ pub(crate) struct State<'a> {
     pub w: &'a [f64],
 }
 
+/// Listed pairs filtered at a time before their touching ones are gathered: the positions the
+/// filter loaded are then still in the L1 cache when the gather loads them again.
+const CHUNK: usize = 256;
+
 /// Finds the pairs (`a[k]`, `b[k]`) closer than `target[k]` and adds their corrections to
-/// `out` (reset for the particle count first); returns the deepest overlap (m). `hits` is
-/// scratch.
+/// `out` (reset for the particle count first); returns the deepest overlap (m).
 #[multiversion(targets(
     "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
     "x86_64+avx2+fma",
@@ -97,32 +100,42 @@ pub(crate) fn find_contacts<'a>(
     (a, b, target): (&[u32], &[u32], &[f64]),
     s: State<'a>,
     friction: Friction,
-    hits: &mut Vec<u32>,
     out: &mut Bins,
 ) -> f64 {
-    // Most listed pairs do not touch: a branch-free filter first (a branch here would be
-    // mispredicted for about every fourth pair of a dense fold). `hits` only grows, so it
-    // is not cleared (a memset of the whole list) every sweep.
-    if hits.len() < a.len() {
-        hits.resize(a.len(), 0);
-    }
-    let mut n = 0;
-    for (k, ((&i, &j), &t)) in a.iter().zip(b).zip(target).enumerate() {
-        let d2 = (s.x[i as usize] - s.x[j as usize]).length_squared();
-        hits[n] = k as u32;
-        n += usize::from(d2 < t * t);
-    }
     let mut deepest = [0.0f64; BLOCK];
     let mut block = Block::EMPTY;
-    for chunk in hits[..n].chunks(BLOCK) {
-        block.gather(chunk, (a, b, target), s);
+    let mut hits = [0u32; CHUNK];
+    for start in (0..a.len()).step_by(CHUNK) {
+        let end = (start + CHUNK).min(a.len());
+        // Most listed pairs do not touch: a branch-free filter first (a branch here would be
+        // mispredicted for about every fourth pair of a dense fold).
+        let mut n = 0;
+        for (k, ((&i, &j), &t)) in a[start..end]
+            .iter()
+            .zip(&b[start..end])
+            .zip(&target[start..end])
+            .enumerate()
+        {
+            let d2 = (s.x[i as usize] - s.x[j as usize]).length_squared();
+            hits[n] = (start + k) as u32;
+            n += usize::from(d2 < t * t);
+        }
+        for &k in &hits[..n] {
+            block.push(k as usize, (a, b, target), s);
+            if block.len == BLOCK {
+                block.contacts(friction, out, &mut deepest);
+                block.len = 0;
+            }
+        }
+    }
+    if block.len > 0 {
         block.contacts(friction, out, &mut deepest);
     }
     deepest.into_iter().fold(0.0, f64::max)
 }
 
-/// The data of up to [`BLOCK`] touching pairs, one lane each, as struct-of-arrays; unused
-/// lanes have no mass and give no contact.
+/// The data of up to [`BLOCK`] touching pairs, one lane each, as struct-of-arrays; the lanes
+/// from `len` on hold stale or no data and are computed but never used.
 ///
 /// Gathering first and computing after, in separate loops, lets the kernel load whole
 /// vectors: loading a vector just assembled from scalar stores stalls on every load (store
@@ -155,29 +168,23 @@ impl Block {
         wb: [0.0; BLOCK],
     };
 
-    /// Loads the pairs `ks` (at most [`BLOCK`]) of the list; the lanes after them get no mass.
+    /// Loads pair `k` of the list into the next lane (the block must not be full).
     #[inline(always)]
-    fn gather(&mut self, ks: &[u32], (a, b, target): (&[u32], &[u32], &[f64]), s: State<'_>) {
-        self.len = ks.len();
-        for (l, &k) in ks.iter().enumerate() {
-            let k = k as usize;
-            let (i, j) = (a[k], b[k]);
-            (self.ia[l], self.ib[l], self.t[l]) = (i, j, target[k]);
-            let (i, j) = (i as usize, j as usize);
-            let (p, q, pp, pq) = (s.x[i], s.x[j], s.prev[i], s.prev[j]);
-            for c in 0..3 {
-                self.xa[c][l] = p[c];
-                self.xb[c][l] = q[c];
-                self.pa[c][l] = pp[c];
-                self.pb[c][l] = pq[c];
-            }
-            self.wa[l] = s.w[i];
-            self.wb[l] = s.w[j];
+    fn push(&mut self, k: usize, (a, b, target): (&[u32], &[u32], &[f64]), s: State<'_>) {
+        let l = self.len;
+        let (i, j) = (a[k], b[k]);
+        (self.ia[l], self.ib[l], self.t[l]) = (i, j, target[k]);
+        let (i, j) = (i as usize, j as usize);
+        let (p, q, pp, pq) = (s.x[i], s.x[j], s.prev[i], s.prev[j]);
+        for c in 0..3 {
+            self.xa[c][l] = p[c];
+            self.xb[c][l] = q[c];
+            self.pa[c][l] = pp[c];
+            self.pb[c][l] = pq[c];
         }
-        for l in ks.len()..BLOCK {
-            self.wa[l] = 0.0;
-            self.wb[l] = 0.0;
-        }
+        self.wa[l] = s.w[i];
+        self.wb[l] = s.w[j];
+        self.len += 1;
     }
 
     /// The corrections of the block's pairs, lane by lane: the contact is the distance
@@ -276,7 +283,7 @@ type Range<'a> = (usize, ((&'a mut [DVec3], &'a mut [DVec3]), &'a mut [u32]));
 /// Below this many contacts [`apply`] runs on one thread.
 const SERIAL_CONTACTS: usize = 2048;
 
-/// Moves every particle with a contact in `found` (per list: scratch, corrections) by the
+/// Moves every particle with a contact in `found` (per list, its corrections) by the
 /// mean of its corrections, and returns the number of contacts; `sums` and `counts` (one per
 /// particle, zero on entry) are scratch and zero again on return.
 ///
@@ -284,12 +291,12 @@ const SERIAL_CONTACTS: usize = 2048;
 /// the ranges run on rayon's threads without sharing a particle (one thread applying all
 /// 16,000 contacts of a resting fold at 128² took 52 µs, two threads this way 31 µs).
 pub(crate) fn apply(
-    found: &[(Vec<u32>, Bins)],
+    found: &[Bins],
     positions: &mut [DVec3],
     sums: &mut [DVec3],
     counts: &mut [u32],
 ) -> usize {
-    let contacts: usize = found.iter().map(|(_, b)| b.contacts).sum();
+    let contacts: usize = found.iter().map(|b| b.contacts).sum();
     if contacts == 0 {
         return 0;
     }
@@ -297,7 +304,7 @@ pub(crate) fn apply(
     let span = 1 << Bins::shift_for(positions.len());
     let range = |(k, ((xs, ss), cs)): Range<'_>| {
         let start = k * span;
-        for (_, bins) in found {
+        for bins in found {
             for c in &bins.bins[k] {
                 let j = c.i as usize - start;
                 cs[j] += 1;
@@ -341,13 +348,13 @@ mod tests {
             pairs.iter().map(|p| p.2).collect(),
         );
         let state = State { x, prev, w };
-        let (mut hits, mut out) = (Vec::new(), Bins::default());
+        let mut out = Bins::default();
         out.reset(x.len());
-        find_contacts((&a, &b, &t), state, Friction::NONE, &mut hits, &mut out);
+        find_contacts((&a, &b, &t), state, Friction::NONE, &mut out);
         let mut x = x.to_vec();
         let mut sums = vec![DVec3::ZERO; x.len()];
         let mut counts = vec![0; x.len()];
-        apply(&[(hits, out)], &mut x, &mut sums, &mut counts);
+        apply(&[out], &mut x, &mut sums, &mut counts);
         assert!(sums.iter().all(|s| *s == DVec3::ZERO) && counts.iter().all(|&c| c == 0));
         x
     }
@@ -416,14 +423,14 @@ mod tests {
                 pairs.iter().map(|p| p.1).collect(),
                 pairs.iter().map(|p| p.2).collect(),
             );
-            let (mut hits, mut out) = (Vec::new(), Bins::default());
+            let mut out = Bins::default();
             out.reset(n);
-            find_contacts((&a, &b, &t), state, friction, &mut hits, &mut out);
+            find_contacts((&a, &b, &t), state, friction, &mut out);
             let mut moved = x.clone();
             let (mut sums, mut counts) = (vec![DVec3::ZERO; n], vec![0; n]);
-            let found = [(hits, out)];
+            let found = [out];
             apply(&found, &mut moved, &mut sums, &mut counts);
-            let [(_, out)] = found;
+            let [out] = found;
             (moved, out)
         };
         let (first, all) = run(&pairs);
