@@ -332,9 +332,9 @@ pub(crate) struct SelfCollision {
     built_for: Option<f64>,
     /// Lists built so far.
     rebuilds: u64,
-    /// Sweep scratch: per list, the corrections of its touching pairs binned by
-    /// particle range; per particle, the exact sum of its corrections and their count (zero
-    /// between sweeps).
+    /// Sweep scratch: per list, the corrections of its touching pairs binned by particle
+    /// range; per particle, the exact sum of its corrections and their count (zero between
+    /// sweeps).
     contacts: Vec<Bins>,
     sums: Vec<DVec3>,
     counts: Vec<u32>,
