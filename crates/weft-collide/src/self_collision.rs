@@ -30,7 +30,7 @@
 //! listed pair that is not touching does nothing), and both the pair search and the sweep run
 //! in parallel.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -503,11 +503,21 @@ impl SelfCollision {
         thickness: &[f64],
         clamp: Option<Clamp<'_>>,
     ) {
-        let (start, before) = (Instant::now(), self.times.upkeep());
-        self.check(positions, thickness, clamp);
-        // The builds and partial updates inside have counted their own time.
-        let inside = self.times.upkeep() - before;
-        self.times.check += start.elapsed().saturating_sub(inside);
+        self.timed(|t| &mut t.check, |s| s.check(positions, thickness, clamp));
+    }
+
+    /// Runs `f` and adds the time it took to the part `part` picks, less the time of the parts
+    /// timed inside it (a check that rebuilds counts the build as a build, not as check).
+    fn timed<T>(
+        &mut self,
+        part: fn(&mut SelfCollisionTimes) -> &mut Duration,
+        f: impl FnOnce(&mut Self) -> T,
+    ) -> T {
+        let (start, before) = (Instant::now(), self.times.total());
+        let out = f(self);
+        let inside = self.times.total() - before;
+        *part(&mut self.times) += start.elapsed().saturating_sub(inside);
+        out
     }
 
     /// [`SelfCollision::refresh`] without its clock.
@@ -594,11 +604,10 @@ impl SelfCollision {
     /// Re-anchors `movers` at xᵢ − c and lists their pairs within R of the new anchors (see
     /// [`SelfCollision::refresh`]); rebuilds instead once many members have been re-anchored.
     fn reanchor(&mut self, positions: &[DVec3], thickness: &[f64], c: DVec3, t: f64) {
-        let (start, built) = (Instant::now(), self.times.rebuild);
-        self.reanchor_movers(positions, thickness, c, t);
-        // A rebuild instead has counted its own time.
-        let inside = self.times.rebuild - built;
-        self.times.reanchor += start.elapsed().saturating_sub(inside);
+        self.timed(
+            |times| &mut times.reanchor,
+            |s| s.reanchor_movers(positions, thickness, c, t),
+        );
     }
 
     /// [`SelfCollision::reanchor`] without its clock.
@@ -693,9 +702,7 @@ impl SelfCollision {
     /// Builds the list at `positions`: pairs from the grid, run by run on rayon's threads,
     /// with their targets.
     fn rebuild(&mut self, positions: &[DVec3], thickness: &[f64]) {
-        let start = Instant::now();
-        self.build(positions, thickness);
-        self.times.rebuild += start.elapsed();
+        self.timed(|t| &mut t.rebuild, |s| s.build(positions, thickness));
     }
 
     /// [`SelfCollision::rebuild`] without its clock.
