@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Summarise Weft's `cargo bench` results as the Markdown tables of the README.
+"""Summarise Weft's `cargo bench` results as docs/benchmarks.md.
 
 Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.8) and
 `<criterion>/substeps_error.json` (written by benches/substeps.rs), and prints:
@@ -11,11 +11,16 @@ Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.
 - collisions (sphere, triangle mesh, self) with and without, and their exponents;
 - self-collision vs constraint solve at N = 128; MCAP logging overhead.
 
-Figures are criterion's median point estimates. Usage:
-    python3 scripts/bench_summary.py [CRITERION_DIR]
+Figures are criterion's median point estimates. The page starts with where they come from:
+the date, the commit (`git describe`), the CPU (`/proc/cpuinfo`'s model name) and the widest
+vector path the CPU offers, or the one forced with WEFT_SIMD. Usage:
+    python3 scripts/bench_summary.py [CRITERION_DIR] [--out docs/benchmarks.md]
 CRITERION_DIR defaults to $CRITERION_HOME, else $CARGO_TARGET_DIR/criterion, else
-target/criterion.
+target/criterion. Without --out the page goes to standard output.
 """
+import contextlib
+import datetime
+import subprocess
 import json
 import math
 import os
@@ -23,9 +28,25 @@ import sys
 from pathlib import Path
 
 
-def criterion_dir():
-    if len(sys.argv) > 1:
-        return Path(sys.argv[1])
+def parse_args(argv):
+    """(criterion directory or None, output path or None) from the command line."""
+    root, out = None, None
+    it = iter(argv)
+    for a in it:
+        if a == "--out":
+            out = next(it, None)
+            if out is None:
+                sys.exit("bench_summary: --out needs a file")
+        elif root is None:
+            root = a
+        else:
+            sys.exit(f"bench_summary: unexpected argument {a!r}")
+    return root, out
+
+
+def criterion_dir(arg):
+    if arg:
+        return Path(arg)
     if os.environ.get("CRITERION_HOME"):
         return Path(os.environ["CRITERION_HOME"])
     if os.environ.get("CARGO_TARGET_DIR"):
@@ -84,7 +105,7 @@ SIZES = [32, 64, 128, 256]
 
 
 def methods(r):
-    print("### Step time per frame (reference cloth, 10 substeps × 1 iteration)\n")
+    print("## Step time per frame (reference cloth, 10 substeps × 1 iteration)\n")
     head = " | ".join(f"{n}² ms/frame" for n in SIZES)
     print(f"| method | {head} | Mproj/s at 128² | exponent p (cost ∝ particles^p) |")
     print("|---" * (len(SIZES) + 3) + "|")
@@ -104,7 +125,7 @@ def methods(r):
 
 
 def reference(r):
-    print("### Reference workload (N×N, stretch + shear, α = 0, 10 × 1, dt = 1/60)\n")
+    print("## Reference workload (N×N, stretch + shear, α = 0, 10 × 1, dt = 1/60)\n")
     print("| threads | N=64 ms/frame | N=128 ms/frame | N=256 ms/frame | ns/projection at 128 |")
     print("|---|---|---|---|---|")
     for t in [1, 2]:
@@ -116,7 +137,7 @@ def reference(r):
 
 
 def substeps(r, root):
-    print("### Substeps × iterations at equal cost (64², XPBD, α = 0, error after 1 s)\n")
+    print("## Substeps × iterations at equal cost (64², XPBD, α = 0, error after 1 s)\n")
     path = root / "substeps_error.json"
     rows = json.loads(path.read_text()) if path.exists() else []
     if not rows:
@@ -134,7 +155,7 @@ def substeps(r, root):
 
 
 def collisions(r):
-    print("### Collisions: step time per frame with and without (XPBD scenarios)\n")
+    print("## Collisions: step time per frame with and without (XPBD scenarios)\n")
     head = " | ".join(f"{n}²" for n in SIZES)
     print(f"| scenario | | {head} | exponent p |")
     print("|---" * (len(SIZES) + 3) + "|")
@@ -158,7 +179,7 @@ def collisions(r):
 
 
 def self_vs_solve(r):
-    print("### Self-collision vs constraint solve, 128² self-fold strip, per frame\n")
+    print("## Self-collision vs constraint solve, 128² self-fold strip, per frame\n")
     print("| what | ms/frame |")
     print("|---|---|")
     for f, label in [("constraint_solve", "constraint solve (no collisions)"),
@@ -169,7 +190,7 @@ def self_vs_solve(r):
 
 
 def logging(r):
-    print("### MCAP logging, default scene at 128² (`weft run` with and without `--out`)\n")
+    print("## MCAP logging, default scene at 128² (`weft run` with and without `--out`)\n")
     a, b, w = (ms(r, f"weft_run/16384/{k}") for k in ["no_log", "mcap", "writer_only"])
     over = f"{100 * (b - a) / a:+.0f} %" if a and b else "–"
     print("| no log ms/frame | with MCAP ms/frame | overhead | writer alone ms/frame |")
@@ -178,20 +199,81 @@ def logging(r):
     print()
 
 
+def cpu_model():
+    """The CPU's model name from /proc/cpuinfo (or the platform's name)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    import platform
+    return platform.processor() or platform.machine()
+
+
+def simd_path():
+    """WEFT_SIMD when set, else the widest vector path the CPU's flags offer."""
+    forced = os.environ.get("WEFT_SIMD")
+    if forced:
+        return f"{forced} (forced with WEFT_SIMD)"
+    try:
+        flags = set(Path("/proc/cpuinfo").read_text().split())
+    except OSError:
+        flags = set()
+    if "avx512f" in flags:
+        return "avx512 (the widest this CPU offers)"
+    if "avx2" in flags and "fma" in flags:
+        return "avx2 (the widest this CPU offers)"
+    return "scalar"
+
+
+def git(*args):
+    try:
+        return subprocess.run(["git", *args], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def header(root, count):
+    date = datetime.date.today().isoformat()
+    print("# Benchmarks\n")
+    print("Generated by `python3 scripts/bench_summary.py --out docs/benchmarks.md` from "
+          "criterion's output after `cargo bench --workspace`; do not edit by hand. Figures are "
+          "criterion's median point estimates, in ms per frame unless a column says otherwise.\n")
+    print(f"- date: {date}")
+    print(f"- commit: {git('describe', '--always', '--dirty')}")
+    print(f"- CPU: {cpu_model()}, {os.cpu_count()} logical CPUs")
+    print(f"- vector path: {simd_path()}")
+    print(f"- {count} benchmarks read from `{root}`\n")
+
+
 def main():
-    root = criterion_dir()
+    arg, out = parse_args(sys.argv[1:])
+    root = criterion_dir(arg)
     r = load(root)
     if not r:
         print(f"no criterion results under {root}: run `cargo bench` first", file=sys.stderr)
         return 1
-    print(f"<!-- {len(r)} benchmarks from {root}; criterion median point estimates -->\n")
+    if out:
+        tmp = Path(out).with_suffix(".md.tmp")
+        with open(tmp, "w") as f, contextlib.redirect_stdout(f):
+            write_page(r, root)
+        tmp.replace(out)
+        print(f"wrote {out}", file=sys.stderr)
+    else:
+        write_page(r, root)
+    return 0
+
+
+def write_page(r, root):
+    header(root, len(r))
     methods(r)
     reference(r)
     substeps(r, root)
     collisions(r)
     self_vs_solve(r)
     logging(r)
-    return 0
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Weft against the peer solvers on the shared reference workload (../shared/peers/README.md,
+# Weft against the peer solvers on the shared reference workload (scripts/peers/README.md,
 # assets/scenes/reference.toml): N×N 1 m cloth of 1 kg, top edge pinned, stretch + shear at
 # α = 0, dt = 1/60, 10 substeps × 1 iteration, no bending, no collisions.
 #
@@ -11,12 +11,12 @@
 # (Taichi/Weft > 1: Weft is faster). Single-thread runs are pinned to one CPU (Taichi pins
 # itself; Weft through taskset) because cross-CPU wake-ups dominate otherwise on this VM.
 #
-# Prerequisite for the peers: bash ../shared/peers/setup.sh   (venvs under /tmp/peers)
+# Prerequisite for the peers: bash scripts/peers/setup.sh   (venvs under /tmp/peers)
 # Usage: scripts/compare_peers.sh            (env: N=128 REPS=5 THREADS="1 2" FRAMES=30
-#                                            PEERS_DIR=../shared/peers PEERS_ROOT=/tmp/peers)
+#                                            PEERS_DIR=scripts/peers PEERS_ROOT=/tmp/peers)
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
-peers="${PEERS_DIR:-$repo/../shared/peers}"
+peers="${PEERS_DIR:-$repo/scripts/peers}"
 venvs="${PEERS_ROOT:-/tmp/peers}"
 N="${N:-128}"
 REPS="${REPS:-5}"
