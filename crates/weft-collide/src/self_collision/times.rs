@@ -1,7 +1,9 @@
-//! Wall-clock time spent in each part of self-collision, for profiling (the counters of
-//! rapier's `Counters`, for one stage). Reading the clock changes no result.
+//! Counters and wall-clock time spent in each part of self-collision, for profiling (the
+//! counters of rapier's `Counters`, for one stage). Reading the clock changes no result.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
+
+use super::SelfCollision;
 
 /// Time spent in each part of self-collision since it was turned on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -33,5 +35,33 @@ impl SelfCollisionTimes {
     /// Everything.
     pub fn total(&self) -> Duration {
         self.upkeep() + self.sweep()
+    }
+}
+
+/// What self-collision has done so far: full builds, partial updates, and the time of each
+/// part.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Tally {
+    /// Lists built so far.
+    pub(super) rebuilds: u64,
+    /// Partial updates (re-anchoring a few members) so far.
+    pub(super) updates: u64,
+    /// Time spent in each part so far.
+    pub(super) times: SelfCollisionTimes,
+}
+
+impl SelfCollision {
+    /// Runs `f` and adds the time it took to the part `part` picks, less the time of the parts
+    /// timed inside it (a check that rebuilds counts the build as a build, not as check).
+    pub(super) fn timed<T>(
+        &mut self,
+        part: fn(&mut SelfCollisionTimes) -> &mut Duration,
+        f: impl FnOnce(&mut Self) -> T,
+    ) -> T {
+        let (start, before) = (Instant::now(), self.tally.times.total());
+        let out = f(self);
+        let inside = self.tally.times.total() - before;
+        *part(&mut self.tally.times) += start.elapsed().saturating_sub(inside);
+        out
     }
 }
