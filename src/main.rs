@@ -10,6 +10,7 @@ mod replay;
 mod run;
 mod sim;
 mod video;
+mod view;
 
 use std::process::ExitCode;
 use std::sync::Arc;

@@ -3,15 +3,13 @@
 use winit::event::MouseButton;
 use winit::keyboard::{Key, NamedKey};
 
+use crate::app::command::Command;
+
 /// Something a key press asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
-    /// Pause or resume the simulation.
-    TogglePause,
-    /// Step one frame (pauses first).
-    Step,
-    /// Rebuild the scene from its file: initial positions, time 0.
-    Reset,
+    /// Pause, step or reset the simulation (as the panel's buttons do).
+    Command(Command),
     /// Draw the cloth as a wireframe.
     ToggleWireframe,
     /// Draw the particles.
@@ -47,14 +45,14 @@ pub const MOUSE: &[(&str, &str)] = &[
 /// The action bound to a key, if any (letters in either case).
 pub fn action_for(key: &Key) -> Option<Action> {
     match key {
-        Key::Named(NamedKey::Space) => Some(Action::TogglePause),
-        Key::Named(NamedKey::ArrowRight) => Some(Action::Step),
+        Key::Named(NamedKey::Space) => Some(Action::Command(Command::TogglePause)),
+        Key::Named(NamedKey::ArrowRight) => Some(Action::Command(Command::Step)),
         Key::Named(NamedKey::Escape) => Some(Action::Quit),
         Key::Named(NamedKey::Tab) => Some(Action::TogglePanel),
         Key::Named(NamedKey::F1) => Some(Action::ToggleHelp),
         Key::Character(c) => match c.to_lowercase().as_str() {
-            "s" => Some(Action::Step),
-            "r" => Some(Action::Reset),
+            "s" => Some(Action::Command(Command::Step)),
+            "r" => Some(Action::Command(Command::Reset)),
             "w" => Some(Action::ToggleWireframe),
             "p" => Some(Action::ToggleParticles),
             "h" => Some(Action::ToggleHelp),
@@ -96,14 +94,14 @@ mod tests {
         let key = |c: &str| Key::Character(c.into());
         assert_eq!(
             action_for(&Key::Named(NamedKey::Space)),
-            Some(Action::TogglePause)
+            Some(Action::Command(Command::TogglePause))
         );
         assert_eq!(
             action_for(&Key::Named(NamedKey::ArrowRight)),
-            Some(Action::Step)
+            Some(Action::Command(Command::Step))
         );
-        assert_eq!(action_for(&key("S")), Some(Action::Step));
-        assert_eq!(action_for(&key("r")), Some(Action::Reset));
+        assert_eq!(action_for(&key("S")), Some(Action::Command(Command::Step)));
+        assert_eq!(action_for(&key("r")), Some(Action::Command(Command::Reset)));
         assert_eq!(action_for(&key("w")), Some(Action::ToggleWireframe));
         assert_eq!(action_for(&key("p")), Some(Action::ToggleParticles));
         assert_eq!(action_for(&key("h")), Some(Action::ToggleHelp));

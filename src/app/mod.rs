@@ -2,23 +2,25 @@
 //!
 //! | file | holds |
 //! |---|---|
-//! | `window.rs` | winit event loop, wgpu surface, renderer + egui drawing, input wiring |
+//! | `window.rs` | winit event loop, renderer + egui drawing, input wiring |
+//! | `surface.rs` | the window's wgpu surface: format, size, reconfiguration |
 //! | `session.rs` | the simulation side: solvers, clock, grab, live changes, log |
 //! | `clock.rs` | fixed simulation step decoupled from the display rate |
 //! | `picking.rs`, `grab.rs` | ray–cloth picking; grabbing and dragging through the solver |
+//! | `command.rs` | pause, step and reset, as the keys and the panel both ask for them |
 //! | `input.rs` | key and mouse-button bindings |
 //! | `panel.rs` | the egui side panel |
-//! | `meshes.rs` | scene meshes for the renderer, the initial camera |
 //! | `recording.rs` | `--record`: the MCAP log and its `/interaction` channel |
 
 pub mod clock;
+pub mod command;
 pub mod grab;
 pub mod input;
-pub mod meshes;
 pub mod panel;
 pub mod picking;
 pub mod recording;
 pub mod session;
+pub mod surface;
 pub mod window;
 
 use std::path::{Path, PathBuf};

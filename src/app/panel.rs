@@ -11,6 +11,7 @@ use weft_render::RenderOptions;
 use weft_solver::glam::DVec3;
 use weft_solver::{Family, Method};
 
+use crate::app::command::Command;
 use crate::app::session::{SceneSource, Session};
 
 /// The panel's own state.
@@ -29,12 +30,8 @@ pub struct PanelState {
 pub struct Outcome {
     /// The scene (and its meshes) changed: rebuild the renderer and re-frame the camera.
     pub scene_changed: bool,
-    /// The pause button was pressed.
-    pub toggle_pause: bool,
-    /// The step button was pressed.
-    pub step: bool,
-    /// The reset button was pressed.
-    pub reset: bool,
+    /// The pause, step or reset button that was pressed (one per frame).
+    pub command: Option<Command>,
 }
 
 /// The built-in scene, then every `*.toml` in `dir` (sorted).
@@ -149,9 +146,16 @@ fn scene_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out
     }
     ui.horizontal(|ui| {
         let paused = session.clock.paused();
-        out.toggle_pause = ui.button(if paused { "run" } else { "pause" }).clicked();
-        out.step = ui.button("step").clicked();
-        out.reset = ui.button("reset").clicked();
+        let buttons = [
+            (if paused { "run" } else { "pause" }, Command::TogglePause),
+            ("step", Command::Step),
+            ("reset", Command::Reset),
+        ];
+        for (label, command) in buttons {
+            if ui.button(label).clicked() {
+                out.command = Some(command);
+            }
+        }
     });
     if let Some(m) = &session.diverged {
         ui.colored_label(

@@ -216,17 +216,23 @@ impl Session {
     }
 }
 
+/// A session of the built-in scene, not recording (for tests).
+#[cfg(test)]
+pub(crate) fn test_session() -> Session {
+    let scene = SceneSource::Default.load(&[]).expect("default scene");
+    Session::new(
+        Simulation::new(scene).expect("solvers"),
+        SceneSource::Default,
+        4,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn session() -> Session {
-        let scene = SceneSource::Default.load(&[]).expect("default scene");
-        Session::new(
-            Simulation::new(scene).expect("solvers"),
-            SceneSource::Default,
-            4,
-        )
+        test_session()
     }
 
     #[test]

@@ -1,5 +1,6 @@
-//! The window: winit's event loop (ApplicationHandler), the wgpu surface, the weft renderer
-//! and the egui overlay, and the mouse and keyboard wired to the session and the camera.
+//! The window: winit's event loop (ApplicationHandler), the weft renderer and the egui
+//! overlay drawn to its surface (`surface.rs`), and the mouse and keyboard wired to the
+//! session (`command.rs`) and the camera.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -14,10 +15,11 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow};
 use winit::window::{Window, WindowId};
 
 use crate::app::input::{self, Action, DragMode};
-use crate::app::meshes;
 use crate::app::panel::{self, PanelState};
 use crate::app::picking::Ray;
 use crate::app::session::Session;
+use crate::app::surface::WindowSurface;
+use crate::view;
 
 /// Width of the side panel (points).
 pub const PANEL_WIDTH: f32 = 300.0;
@@ -38,9 +40,8 @@ pub struct WindowConfig {
 /// Everything that exists only while the window does.
 struct Gfx {
     window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
+    surface: WindowSurface,
     gpu: Gpu,
-    config: wgpu::SurfaceConfiguration,
     renderer: Renderer,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
@@ -78,7 +79,7 @@ impl App {
     ) -> Self {
         let camera = match config.camera {
             Some((eye, target)) => Camera::looking_at(eye, target),
-            None => meshes::initial_camera(&session.sim),
+            None => view::initial_camera(&session.sim),
         };
         Self {
             session,
@@ -123,35 +124,9 @@ impl App {
             .with_title(format!("Weft — {}", self.session.sim.scene.name))
             .with_inner_size(PhysicalSize::new(w, h));
         let window = Arc::new(event_loop.create_window(attrs)?);
-        let display = event_loop.owned_display_handle();
-        let mut desc =
-            wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display));
-        if wgpu::Backends::from_env().is_none() {
-            desc.backends = wgpu::Backends::all();
-        }
-        let instance = wgpu::Instance::new(desc);
-        let surface = instance.create_surface(Arc::clone(&window))?;
-        let gpu = Gpu::for_surface(instance, &surface).map_err(|e| {
-            anyhow::anyhow!(
-                "no graphics adapter can draw to this window ({e}); `weft run` simulates without one"
-            )
-        })?;
-        let size = window.inner_size();
-        let caps = surface.get_capabilities(&gpu.adapter);
-        let format = caps
-            .formats
-            .iter()
-            .copied()
-            .find(wgpu::TextureFormat::is_srgb)
-            .or_else(|| caps.formats.first().copied())
-            .ok_or_else(|| anyhow::anyhow!("the window surface offers no format"))?;
-        let mut config = surface
-            .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
-            .ok_or_else(|| anyhow::anyhow!("the adapter cannot draw to this window's surface"))?;
-        config.format = format;
-        config.present_mode = wgpu::PresentMode::AutoVsync;
-        surface.configure(&gpu.device, &config);
-        let (renderer, framing) = meshes::renderer_for(&gpu.device, format, &self.session.sim);
+        let (surface, gpu) = WindowSurface::new(event_loop, Arc::clone(&window))?;
+        let (format, size) = (surface.format(), surface.size());
+        let (renderer, framing) = view::renderer_for(&gpu.device, format, &self.session.sim);
         self.camera = match self.config.camera {
             Some((eye, target)) => Camera::looking_at(eye, target),
             None => framing,
@@ -169,15 +144,14 @@ impl App {
         eprintln!(
             "weft: {}: window {}x{} on {}",
             self.session.sim.scene.name,
-            size.width,
-            size.height,
+            size.x,
+            size.y,
             gpu.describe()
         );
         Ok(Gfx {
             window,
             surface,
             gpu,
-            config,
             renderer,
             egui_state,
             egui_renderer,
@@ -188,7 +162,7 @@ impl App {
         self.gfx
             .as_ref()
             .map_or(UVec2::new(self.config.size.0, self.config.size.1), |g| {
-                UVec2::new(g.config.width, g.config.height)
+                g.surface.size()
             })
     }
 
@@ -202,19 +176,9 @@ impl App {
 
     fn act(&mut self, action: Action, event_loop: &ActiveEventLoop) {
         match action {
-            Action::TogglePause => {
-                let p = self.session.clock.paused();
-                self.session.clock.set_paused(!p);
-            }
-            Action::Step => {
-                self.session.clock.set_paused(true);
-                if let Err(e) = self.session.step_once() {
+            Action::Command(c) => {
+                if let Err(e) = c.apply(&mut self.session, &mut self.panel.error) {
                     self.fail(event_loop, e);
-                }
-            }
-            Action::Reset => {
-                if let Err(e) = self.session.reset() {
-                    self.panel.error = Some(format!("{e:#}"));
                 }
             }
             Action::ToggleWireframe => self.options.wireframe = !self.options.wireframe,
@@ -226,10 +190,10 @@ impl App {
     }
 
     fn rebuild_scene(&mut self) {
-        self.camera = meshes::initial_camera(&self.session.sim);
+        self.camera = view::initial_camera(&self.session.sim);
         if let Some(g) = self.gfx.as_mut() {
             let (renderer, camera) =
-                meshes::renderer_for(&g.gpu.device, g.config.format, &self.session.sim);
+                view::renderer_for(&g.gpu.device, g.surface.format(), &self.session.sim);
             g.renderer = renderer;
             self.camera = camera;
             g.window
@@ -352,16 +316,8 @@ impl App {
         pixels_per_point: f32,
         outcome: panel::Outcome,
     ) -> anyhow::Result<()> {
-        if outcome.toggle_pause {
-            let p = self.session.clock.paused();
-            self.session.clock.set_paused(!p);
-        }
-        if outcome.step {
-            self.session.clock.set_paused(true);
-            self.session.step_once()?;
-        }
-        if outcome.reset {
-            self.session.reset()?;
+        if let Some(c) = outcome.command {
+            c.apply(&mut self.session, &mut self.panel.error)?;
         }
         if outcome.scene_changed {
             self.rebuild_scene();
@@ -373,7 +329,7 @@ impl App {
         let cloths: Vec<&[weft_solver::glam::DVec3]> = (0..sim.scene.cloths.len())
             .map(|i| sim.cloth_positions(i))
             .collect();
-        let poses = meshes::collider_poses(sim);
+        let poses = view::frame_poses(sim);
         let grab = self.session.grab;
         g.renderer.update(
             &g.gpu.queue,
@@ -384,19 +340,13 @@ impl App {
                 drag_target: grab.map(|g| g.target.as_vec3()),
             },
         );
-        let texture = match g.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                g.surface.configure(&g.gpu.device, &g.config);
-                return Ok(());
-            }
-            _ => return Ok(()),
+        let Some(texture) = g.surface.acquire(&g.gpu.device) else {
+            return Ok(());
         };
         let view = texture
             .texture
             .create_view(&wgpu::TextureViewDescriptor::default());
-        let size = UVec2::new(g.config.width, g.config.height);
+        let size = g.surface.size();
         let mut encoder = g
             .gpu
             .device
@@ -498,13 +448,8 @@ impl ApplicationHandler for App {
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(s) => {
-                if let Some(g) = self.gfx.as_mut()
-                    && s.width > 0
-                    && s.height > 0
-                {
-                    g.config.width = s.width;
-                    g.config.height = s.height;
-                    g.surface.configure(&g.gpu.device, &g.config);
+                if let Some(g) = self.gfx.as_mut() {
+                    g.surface.resize(&g.gpu.device, s.width, s.height);
                 }
             }
             WindowEvent::RedrawRequested => self.frame(event_loop),

@@ -9,7 +9,6 @@ mod spec;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 use anyhow::{Context, bail};
 use rayon::prelude::*;
@@ -20,6 +19,14 @@ use crate::record::{RecordOptions, Recorder, Status};
 use crate::sim::Simulation;
 use metrics::Meter;
 use spec::{PlannedRun, Spec, parse_shard};
+
+/// A run and its result, when it has one (a row of the summary and of its plots).
+pub struct Row<'a> {
+    /// The planned run.
+    pub run: &'a PlannedRun,
+    /// Its result.
+    pub result: RunResult,
+}
 
 /// What one run produced (written as `results/run-<index>.json`).
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -187,7 +194,6 @@ fn execute(
         })
         .transpose()?;
     let mut meter = Meter::new(&sim);
-    let start = Instant::now();
     let mut status = Status::Complete;
     let mut first = sim.stats(0.0, 0);
     first.frame = 0;
@@ -227,7 +233,6 @@ fn execute(
     {
         v.finish()?;
     }
-    let _ = start;
     let metrics = meter
         .values(&sim)
         .into_iter()

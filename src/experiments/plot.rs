@@ -8,8 +8,8 @@ use anyhow::{Context, bail};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+use crate::experiments::Row;
 use crate::experiments::metrics::Metric;
-use crate::experiments::report::Row;
 use crate::experiments::spec::PlotSpec;
 
 /// DejaVu Sans Mono (see assets/fonts/DejaVu-LICENSE.txt).

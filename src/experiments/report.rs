@@ -5,17 +5,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::experiments::RunResult;
 use crate::experiments::plot;
 use crate::experiments::spec::{PlannedRun, Spec};
-
-/// A run and its result, when it has one.
-pub struct Row<'a> {
-    /// The planned run.
-    pub run: &'a PlannedRun,
-    /// Its result.
-    pub result: RunResult,
-}
+use crate::experiments::{Row, RunResult};
 
 fn fmt(v: Option<f64>) -> String {
     match v {

@@ -204,19 +204,14 @@ pub fn colliders(time: f64, colliders: &[ColliderSpec]) -> SceneUpdate {
     let entities = colliders
         .iter()
         .map(|c| {
-            let t = c.motion.transform(time);
+            let (position, rotation) = c.motion.transform(time).carry(c.position, c.rotation);
             let mut e = SceneEntity {
                 timestamp: Some(timestamp(time)),
                 frame_id: FRAME_ID.into(),
                 id: format!("collider/{}", c.name),
                 ..SceneEntity::default()
             };
-            add_shape(
-                &mut e,
-                &c.shape,
-                t.apply(c.position),
-                t.rotation * c.rotation,
-            );
+            add_shape(&mut e, &c.shape, position, rotation);
             e
         })
         .collect();

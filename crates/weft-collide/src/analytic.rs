@@ -9,8 +9,8 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use crate::collider::SurfacePoint;
 use crate::shape::ShapeDesc;
+use crate::surface::SurfacePoint;
 
 /// Below this length (m) a direction is taken as undefined and a fixed fallback is used.
 const TINY: f64 = 1e-12;
@@ -35,15 +35,6 @@ impl WorldPose {
             rotation,
             basis: DMat3::from_quat(rotation),
         }
-    }
-
-    /// `self ∘ base` where `self` is given as (rotation, translation): the pose of a body at
-    /// `base` carried by the motion.
-    pub fn carry(rotation: DQuat, translation: DVec3, base: &WorldPose) -> Self {
-        Self::new(
-            rotation * base.translation + translation,
-            rotation * base.rotation,
-        )
     }
 
     /// World point of local point `p`.

@@ -12,6 +12,7 @@ use crate::convert::{compose, pose};
 use crate::error::ShapeError;
 use crate::friction::Friction;
 use crate::shape::ShapeDesc;
+use crate::surface::SurfacePoint;
 
 /// How to build a collider: shape, placement at t = 0, motion and friction.
 #[derive(Clone, Debug, PartialEq)]
@@ -63,17 +64,6 @@ impl ColliderDesc {
         self.friction = friction;
         self
     }
-}
-
-/// The closest surface point of a collider to a particle, in world space.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfacePoint {
-    /// Closest point on the surface (m).
-    pub point: DVec3,
-    /// Outward unit normal there.
-    pub normal: DVec3,
-    /// Signed distance of the particle from the surface, negative inside (m).
-    pub distance: f64,
 }
 
 /// A built collider: parry shape, rest pose, motion, friction and the current pose.
@@ -273,8 +263,8 @@ impl Collider {
 
 /// The f64 pose of a body at `rest` carried by `motion` at time `t` (s).
 fn carry(motion: Motion, t: f64, rest: &WorldPose) -> WorldPose {
-    let m = motion.transform(t);
-    WorldPose::carry(m.rotation, m.translation, rest)
+    let (translation, rotation) = motion.transform(t).carry(rest.translation, rest.rotation);
+    WorldPose::new(translation, rotation)
 }
 
 /// Signed closest-point query in the shape's frame: `(point, outward normal, signed distance)`.

@@ -10,30 +10,27 @@ mod collider;
 mod convert;
 mod error;
 mod friction;
+mod grid;
 mod mesh;
 mod obj;
 pub mod scenarios;
 mod self_collision;
-mod self_contact;
 mod shape;
-mod skin;
-mod spatial_hash;
+mod surface;
 mod tessellate;
 #[cfg(test)]
 mod test_rand;
-mod times;
 mod world;
 
-pub use collider::{Collider, ColliderDesc, SurfacePoint};
+pub use collider::{Collider, ColliderDesc};
 pub use error::{CollideError, MeshError, ShapeError};
 pub use friction::Friction;
 pub use mesh::TriangleMesh;
 pub use obj::{load_obj, parse_obj};
-pub use self_collision::SelfCollisionParams;
+pub use self_collision::{SelfCollisionParams, SelfCollisionTimes};
 pub use shape::{CompoundPart, ShapeDesc};
-pub use spatial_hash::SpatialHash;
+pub use surface::SurfacePoint;
 pub use tessellate::{HALF_SPACE_EXTENT, Tessellation, tessellate_shape};
-pub use times::SelfCollisionTimes;
 pub use world::{CollisionWorld, ContactStats};
 
 /// Re-export of parry, so users name the same shape types.

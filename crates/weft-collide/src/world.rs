@@ -15,8 +15,7 @@ use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
-use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams};
-use crate::times::SelfCollisionTimes;
+use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

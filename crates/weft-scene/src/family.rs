@@ -1,7 +1,7 @@
 //! Per-family constraint parameters as flat cloth keys: `<family>_<field>`, e.g.
 //! `stretch_compliance`, `bend_dihedral_enabled`, `tether_spring_stiffness`.
 
-use weft_solver::{ClothParams, Family};
+use weft_solver::{ClothParams, Family, FamilyParams};
 
 /// A field of [`weft_solver::FamilyParams`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,6 +21,16 @@ pub enum Field {
 }
 
 impl Field {
+    /// Every field, in the order of a family's keys.
+    pub const ALL: [Field; 6] = [
+        Field::Enabled,
+        Field::Compliance,
+        Field::Damping,
+        Field::PbdStiffness,
+        Field::SpringStiffness,
+        Field::SpringDamping,
+    ];
+
     /// The field's name inside a key.
     pub fn name(self) -> &'static str {
         match self {
@@ -33,15 +43,13 @@ impl Field {
         }
     }
 
-    /// Whether `v` is allowed, and what is expected otherwise.
-    pub fn check(self, v: f64) -> Result<(), &'static str> {
+    /// The range check of the field's values: weft-solver's, the one authority on them (a
+    /// flag is always allowed).
+    pub fn rule(self) -> fn(f64) -> Result<(), &'static str> {
         match self {
-            Field::Enabled => Ok(()),
-            Field::PbdStiffness if !(v.is_finite() && (0.0..=1.0).contains(&v)) => {
-                Err("must be finite and in [0, 1]")
-            }
-            _ if !(v.is_finite() && v >= 0.0) => Err("must be finite and >= 0"),
-            _ => Ok(()),
+            Field::Enabled => |_| Ok(()),
+            Field::PbdStiffness => FamilyParams::check_pbd_stiffness,
+            _ => FamilyParams::check_non_negative,
         }
     }
 }
@@ -51,18 +59,60 @@ pub fn key(family: Family, field: Field) -> String {
     format!("{}_{}", family.name(), field.name())
 }
 
-/// Applies `(family, field, value)` entries that are set to `params` (values unchecked).
-pub fn apply(entries: &[(Family, Field, Option<f64>)], params: &mut ClothParams) {
-    for &(family, field, value) in entries {
-        let Some(v) = value else { continue };
+/// The value of one per-family key, typed as it is written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Setting {
+    /// `<family>_enabled`.
+    Enabled(bool),
+    /// `<family>_compliance`.
+    Compliance(f64),
+    /// `<family>_damping`.
+    Damping(f64),
+    /// `<family>_pbd_stiffness`.
+    PbdStiffness(f64),
+    /// `<family>_spring_stiffness`.
+    SpringStiffness(f64),
+    /// `<family>_spring_damping`.
+    SpringDamping(f64),
+}
+
+impl Setting {
+    /// The field this value sets.
+    pub fn field(self) -> Field {
+        match self {
+            Setting::Enabled(_) => Field::Enabled,
+            Setting::Compliance(_) => Field::Compliance,
+            Setting::Damping(_) => Field::Damping,
+            Setting::PbdStiffness(_) => Field::PbdStiffness,
+            Setting::SpringStiffness(_) => Field::SpringStiffness,
+            Setting::SpringDamping(_) => Field::SpringDamping,
+        }
+    }
+
+    /// The value as a number (`None` for a flag).
+    pub fn number(self) -> Option<f64> {
+        match self {
+            Setting::Enabled(_) => None,
+            Setting::Compliance(v)
+            | Setting::Damping(v)
+            | Setting::PbdStiffness(v)
+            | Setting::SpringStiffness(v)
+            | Setting::SpringDamping(v) => Some(v),
+        }
+    }
+}
+
+/// Applies `(family, setting)` pairs to `params` (values unchecked).
+pub fn apply(settings: &[(Family, Setting)], params: &mut ClothParams) {
+    for &(family, setting) in settings {
         let p = params.get_mut(family);
-        match field {
-            Field::Enabled => p.enabled = v != 0.0,
-            Field::Compliance => p.compliance = v,
-            Field::Damping => p.damping = v,
-            Field::PbdStiffness => p.pbd_stiffness = v,
-            Field::SpringStiffness => p.spring_stiffness = v,
-            Field::SpringDamping => p.spring_damping = v,
+        match setting {
+            Setting::Enabled(on) => p.enabled = on,
+            Setting::Compliance(v) => p.compliance = v,
+            Setting::Damping(v) => p.damping = v,
+            Setting::PbdStiffness(v) => p.pbd_stiffness = v,
+            Setting::SpringStiffness(v) => p.spring_stiffness = v,
+            Setting::SpringDamping(v) => p.spring_damping = v,
         }
     }
 }

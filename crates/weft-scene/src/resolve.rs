@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use weft_collide::SelfCollisionParams;
 use weft_solver::glam::{DQuat, DVec3, EulerRot};
 use weft_solver::{
     Aero, ClothMesh, ClothParams, Corner, Edge, Forces, GridDesc, Mass, MeshError, Method, Motion,
@@ -56,6 +57,15 @@ impl<'a> Checker<'a> {
             self.bad(key, format!("must be {expected}, got {}", show(v)));
         }
         good
+    }
+
+    /// Checks `v` by `rule` (a library's range check, which says what it expects).
+    fn rule(&mut self, key: &str, v: f64, rule: fn(f64) -> Result<(), &'static str>) -> bool {
+        let result = rule(v);
+        if let Err(expected) = result {
+            self.bad(key, format!("must be {expected}, got {}", show(v)));
+        }
+        result.is_ok()
     }
 
     fn non_negative(&mut self, key: &str, v: f64) -> bool {
@@ -243,13 +253,17 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
                 "must not exceed static_friction",
             );
         }
-        c.check(
+        // The ranges are weft-collide's, the one authority on them.
+        c.rule(
             "self_collision.max_displacement",
             s.max_displacement,
-            s.max_displacement > 0.0 && s.max_displacement <= 0.5,
-            "in (0, 0.5]",
+            SelfCollisionParams::check_max_displacement,
         );
-        c.non_negative("self_collision.search_margin", s.search_margin);
+        c.rule(
+            "self_collision.search_margin",
+            s.search_margin,
+            SelfCollisionParams::check_search_margin,
+        );
         s.enabled.then_some(SelfCollisionSpec {
             cloths: names,
             static_friction: s.static_friction,
@@ -326,18 +340,17 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
     let center = c.vector(&k("center"), s.center.unwrap_or_default());
     let pins = s.pins.clone().unwrap_or_default();
     let mut params = ClothParams::default();
-    let entries = s.family_entries();
-    for &(fam, field, value) in &entries {
-        if let Some(v) = value
-            && let Err(expected) = field.check(v)
-        {
-            c.bad(
-                &k(&family::key(fam, field)),
-                format!("{expected}, got {}", show(v)),
+    let settings = s.family_settings();
+    for &(fam, setting) in &settings {
+        if let Some(v) = setting.number() {
+            c.rule(
+                &k(&family::key(fam, setting.field())),
+                v,
+                setting.field().rule(),
             );
         }
     }
-    family::apply(&entries, &mut params);
+    family::apply(&settings, &mut params);
     let thickness = s.thickness.unwrap_or(0.005);
     c.non_negative(&k("thickness"), thickness);
     let motion = c.motion(&k("motion"), &s.motion);

@@ -10,7 +10,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use weft_solver::Family;
 
-use crate::family::Field;
+use crate::family::Setting;
 
 /// A whole scene file.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
@@ -279,268 +279,124 @@ pub enum MotionSpec {
     },
 }
 
-/// `[cloth.<name>]`.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct ClothSection {
-    /// Method of this cloth, overriding `sim.method` (a scene yields one solver per method).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub method: Option<MethodName>,
-    /// Grid particles `[columns, rows]` (grid cloths).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub resolution: Option<[i64; 2]>,
-    /// Grid size `[width, height]` (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub size: Option<[f64; 2]>,
-    /// Grid plane: `vertical` or `horizontal`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub orientation: Option<OrientationName>,
-    /// OBJ mesh file, relative to the scene file (instead of a grid).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mesh: Option<String>,
-    /// Scale applied to the OBJ mesh's vertices.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub scale: Option<f64>,
-    /// Centre of a grid, or translation of a mesh (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub center: Option<[f64; 3]>,
-    /// Total mass (kg); give this or `density`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mass: Option<f64>,
-    /// Areal density (kg/m²); give this or `mass`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub density: Option<f64>,
-    /// Pinned particles.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pins: Option<Vec<PinSpec>>,
-    /// Motion the pins follow (default: static).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub motion: Option<MotionSpec>,
-    /// Collision thickness (m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub thickness: Option<f64>,
-    // Per-family parameters, `<family>_<field>` (generated list).
-    /// `stretch`: whether the family's constraints are created.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stretch_enabled: Option<bool>,
-    /// `stretch`: XPBD compliance.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stretch_compliance: Option<f64>,
-    /// `stretch`: XPBD constraint damping (s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stretch_damping: Option<f64>,
-    /// `stretch`: PBD stiffness in [0, 1].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stretch_pbd_stiffness: Option<f64>,
-    /// `stretch`: mass-spring stiffness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stretch_spring_stiffness: Option<f64>,
-    /// `stretch`: mass-spring damping (N·s/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stretch_spring_damping: Option<f64>,
-    /// `shear`: whether the family's constraints are created.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shear_enabled: Option<bool>,
-    /// `shear`: XPBD compliance.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shear_compliance: Option<f64>,
-    /// `shear`: XPBD constraint damping (s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shear_damping: Option<f64>,
-    /// `shear`: PBD stiffness in [0, 1].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shear_pbd_stiffness: Option<f64>,
-    /// `shear`: mass-spring stiffness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shear_spring_stiffness: Option<f64>,
-    /// `shear`: mass-spring damping (N·s/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shear_spring_damping: Option<f64>,
-    /// `bend_distance`: whether the family's constraints are created.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_distance_enabled: Option<bool>,
-    /// `bend_distance`: XPBD compliance.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_distance_compliance: Option<f64>,
-    /// `bend_distance`: XPBD constraint damping (s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_distance_damping: Option<f64>,
-    /// `bend_distance`: PBD stiffness in [0, 1].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_distance_pbd_stiffness: Option<f64>,
-    /// `bend_distance`: mass-spring stiffness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_distance_spring_stiffness: Option<f64>,
-    /// `bend_distance`: mass-spring damping (N·s/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_distance_spring_damping: Option<f64>,
-    /// `bend_dihedral`: whether the family's constraints are created.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_dihedral_enabled: Option<bool>,
-    /// `bend_dihedral`: XPBD compliance.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_dihedral_compliance: Option<f64>,
-    /// `bend_dihedral`: XPBD constraint damping (s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_dihedral_damping: Option<f64>,
-    /// `bend_dihedral`: PBD stiffness in [0, 1].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_dihedral_pbd_stiffness: Option<f64>,
-    /// `bend_dihedral`: mass-spring stiffness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_dihedral_spring_stiffness: Option<f64>,
-    /// `bend_dihedral`: mass-spring damping (N·s/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bend_dihedral_spring_damping: Option<f64>,
-    /// `tether`: whether the family's constraints are created.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether_enabled: Option<bool>,
-    /// `tether`: XPBD compliance.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether_compliance: Option<f64>,
-    /// `tether`: XPBD constraint damping (s).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether_damping: Option<f64>,
-    /// `tether`: PBD stiffness in [0, 1].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether_pbd_stiffness: Option<f64>,
-    /// `tether`: mass-spring stiffness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether_spring_stiffness: Option<f64>,
-    /// `tether`: mass-spring damping (N·s/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether_spring_damping: Option<f64>,
+/// Defines [`ClothSection`]: its own keys as written, then six keys per family in the order
+/// of [`Field`](crate::family::Field) (`<family>_enabled`, `_compliance`, `_damping`,
+/// `_pbd_stiffness`, `_spring_stiffness`, `_spring_damping`), and
+/// [`ClothSection::family_settings`], which reads those keys back. One list of names yields
+/// both; a unit test checks each name against [`crate::family::key`].
+macro_rules! cloth_section {
+    (
+        $(#[$meta:meta])*
+        pub struct ClothSection {
+            $($own:tt)*
+        }
+        families {
+            $($family:ident: $enabled:ident, $compliance:ident, $damping:ident,
+                $pbd_stiffness:ident, $spring_stiffness:ident, $spring_damping:ident;)*
+        }
+    ) => {
+        $(#[$meta])*
+        pub struct ClothSection {
+            $($own)*
+            $(
+                #[doc = concat!("`", stringify!($enabled), "`: whether the family's constraints are created.")]
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub $enabled: Option<bool>,
+                #[doc = concat!("`", stringify!($compliance), "`: XPBD compliance.")]
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub $compliance: Option<f64>,
+                #[doc = concat!("`", stringify!($damping), "`: XPBD constraint damping (s).")]
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub $damping: Option<f64>,
+                #[doc = concat!("`", stringify!($pbd_stiffness), "`: PBD stiffness in [0, 1].")]
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub $pbd_stiffness: Option<f64>,
+                #[doc = concat!("`", stringify!($spring_stiffness), "`: mass-spring stiffness.")]
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub $spring_stiffness: Option<f64>,
+                #[doc = concat!("`", stringify!($spring_damping), "`: mass-spring damping (N·s/m).")]
+                #[serde(default, skip_serializing_if = "Option::is_none")]
+                pub $spring_damping: Option<f64>,
+            )*
+        }
+
+        impl ClothSection {
+            /// The per-family keys that are set, as `(family, setting)` pairs in key order.
+            pub fn family_settings(&self) -> Vec<(Family, Setting)> {
+                let mut set = Vec::new();
+                $(
+                    let family = Family::$family;
+                    set.extend(self.$enabled.map(|v| (family, Setting::Enabled(v))));
+                    set.extend(self.$compliance.map(|v| (family, Setting::Compliance(v))));
+                    set.extend(self.$damping.map(|v| (family, Setting::Damping(v))));
+                    set.extend(self.$pbd_stiffness.map(|v| (family, Setting::PbdStiffness(v))));
+                    set.extend(
+                        self.$spring_stiffness
+                            .map(|v| (family, Setting::SpringStiffness(v))),
+                    );
+                    set.extend(self.$spring_damping.map(|v| (family, Setting::SpringDamping(v))));
+                )*
+                set
+            }
+        }
+    };
 }
 
-impl ClothSection {
-    /// The keys as `(family, field, value)` triples, numbers as f64 and booleans as 0/1.
-    pub fn family_entries(&self) -> Vec<(Family, Field, Option<f64>)> {
-        vec![
-            (
-                Family::Stretch,
-                Field::Enabled,
-                self.stretch_enabled.map(|b| if b { 1.0 } else { 0.0 }),
-            ),
-            (Family::Stretch, Field::Compliance, self.stretch_compliance),
-            (Family::Stretch, Field::Damping, self.stretch_damping),
-            (
-                Family::Stretch,
-                Field::PbdStiffness,
-                self.stretch_pbd_stiffness,
-            ),
-            (
-                Family::Stretch,
-                Field::SpringStiffness,
-                self.stretch_spring_stiffness,
-            ),
-            (
-                Family::Stretch,
-                Field::SpringDamping,
-                self.stretch_spring_damping,
-            ),
-            (
-                Family::Shear,
-                Field::Enabled,
-                self.shear_enabled.map(|b| if b { 1.0 } else { 0.0 }),
-            ),
-            (Family::Shear, Field::Compliance, self.shear_compliance),
-            (Family::Shear, Field::Damping, self.shear_damping),
-            (Family::Shear, Field::PbdStiffness, self.shear_pbd_stiffness),
-            (
-                Family::Shear,
-                Field::SpringStiffness,
-                self.shear_spring_stiffness,
-            ),
-            (
-                Family::Shear,
-                Field::SpringDamping,
-                self.shear_spring_damping,
-            ),
-            (
-                Family::BendDistance,
-                Field::Enabled,
-                self.bend_distance_enabled
-                    .map(|b| if b { 1.0 } else { 0.0 }),
-            ),
-            (
-                Family::BendDistance,
-                Field::Compliance,
-                self.bend_distance_compliance,
-            ),
-            (
-                Family::BendDistance,
-                Field::Damping,
-                self.bend_distance_damping,
-            ),
-            (
-                Family::BendDistance,
-                Field::PbdStiffness,
-                self.bend_distance_pbd_stiffness,
-            ),
-            (
-                Family::BendDistance,
-                Field::SpringStiffness,
-                self.bend_distance_spring_stiffness,
-            ),
-            (
-                Family::BendDistance,
-                Field::SpringDamping,
-                self.bend_distance_spring_damping,
-            ),
-            (
-                Family::BendDihedral,
-                Field::Enabled,
-                self.bend_dihedral_enabled
-                    .map(|b| if b { 1.0 } else { 0.0 }),
-            ),
-            (
-                Family::BendDihedral,
-                Field::Compliance,
-                self.bend_dihedral_compliance,
-            ),
-            (
-                Family::BendDihedral,
-                Field::Damping,
-                self.bend_dihedral_damping,
-            ),
-            (
-                Family::BendDihedral,
-                Field::PbdStiffness,
-                self.bend_dihedral_pbd_stiffness,
-            ),
-            (
-                Family::BendDihedral,
-                Field::SpringStiffness,
-                self.bend_dihedral_spring_stiffness,
-            ),
-            (
-                Family::BendDihedral,
-                Field::SpringDamping,
-                self.bend_dihedral_spring_damping,
-            ),
-            (
-                Family::Tether,
-                Field::Enabled,
-                self.tether_enabled.map(|b| if b { 1.0 } else { 0.0 }),
-            ),
-            (Family::Tether, Field::Compliance, self.tether_compliance),
-            (Family::Tether, Field::Damping, self.tether_damping),
-            (
-                Family::Tether,
-                Field::PbdStiffness,
-                self.tether_pbd_stiffness,
-            ),
-            (
-                Family::Tether,
-                Field::SpringStiffness,
-                self.tether_spring_stiffness,
-            ),
-            (
-                Family::Tether,
-                Field::SpringDamping,
-                self.tether_spring_damping,
-            ),
-        ]
+cloth_section! {
+    /// `[cloth.<name>]`.
+    #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct ClothSection {
+        /// Method of this cloth, overriding `sim.method` (a scene yields one solver per method).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub method: Option<MethodName>,
+        /// Grid particles `[columns, rows]` (grid cloths).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub resolution: Option<[i64; 2]>,
+        /// Grid size `[width, height]` (m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub size: Option<[f64; 2]>,
+        /// Grid plane: `vertical` or `horizontal`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub orientation: Option<OrientationName>,
+        /// OBJ mesh file, relative to the scene file (instead of a grid).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub mesh: Option<String>,
+        /// Scale applied to the OBJ mesh's vertices.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub scale: Option<f64>,
+        /// Centre of a grid, or translation of a mesh (m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub center: Option<[f64; 3]>,
+        /// Total mass (kg); give this or `density`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub mass: Option<f64>,
+        /// Areal density (kg/m²); give this or `mass`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub density: Option<f64>,
+        /// Pinned particles.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub pins: Option<Vec<PinSpec>>,
+        /// Motion the pins follow (default: static).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub motion: Option<MotionSpec>,
+        /// Collision thickness (m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub thickness: Option<f64>,
+    }
+    families {
+        Stretch: stretch_enabled, stretch_compliance, stretch_damping,
+            stretch_pbd_stiffness, stretch_spring_stiffness, stretch_spring_damping;
+        Shear: shear_enabled, shear_compliance, shear_damping,
+            shear_pbd_stiffness, shear_spring_stiffness, shear_spring_damping;
+        BendDistance: bend_distance_enabled, bend_distance_compliance, bend_distance_damping,
+            bend_distance_pbd_stiffness, bend_distance_spring_stiffness,
+            bend_distance_spring_damping;
+        BendDihedral: bend_dihedral_enabled, bend_dihedral_compliance, bend_dihedral_damping,
+            bend_dihedral_pbd_stiffness, bend_dihedral_spring_stiffness,
+            bend_dihedral_spring_damping;
+        Tether: tether_enabled, tether_compliance, tether_damping,
+            tether_pbd_stiffness, tether_spring_stiffness, tether_spring_damping;
     }
 }
 
@@ -692,4 +548,41 @@ fn default_max_displacement() -> f64 {
 }
 fn default_search_margin() -> f64 {
     0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::family::{self, Field};
+
+    #[test]
+    fn every_family_key_reads_back_as_its_family_and_field() {
+        // Every `<family>_<field>` key set to a value of its own (flags alternate), in the
+        // order of the families and fields: the settings must name the same family and field
+        // with the same value, in the same order.
+        let mut text = String::new();
+        let mut expected = Vec::new();
+        for (i, family) in Family::ALL.into_iter().enumerate() {
+            for (j, field) in Field::ALL.into_iter().enumerate() {
+                let key = family::key(family, field);
+                let v = (10 * i + j) as f64;
+                let setting = match field {
+                    Field::Enabled => Setting::Enabled(i % 2 == 0),
+                    Field::Compliance => Setting::Compliance(v),
+                    Field::Damping => Setting::Damping(v),
+                    Field::PbdStiffness => Setting::PbdStiffness(v),
+                    Field::SpringStiffness => Setting::SpringStiffness(v),
+                    Field::SpringDamping => Setting::SpringDamping(v),
+                };
+                match setting {
+                    Setting::Enabled(on) => text.push_str(&format!("{key} = {on}\n")),
+                    _ => text.push_str(&format!("{key} = {v:?}\n")),
+                }
+                expected.push((family, setting));
+            }
+        }
+        let section: ClothSection = toml_edit::de::from_str(&text).expect("every key is known");
+        assert_eq!(section.family_settings(), expected);
+        assert!(ClothSection::default().family_settings().is_empty());
+    }
 }

@@ -4,6 +4,7 @@ use glam::DVec3;
 use thiserror::Error;
 
 use crate::method::Method;
+pub use crate::params::ParamError;
 
 /// A cloth mesh that cannot be simulated.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -77,18 +78,6 @@ pub enum MeshError {
         /// Height given.
         height: f64,
     },
-}
-
-/// A parameter outside the range where it makes sense.
-#[derive(Clone, Debug, Error, PartialEq)]
-#[error("parameter `{name}` = {value} is invalid: {expected}")]
-pub struct ParamError {
-    /// Dotted name of the parameter, e.g. `stretch.compliance`.
-    pub name: String,
-    /// The value given.
-    pub value: f64,
-    /// What was expected.
-    pub expected: &'static str,
 }
 
 /// A failure while stepping.

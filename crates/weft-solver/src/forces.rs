@@ -3,9 +3,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::chunk::CHUNK;
 use crate::error::ParamError;
 use crate::particles::Particles;
-use crate::solver::CHUNK;
 
 /// Per-triangle aerodynamic drag and lift coefficients.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 mod builder;
+mod chunk;
 mod cloth;
 mod coloring;
 pub mod constraints;

@@ -53,6 +53,12 @@ impl RigidTransform {
     pub fn apply(&self, p: DVec3) -> DVec3 {
         self.rotation * p + self.translation
     }
+
+    /// The pose `(position, rotation)` of a body placed at `position`, `rotation` and then
+    /// carried by this transform: the one pose the collision world and the log both use.
+    pub fn carry(&self, position: DVec3, rotation: DQuat) -> (DVec3, DQuat) {
+        (self.apply(position), self.rotation * rotation)
+    }
 }
 
 impl Motion {

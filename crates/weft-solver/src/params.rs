@@ -1,6 +1,6 @@
 //! Constraint families and their per-method parameters.
 
-use crate::error::ParamError;
+use thiserror::Error;
 
 /// A family of constraints; each cloth sets each family's parameters on its own.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -93,49 +93,47 @@ impl FamilyParams {
         }
     }
 
+    /// Checks a compliance, damping, spring stiffness or spring damping: finite and ≥ 0.
+    /// Says what is expected otherwise.
+    pub fn check_non_negative(v: f64) -> Result<(), &'static str> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(())
+        } else {
+            Err("finite and >= 0")
+        }
+    }
+
+    /// Checks a PBD stiffness: finite and in [0, 1]. Says what is expected otherwise.
+    pub fn check_pbd_stiffness(v: f64) -> Result<(), &'static str> {
+        if v.is_finite() && (0.0..=1.0).contains(&v) {
+            Ok(())
+        } else {
+            Err("finite and in [0, 1]")
+        }
+    }
+
     /// Checks every value is finite and in range; `family` names the parameter in the error.
     pub fn validate(&self, family: Family) -> Result<(), ParamError> {
-        let check = |field: &str, value: f64, ok: bool, expected: &'static str| {
-            if value.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name: format!("{}.{field}", family.name()),
-                    value,
-                    expected,
-                })
-            }
-        };
-        check(
-            "compliance",
-            self.compliance,
-            self.compliance >= 0.0,
-            "finite and >= 0",
-        )?;
-        check(
-            "damping",
-            self.damping,
-            self.damping >= 0.0,
-            "finite and >= 0",
-        )?;
-        check(
-            "pbd_stiffness",
-            self.pbd_stiffness,
-            (0.0..=1.0).contains(&self.pbd_stiffness),
-            "in [0, 1]",
-        )?;
-        check(
-            "spring_stiffness",
-            self.spring_stiffness,
-            self.spring_stiffness >= 0.0,
-            "finite and >= 0",
-        )?;
-        check(
-            "spring_damping",
-            self.spring_damping,
-            self.spring_damping >= 0.0,
-            "finite and >= 0",
-        )
+        let non_negative = Self::check_non_negative as fn(f64) -> Result<(), &'static str>;
+        [
+            ("compliance", self.compliance, non_negative),
+            ("damping", self.damping, non_negative),
+            (
+                "pbd_stiffness",
+                self.pbd_stiffness,
+                Self::check_pbd_stiffness,
+            ),
+            ("spring_stiffness", self.spring_stiffness, non_negative),
+            ("spring_damping", self.spring_damping, non_negative),
+        ]
+        .into_iter()
+        .try_for_each(|(field, value, check)| {
+            check(value).map_err(|expected| ParamError {
+                name: format!("{}.{field}", family.name()),
+                value,
+                expected,
+            })
+        })
     }
 }
 
@@ -183,6 +181,18 @@ impl ClothParams {
             .iter()
             .try_for_each(|&f| self.get(f).validate(f))
     }
+}
+
+/// A parameter outside the range where it makes sense.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[error("parameter `{name}` = {value} is invalid: {expected}")]
+pub struct ParamError {
+    /// Dotted name of the parameter, e.g. `stretch.compliance`.
+    pub name: String,
+    /// The value given.
+    pub value: f64,
+    /// What was expected.
+    pub expected: &'static str,
 }
 
 /// Checks a cloth thickness (m) is finite and non-negative.

@@ -36,11 +36,6 @@ impl Particles {
         self.inv_masses.push(inv_mass);
     }
 
-    /// Whether particle `i` is pinned (inverse mass 0).
-    pub fn is_pinned(&self, i: usize) -> bool {
-        self.inv_masses[i] == 0.0
-    }
-
     /// Total kinetic energy ½ Σ m v² of the free particles (J).
     pub fn kinetic_energy(&self) -> f64 {
         self.velocities

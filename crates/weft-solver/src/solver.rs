@@ -5,6 +5,7 @@ use std::ops::Range;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::chunk::CHUNK;
 use crate::constraints::{ConstraintSet, Residual, Rule};
 use crate::domains::{DomainStats, Domains, Finish, Integration};
 use crate::error::{ParamError, SolverError};
@@ -54,7 +55,6 @@ pub struct Solver {
     settings: Settings,
     forces: Forces,
     particles: Particles,
-    initial: Particles,
     cloths: Vec<Cloth>,
     all_triangles: Vec<[u32; 3]>,
     params: Vec<FamilyParams>,
@@ -70,11 +70,6 @@ pub struct Solver {
     time: f64,
     frame: u64,
 }
-
-/// Particles per parallel task in the general loop's per-particle passes (and the external
-/// accelerations'). Each particle's update reads only its own state, so results do not depend
-/// on the thread count.
-pub(crate) const CHUNK: usize = 1024;
 
 impl Solver {
     #[allow(clippy::too_many_arguments)]
@@ -98,7 +93,6 @@ impl Solver {
             forces,
             domains,
             targets: Vec::new(),
-            initial: particles.clone(),
             particles,
             cloths,
             all_triangles,
@@ -141,11 +135,6 @@ impl Solver {
     /// How the distance constraints are cut into domains and SIMD chunks.
     pub fn domain_stats(&self) -> DomainStats {
         self.domains.stats()
-    }
-
-    /// The kinematic pins.
-    pub fn kinematic_pins(&self) -> &[KinematicPin] {
-        &self.pins
     }
 
     /// Current settings.
@@ -229,14 +218,6 @@ impl Solver {
     /// Frames stepped so far.
     pub fn frame(&self) -> u64 {
         self.frame
-    }
-
-    /// Puts every particle back where it started and the clock at 0.
-    pub fn reset(&mut self) {
-        self.particles = self.initial.clone();
-        self.grab = None;
-        self.time = 0.0;
-        self.frame = 0;
     }
 
     /// |C| over the distance-like constraints at the current positions (m).

@@ -12,10 +12,15 @@
 // that each compiles to one vector operation per axis.
 #![allow(clippy::needless_range_loop)]
 
+use std::time::Instant;
+
 use glam::DVec3;
 use multiversion::multiversion;
 use rayon::prelude::*;
+use weft_solver::Particles;
 
+use super::SelfCollision;
+use super::list::PairList;
 use crate::friction::Friction;
 
 /// Adding and subtracting 1.5 · 2¹² rounds an f64 of magnitude below 2¹¹ to the nearest
@@ -35,7 +40,7 @@ const BLOCK: usize = 64;
 
 /// One particle's correction from one contact, a multiple of 2⁻⁴⁰ m per axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Correction {
+struct Correction {
     i: u32,
     d: [f64; 3],
 }
@@ -46,7 +51,7 @@ const BINS: usize = 8;
 /// A sweep's corrections, binned by particle range (bin k holds those of particles
 /// k·2^shift..(k+1)·2^shift), so that each range can be applied on its own thread.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Bins {
+struct Bins {
     shift: u32,
     bins: Vec<Vec<Correction>>,
     contacts: usize,
@@ -59,7 +64,7 @@ impl Bins {
     }
 
     /// Empties the bins and sets their ranges for `n` particles.
-    pub(crate) fn reset(&mut self, n: usize) {
+    fn reset(&mut self, n: usize) {
         self.shift = Self::shift_for(n);
         self.bins
             .resize_with(n.div_ceil(1 << self.shift).max(1), Vec::new);
@@ -76,7 +81,7 @@ impl Bins {
 
 /// The particle state a sweep reads.
 #[derive(Clone, Copy)]
-pub(crate) struct State<'a> {
+struct State<'a> {
     /// Positions at the start of the sweep.
     pub x: &'a [DVec3],
     /// Positions at the start of the substep.
@@ -96,7 +101,7 @@ const CHUNK: usize = 256;
     "x86_64+avx2+fma",
     "aarch64+neon"
 ))]
-pub(crate) fn find_contacts<'a>(
+fn find_contacts<'a>(
     (a, b, target): (&[u32], &[u32], &[f64]),
     s: State<'a>,
     friction: Friction,
@@ -288,14 +293,8 @@ const SERIAL_CONTACTS: usize = 2048;
 /// particle, zero on entry) are scratch and zero again on return.
 ///
 /// Particle range by particle range, each range reading only its own bin of every list, so
-/// the ranges run on rayon's threads without sharing a particle (one thread applying all
-/// 16,000 contacts of a resting fold at 128² took 52 µs, two threads this way 31 µs).
-pub(crate) fn apply(
-    found: &[Bins],
-    positions: &mut [DVec3],
-    sums: &mut [DVec3],
-    counts: &mut [u32],
-) -> usize {
+/// the ranges run on rayon's threads without sharing a particle.
+fn apply(found: &[Bins], positions: &mut [DVec3], sums: &mut [DVec3], counts: &mut [u32]) -> usize {
     let contacts: usize = found.iter().map(|b| b.contacts).sum();
     if contacts == 0 {
         return 0;
@@ -333,6 +332,75 @@ pub(crate) fn apply(
         .with_min_len(serial)
         .for_each(range);
     contacts
+}
+
+/// Below this many listed pairs a sweep runs on one thread.
+const SERIAL_PAIRS: usize = 4096;
+
+/// Scratch of a sweep: per list, the corrections of its touching pairs binned by particle
+/// range; per particle, the exact sum of its corrections and their count (zero between
+/// sweeps).
+#[derive(Clone, Debug)]
+pub(super) struct Sweep {
+    contacts: Vec<Bins>,
+    sums: Vec<DVec3>,
+    counts: Vec<u32>,
+}
+
+impl Sweep {
+    /// Scratch for `n` particles.
+    pub(super) fn new(n: usize) -> Self {
+        Self {
+            contacts: Vec::new(),
+            sums: vec![DVec3::ZERO; n],
+            counts: vec![0; n],
+        }
+    }
+}
+
+impl SelfCollision {
+    /// One Jacobi sweep over the touching pairs (see the module doc); returns the number of
+    /// contacts and the deepest overlap (m). Call [`SelfCollision::refresh`] first.
+    pub(crate) fn solve(&mut self, p: &mut Particles) -> (usize, f64) {
+        let start = Instant::now();
+        let lists: Vec<&PairList> = self.list.pairs.iter().chain([&self.list.extra]).collect();
+        self.sweep
+            .contacts
+            .resize_with(lists.len(), Default::default);
+        let friction = self.params.friction;
+        let state = State {
+            x: &p.positions,
+            prev: &p.prev_positions,
+            w: &p.inv_masses,
+        };
+        let n = p.positions.len();
+        let find = |(list, out): (&&PairList, &mut Bins)| {
+            out.reset(n);
+            find_contacts((&list.a, &list.b, &list.target), state, friction, out)
+        };
+        // A few thousand pairs take less time than waking another thread: below that, the
+        // lists are not split among threads.
+        let total: usize = lists.iter().map(|l| l.len()).sum();
+        let serial = if total < SERIAL_PAIRS { usize::MAX } else { 1 };
+        let deepest = lists
+            .par_iter()
+            .zip(self.sweep.contacts.par_iter_mut())
+            .with_min_len(serial)
+            .map(find)
+            .reduce(|| 0.0, f64::max);
+        let found = Instant::now();
+        self.tally.times.find += found - start;
+        self.sweep.sums.resize(n, DVec3::ZERO);
+        self.sweep.counts.resize(n, 0);
+        let contacts = apply(
+            &self.sweep.contacts,
+            &mut p.positions,
+            &mut self.sweep.sums,
+            &mut self.sweep.counts,
+        );
+        self.tally.times.apply += found.elapsed();
+        (contacts, deepest)
+    }
 }
 
 #[cfg(test)]

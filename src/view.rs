@@ -1,0 +1,136 @@
+//! What the renderer is shown of a simulation, for the window and `weft render` alike: the
+//! cloth and collider meshes, the collider poses, the floor, and the camera that frames the
+//! scene.
+
+use glam::{Mat4, Vec3};
+use weft_render::{Camera, ClothTopology, Renderer, SceneMeshes, TriMesh};
+
+use crate::sim::Simulation;
+
+/// What the renderer draws for a simulation, and where its ground is.
+pub struct SceneView {
+    /// Cloth topologies and collider meshes, in scene order.
+    pub meshes: SceneMeshes,
+    /// Height of an upward-facing half-space collider, drawn as the ground (and left out of
+    /// the meshes, so the two do not fight).
+    pub ground: Option<f32>,
+}
+
+/// The colliders of a simulation (those of its first collision world: every solver group
+/// holds the same ones).
+fn colliders(sim: &Simulation) -> &[weft_collide::Collider] {
+    sim.groups
+        .iter()
+        .find_map(|g| g.world.as_ref())
+        .map(|w| w.colliders())
+        .unwrap_or(&[])
+}
+
+/// Cloth topologies and tessellated colliders of `sim`.
+pub fn scene_meshes(sim: &Simulation) -> SceneView {
+    let cloths = sim
+        .scene
+        .cloths
+        .iter()
+        .map(|c| ClothTopology {
+            particle_count: c.mesh.positions.len(),
+            triangles: c.mesh.triangles.clone(),
+        })
+        .collect();
+    let mut ground: Option<f32> = None;
+    let colliders = colliders(sim)
+        .iter()
+        .map(|c| match c.half_space_normal() {
+            Some(n) if n.y > 0.999 => {
+                let y = c.world_matrix().w_axis.y;
+                ground = Some(ground.map_or(y, |g| g.max(y)));
+                TriMesh::default()
+            }
+            _ => {
+                let (positions, indices) = c.tessellate();
+                TriMesh { positions, indices }
+            }
+        })
+        .collect();
+    SceneView {
+        meshes: SceneMeshes { cloths, colliders },
+        ground,
+    }
+}
+
+/// The current world pose of each collider of `sim`.
+pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
+    colliders(sim).iter().map(|c| c.world_matrix()).collect()
+}
+
+/// Height of the floor drawn under `sim`: its upward half-space if it has one, else y = 0,
+/// lowered under any cloth that starts below it.
+pub fn floor_height(sim: &Simulation, view: &SceneView) -> f32 {
+    view.ground.unwrap_or_else(|| {
+        let lowest = (0..sim.scene.cloths.len())
+            .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y as f32))
+            .fold(0.0f32, f32::min);
+        if lowest < 0.0 { lowest - 0.01 } else { 0.0 }
+    })
+}
+
+/// A camera that frames the cloths and bounded colliders of `sim` as they are now, and the
+/// floor under them when it is near (so shadows and the drop are in view).
+pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for i in 0..sim.scene.cloths.len() {
+        for p in sim.cloth_positions(i) {
+            lo = lo.min(p.as_vec3());
+            hi = hi.max(p.as_vec3());
+        }
+    }
+    for (mesh, pose) in view.meshes.colliders.iter().zip(frame_poses(sim)) {
+        let (mut a, mut b) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for p in &mesh.positions {
+            let w = pose.transform_point3(*p);
+            a = a.min(w);
+            b = b.max(w);
+        }
+        // Large walls (half-spaces) would shrink everything else to a dot.
+        if (b - a).length() < 20.0 {
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+    }
+    let floor = floor_height(sim, view);
+    if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length() {
+        // Take in the floor and the shadow of the box's underside on it (its corners carried
+        // down along the sunlight), so hanging things show where their shadow falls.
+        let sun = weft_render::sun_direction();
+        let (a, b) = (lo, hi);
+        for i in 0..4 {
+            let c = Vec3::new(
+                if i & 1 == 0 { a.x } else { b.x },
+                a.y,
+                if i & 2 == 0 { a.z } else { b.z },
+            );
+            let shadow = c - sun * ((c.y - floor) / sun.y.max(0.1));
+            lo = lo.min(shadow);
+            hi = hi.max(shadow);
+        }
+    }
+    Camera::framing(lo, hi)
+}
+
+/// A renderer drawing `sim` into targets of `format`, with its floor (see [`floor_height`]),
+/// and the camera framing the scene now.
+pub fn renderer_for(
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
+    sim: &Simulation,
+) -> (Renderer, Camera) {
+    let view = scene_meshes(sim);
+    let mut renderer = Renderer::new(device, format, &view.meshes);
+    renderer.set_ground_height(floor_height(sim, &view));
+    (renderer, framing_camera(sim, &view))
+}
+
+/// The camera that frames the scene now ([`framing_camera`]).
+pub fn initial_camera(sim: &Simulation) -> Camera {
+    framing_camera(sim, &scene_meshes(sim))
+}
