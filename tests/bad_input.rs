@@ -100,7 +100,7 @@ fn malformed_cloth_mesh_names_scene_key_and_obj_line() {
         "{err}"
     );
     assert!(
-        err.contains("shirt.obj:4: face uses vertex 6, but only 3 vertices"),
+        err.contains("shirt.obj:4: face uses vertex 7 (OBJ counts from 1), but only 3 vertices"),
         "{err}"
     );
 }
