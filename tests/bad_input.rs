@@ -65,7 +65,7 @@ fn nan_and_negative_values_are_rejected_with_their_lines() {
     );
     assert!(
         err.contains(&format!(
-            "{path}:11: cloth.flag.mass: must be finite and > 0, got -1"
+            "{path}:11: cloth.flag.mass: out of range: must be in [1e-6, 1e6] kg"
         )),
         "{err}"
     );
