@@ -6,6 +6,8 @@ use clap::{Args, Parser, Subcommand};
 use weft_scene::Override;
 use weft_solver::Method;
 
+use crate::limits::LimitArgs;
+
 /// Real-time cloth simulation with XPBD, PBD and mass-spring.
 ///
 /// With no command, opens the interactive viewer on the built-in default scene
@@ -36,6 +38,19 @@ pub enum Command {
     View(ViewArgs),
     /// Render a scene offscreen: PNG frames, an animated GIF and (with ffmpeg) an MP4.
     Render(RenderArgs),
+    /// Rebuild a valid log from one cut short (killed, power cut): every complete chunk's
+    /// messages, the scene attachments and metadata, and status `recovered`.
+    Recover(RecoverArgs),
+}
+
+/// `weft recover`.
+#[derive(Debug, Args)]
+pub struct RecoverArgs {
+    /// The damaged log (e.g. `run.partial.mcap`, left by a killed run).
+    pub log: PathBuf,
+    /// Where to write the recovered log.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// `weft run`.
@@ -67,6 +82,9 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Memory and file-size limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 impl RunArgs {
@@ -199,6 +217,9 @@ pub struct CheckArgs {
     /// Overrides to validate with the file.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<Override>,
+    /// Memory and file-size limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// `weft replay`.
@@ -212,6 +233,9 @@ pub struct ReplayArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Memory and file-size limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// `weft experiments`.
@@ -225,9 +249,10 @@ pub struct ExperimentArgs {
     /// Run only every N-th run starting at K (`K/N`, K in 0..N), for batch schedulers.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// Parallel runs (default: the number of cores).
-    #[arg(long)]
-    pub jobs: Option<usize>,
+    /// Parallel runs, at least 1 (default: the number of cores; more than four per core is
+    /// cut to that, with a message).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub jobs: Option<u32>,
     /// Skip writing one MCAP per run.
     #[arg(long)]
     pub no_mcap: bool,
@@ -238,6 +263,16 @@ pub struct ExperimentArgs {
     /// Also render each run (PNG frames and a GIF, ~30 images/s) into `runs/<run>/`.
     #[arg(long)]
     pub render: bool,
+    /// Skip runs that already have a result in the output directory (after an interrupted or
+    /// killed queue).
+    #[arg(long)]
+    pub resume: bool,
+    /// Run a queue longer than 1000 runs (without it such a queue is refused).
+    #[arg(long)]
+    pub yes: bool,
+    /// Memory and file-size limits (the memory limit applies to each run's scene).
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// `weft render`.
@@ -275,4 +310,7 @@ pub struct RenderArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Memory and file-size limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }

@@ -1,23 +1,30 @@
 //! The `weft` binary: the interactive viewer; runs scenes headless, logs them to MCAP, checks
 //! scene files, replays logs and runs experiment queues.
 
+// First, so that `say!` is in scope in every module below.
+#[macro_use]
+mod say;
 mod app;
 mod cli;
 mod default_scene;
 mod experiments;
+mod limits;
+mod output;
 mod record;
+mod recover;
 mod replay;
 mod run;
 mod sim;
+mod stop;
 mod video;
 mod view;
 
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use clap::Parser;
-use weft_scene::{Scene, SceneErrors};
+use weft_scene::{Limits, Scene, SceneErrors};
 
 use cli::{Cli, Command, RunArgs};
 use record::RecordOptions;
@@ -25,20 +32,24 @@ use run::RunPlan;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // SIGINT and SIGTERM only raise a flag: runs check it every frame and close their logs.
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst)) {
-        eprintln!("weft: warning: cannot catch SIGINT/SIGTERM: {e}");
-    }
+    // SIGINT and SIGTERM end the process at once unless a loop polls the flag (see stop.rs):
+    // runs then close their logs, the solver stops within a substep.
+    let stop = stop::install();
     let result = match cli.command {
-        None => app::view(&cli.view, Arc::clone(&stop)),
-        Some(Command::View(args)) => app::view(&args, Arc::clone(&stop)),
+        None => {
+            let _polling = stop::Polling::start();
+            app::view(&cli.view, Arc::clone(&stop))
+        }
+        Some(Command::View(args)) => {
+            let _polling = stop::Polling::start();
+            app::view(&args, Arc::clone(&stop))
+        }
         Some(Command::Run(args)) => run_command(&args, &stop),
         Some(Command::Check(args)) => check(&args),
         Some(Command::Replay(args)) => replay::replay(&args, &stop),
         Some(Command::Experiments(args)) => experiments::run(&args, &stop),
         Some(Command::Render(args)) => render_command(&args, &stop),
+        Some(Command::Recover(args)) => recover::recover(&args),
     };
     match result {
         Ok(code) => code,
@@ -49,13 +60,14 @@ fn main() -> ExitCode {
     }
 }
 
-/// Loads the scene a run names (or the default one), printing every error.
+/// Loads the scene a run names (or the default one) within `limits`.
 fn load_scene(
     path: Option<&std::path::Path>,
     overrides: &[weft_scene::Override],
+    limits: &Limits,
 ) -> Result<Scene, SceneErrors> {
     match path {
-        Some(p) => weft_scene::load(p, overrides),
+        Some(p) => weft_scene::load_with(p, overrides, limits),
         None => default_scene::load(overrides),
     }
 }
@@ -67,12 +79,21 @@ fn report(errors: &SceneErrors) -> ExitCode {
     ExitCode::FAILURE
 }
 
-fn run_command(args: &RunArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
-    let scene = match load_scene(args.scene.as_deref(), &args.overrides()) {
+fn run_command(args: &RunArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
+    let scene = match load_scene(
+        args.scene.as_deref(),
+        &args.overrides(),
+        &args.limits.limits(),
+    ) {
         Ok(s) => s,
         Err(e) => return Ok(report(&e)),
     };
     let plan = RunPlan {
+        inputs: args
+            .scene
+            .iter()
+            .map(|p| ("the scene", p.clone()))
+            .collect(),
         frames: args.frames,
         out: args.out.as_deref(),
         dump_final: args.dump_final.as_deref(),
@@ -85,8 +106,8 @@ fn run_command(args: &RunArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
     run::run(scene, &plan, stop)
 }
 
-fn render_command(args: &cli::RenderArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
-    let scene = match load_scene(args.scene.as_deref(), &args.set) {
+fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
+    let scene = match load_scene(args.scene.as_deref(), &args.set, &args.limits.limits()) {
         Ok(s) => s,
         Err(e) => return Ok(report(&e)),
     };
@@ -103,23 +124,36 @@ fn render_command(args: &cli::RenderArgs, stop: &AtomicBool) -> anyhow::Result<E
         },
         progress: !args.quiet,
     };
+    if let Some(scene) = &args.scene {
+        output::refuse_clashes(
+            &[output::Named {
+                role: "the scene",
+                path: scene,
+            }],
+            &[output::Named {
+                role: "--out",
+                path: &args.out,
+            }],
+        )?;
+    }
     video::render(scene, &plan, stop)
 }
 
+/// `weft check`: loads and builds the scene. Nothing is written, so a signal ends it at once.
 fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
-    match weft_scene::load(&args.scene, &args.set) {
+    match weft_scene::load_with(&args.scene, &args.set, &args.limits.limits()) {
         Ok(scene) => {
             if let Err(e) = scene.build() {
                 return Ok(report(&e.into()));
             }
             let methods: Vec<&str> = scene.methods().iter().map(|m| m.name()).collect();
-            println!(
+            say!(
                 "{}: ok ({} cloth(s), {} collider(s), methods: {})",
                 scene.name,
                 scene.cloths.len(),
                 scene.colliders.len(),
                 methods.join(", ")
-            );
+            )?;
             Ok(ExitCode::SUCCESS)
         }
         Err(e) => Ok(report(&e)),

@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, bail};
@@ -18,16 +19,21 @@ pub struct LoggedRun {
     pub run: BTreeMap<String, String>,
     /// Attachments by name.
     pub attachments: BTreeMap<String, Vec<u8>>,
+    /// `weft.status` metadata, when the log has it.
+    pub status: Option<BTreeMap<String, String>>,
 }
 
 /// Reads the metadata and attachments of a Weft log.
 pub fn read_log(bytes: &[u8]) -> anyhow::Result<LoggedRun> {
     let summary = mcap::Summary::read(bytes)?.context("the log has no summary section")?;
     let mut run = None;
+    let mut status = None;
     for idx in &summary.metadata_indexes {
         let m = mcap::read::metadata(bytes, idx)?;
-        if m.name == "weft.run" {
-            run = Some(m.metadata);
+        match m.name.as_str() {
+            "weft.run" => run = Some(m.metadata),
+            "weft.status" => status = Some(m.metadata),
+            _ => {}
         }
     }
     let mut attachments = BTreeMap::new();
@@ -36,28 +42,62 @@ pub fn read_log(bytes: &[u8]) -> anyhow::Result<LoggedRun> {
         attachments.insert(a.name.clone(), a.data.into_owned());
     }
     let run = run.context("the log has no weft.run metadata: not written by weft run")?;
-    Ok(LoggedRun { run, attachments })
+    Ok(LoggedRun {
+        run,
+        attachments,
+        status,
+    })
 }
 
 /// Runs `weft replay`.
-pub fn replay(args: &ReplayArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
-    let bytes =
-        std::fs::read(&args.log).with_context(|| format!("cannot read {}", args.log.display()))?;
+pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
+    let bytes = weft_scene::read_regular(&args.log, u64::MAX)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.log.display()))?;
+    // Whole and every CRC intact, or say what is wrong and how to recover it.
+    if let Err(fault) = crate::record::verify::verify(&bytes) {
+        bail!("{}", fault.message(&args.log));
+    }
     let log = read_log(&bytes).with_context(|| format!("{}", args.log.display()))?;
     let get = |k: &str| {
         log.run
             .get(k)
             .with_context(|| format!("weft.run metadata lacks `{k}`"))
     };
+    // A malformed value names its key and shows (a short piece of) what it holds.
+    fn parsed<T: std::str::FromStr>(key: &str, v: &str, what: &str) -> anyhow::Result<T> {
+        v.trim().parse().map_err(|_| {
+            anyhow::anyhow!(
+                "weft.run metadata: `{key}` must be {what}, got {:?}",
+                weft_scene::elide(v)
+            )
+        })
+    }
     let name = get("scene")?.clone();
-    let frames: u64 = get("frames")?.parse()?;
-    let mesh_every: u64 = get("mesh_every")?.parse()?;
-    let timing: bool = get("timing")?.parse()?;
-    let overrides: Vec<String> = serde_json::from_str(get("overrides")?)?;
+    let logged_frames: u64 = parsed("frames", get("frames")?, "a frame count")?;
+    let mesh_every: u64 = parsed("mesh_every", get("mesh_every")?, "a frame count")?;
+    let timing: bool = parsed("timing", get("timing")?, "true or false")?;
+    let overrides: Vec<String> = serde_json::from_str(get("overrides")?).map_err(|e| {
+        anyhow::anyhow!("weft.run metadata: `overrides` must be a JSON list of KEY=VALUE: {e}")
+    })?;
     let overrides: Vec<Override> = overrides
         .iter()
         .map(|s| s.parse())
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<_, _>>()
+        .map_err(|e| anyhow::anyhow!("weft.run metadata: `overrides`: {e}"))?;
+    // A log cut short (interrupted, recovered) holds fewer frames than were asked for: replay
+    // the frames it holds.
+    let frames = match &log.status {
+        Some(st)
+            if matches!(
+                st.get("status").map(String::as_str),
+                Some("interrupted" | "recovered")
+            ) =>
+        {
+            let held = st.get("frames").map(String::as_str).unwrap_or("");
+            parsed::<u64>("weft.status frames", held, "a frame count")?.min(logged_frames)
+        }
+        _ => logged_frames,
+    };
     let source = log
         .attachments
         .get("scene/source.toml")
@@ -69,7 +109,8 @@ pub fn replay(args: &ReplayArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> 
             .filter_map(|(k, v)| Some((k.strip_prefix("files/")?.to_owned(), v.clone())))
             .collect(),
     );
-    let scene = match weft_scene::from_text(&name, &source, &overrides, &files) {
+    let limits = args.limits.limits();
+    let scene = match weft_scene::from_text_with(&name, &source, &overrides, &files, &limits) {
         Ok(s) => s,
         Err(e) => bail!("the logged scene no longer validates:\n{e}"),
     };
@@ -79,6 +120,7 @@ pub fn replay(args: &ReplayArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> 
         PathBuf::from(p)
     });
     let plan = RunPlan {
+        inputs: vec![("the log", args.log.clone())],
         frames,
         out: Some(&out),
         dump_final: None,
@@ -88,12 +130,12 @@ pub fn replay(args: &ReplayArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> 
     let code = run::run(scene, &plan, stop)?;
     let again = std::fs::read(&out)?;
     if again == bytes {
-        println!("replay is byte-identical to {}", args.log.display());
+        say!("replay is byte-identical to {}", args.log.display())?;
     } else {
-        println!(
+        say!(
             "replay differs from {} (expected if the log was interrupted, diverged, or used --timing)",
             args.log.display()
-        );
+        )?;
     }
     Ok(code)
 }

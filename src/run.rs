@@ -1,26 +1,31 @@
 //! `weft run`: a scene headless, logged to MCAP, stopped cleanly by a signal or divergence.
 
-use std::fs::File;
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use weft_scene::Scene;
+use weft_solver::SolverError;
 
+use crate::output::{Named, Output, refuse_clashes};
 use crate::record::{RecordOptions, Recorder, Status};
 use crate::sim::Simulation;
 
 /// Exit code of a run that diverged.
 pub const EXIT_DIVERGED: u8 = 2;
 /// Exit code of a run stopped by SIGINT/SIGTERM.
-pub const EXIT_INTERRUPTED: u8 = 130;
+pub const EXIT_INTERRUPTED: u8 = crate::stop::EXIT_INTERRUPTED as u8;
 
 /// Options of one run.
 pub struct RunPlan<'a> {
+    /// Files the run reads (the scene file; its meshes are added from the scene), with what
+    /// they are called in messages: no output may be one of them.
+    pub inputs: Vec<(&'static str, PathBuf)>,
     /// Frames to simulate.
     pub frames: u64,
     /// MCAP output.
@@ -33,20 +38,63 @@ pub struct RunPlan<'a> {
     pub progress: bool,
 }
 
-/// Creates `path` for writing, with a message naming it.
-pub fn create_output(path: &Path) -> anyhow::Result<File> {
-    File::create(path).with_context(|| format!("cannot write {}", path.display()))
+/// Creates `path` for writing, with a message naming it (the viewer's `--record`).
+pub fn create_output(path: &Path) -> anyhow::Result<std::fs::File> {
+    std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Every file `scene` read, as paths: the scene file and its meshes (relative to its directory).
+pub fn scene_inputs(scene_file: &Path, scene: &Scene) -> Vec<(&'static str, PathBuf)> {
+    let dir = Scene::dir_of(scene_file);
+    let mut v = vec![("the scene", scene_file.to_path_buf())];
+    v.extend(
+        scene
+            .files
+            .keys()
+            .map(|f| ("a mesh of the scene", dir.join(f))),
+    );
+    v
 }
 
 /// Runs `scene` as planned; `stop` is set by the signal handler.
-pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
-    // Fail on an unwritable path before anything is simulated.
-    let file = plan.out.map(create_output).transpose()?;
-    if let Some(p) = plan.dump_final {
-        create_output(p)?;
+pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
+    let mut inputs = plan.inputs.clone();
+    if let Some((_, scene_file)) = plan.inputs.iter().find(|(r, _)| *r == "the scene") {
+        inputs = scene_inputs(scene_file, &scene);
+        inputs.extend(
+            plan.inputs
+                .iter()
+                .filter(|(r, _)| *r != "the scene")
+                .cloned(),
+        );
     }
+    let named_inputs: Vec<Named<'_>> = inputs
+        .iter()
+        .map(|(role, path)| Named { role, path })
+        .collect();
+    let mut outputs = Vec::new();
+    if let Some(p) = plan.out {
+        outputs.push(Named {
+            role: "--out",
+            path: p,
+        });
+    }
+    if let Some(p) = plan.dump_final {
+        outputs.push(Named {
+            role: "--dump-final",
+            path: p,
+        });
+    }
+    refuse_clashes(&named_inputs, &outputs)?;
+    // Claim the outputs before anything is simulated: an unwritable path, or one another weft
+    // is writing, fails now. Nothing appears under the final names until the run is over.
+    let log = plan.out.map(Output::create).transpose()?;
+    let dump = plan.dump_final.map(Output::create).transpose()?;
     let name = scene.name.clone();
     let mut sim = Simulation::new(scene)?;
+    sim.set_stop(Arc::clone(stop));
+    // From here a signal raises the flag: the loop below stops and closes the log.
+    let _polling = crate::stop::Polling::start();
     let particles: usize = sim.groups.iter().map(|g| g.solver.particles().len()).sum();
     let methods: Vec<String> = sim.groups.iter().map(|g| g.method.to_string()).collect();
     eprintln!(
@@ -57,12 +105,17 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Resul
         sim.scene.settings.substeps,
         sim.scene.settings.iterations,
     );
-    let mut rec = file
-        .map(|f| Recorder::new(f, &sim, plan.frames, plan.record))
+    let mut rec = log
+        .as_ref()
+        .map(|o| {
+            Recorder::new(o.handle()?, &sim, plan.frames, plan.record)
+                .with_context(|| format!("writing {}", o.target().display()))
+        })
         .transpose()?;
     let bar = progress_bar(plan.frames, plan.progress);
     let start = Instant::now();
     let mut status = Status::Complete;
+    let mut torn = false;
     let mut last = sim.stats(0.0, 0);
     let result = (|| -> anyhow::Result<()> {
         if let Some(r) = rec.as_mut() {
@@ -80,8 +133,16 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Resul
                         r.frame(&sim, &stats)?;
                     }
                 }
+                Err(e) if sim.interrupted(&e) => {
+                    status = Status::Interrupted;
+                    torn = true;
+                    break;
+                }
                 Err(e) => {
                     status = Status::Diverged(e.to_string());
+                    if let Some(hint) = divergence_hint(&e, &sim) {
+                        eprintln!("weft: {hint}");
+                    }
                     break;
                 }
             }
@@ -92,23 +153,35 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Resul
     bar.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     let frames = last.frame;
-    // Close the log on every way out, so it is readable and says how the run ended.
-    if let Some(r) = rec {
+    // Close the log on every way out, so it is readable and says how the run ended; only a
+    // finished log is renamed into place.
+    if let (Some(r), Some(o)) = (rec, log) {
+        let target = o.target().display().to_string();
         let finished = r.finish(&status, frames);
-        result?;
-        finished.context("finishing the MCAP file")?;
+        result.with_context(|| format!("writing {target}"))?;
+        finished.with_context(|| format!("finishing {target}"))?;
+        o.commit()?;
     } else {
         result?;
     }
-    if let Some(p) = plan.dump_final {
-        dump_final(p, &sim)?;
+    if let Some(mut o) = dump {
+        if torn {
+            eprintln!(
+                "weft: {} not written: the stop came inside frame {}",
+                o.target().display(),
+                frames + 1
+            );
+        } else {
+            o.write_all(dump_final(&sim)?.as_bytes())?;
+            o.commit()?;
+        }
     }
     let lowest = (0..sim.scene.cloths.len())
         .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y))
         .fold(f64::INFINITY, f64::min);
-    println!(
+    say!(
         "{frames} frames, {:.3} s simulated, {wall:.3} s wall, {:.3} ms/frame; lowest point y = {lowest:+.4} m, stretch error max {:.2e} m, kinetic energy {:.3e} J",
-        sim.time(),
+        frames as f64 * sim.scene.settings.dt,
         if frames > 0 {
             1e3 * wall / frames as f64
         } else {
@@ -116,10 +189,10 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Resul
         },
         last.residual_max,
         last.kinetic_energy,
-    );
+    )?;
     if let Some(p) = plan.out {
         let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
-        println!("wrote {} ({size} bytes)", p.display());
+        say!("wrote {} ({size} bytes)", p.display())?;
     }
     Ok(match status {
         Status::Complete => ExitCode::SUCCESS,
@@ -135,6 +208,38 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &AtomicBool) -> anyhow::Resul
     })
 }
 
+/// Advice for a divergence whose cause is not a too-large time step: a cloth that starts
+/// beyond the bound, or a value that overflowed within the first frame.
+pub fn divergence_hint(e: &SolverError, sim: &Simulation) -> Option<String> {
+    let SolverError::Diverged {
+        frame, position, ..
+    } = e
+    else {
+        return None;
+    };
+    let bound = sim.scene.settings.divergence_bound;
+    let starts_outside = sim.scene.cloths.iter().any(|c| {
+        c.mesh
+            .positions
+            .iter()
+            .any(|p| p.abs().max_element() > bound)
+    });
+    if starts_outside {
+        return Some(format!(
+            "hint: a cloth starts beyond sim.divergence_bound = {bound} m: move it (center) or \
+             raise the bound; no time step fixes that"
+        ));
+    }
+    if *frame == 0 && !position.is_finite() {
+        return Some(
+            "hint: a value overflowed within the first frame: check the masses, compliances and \
+             sizes against the ranges `weft check` states"
+                .into(),
+        );
+    }
+    None
+}
+
 fn progress_bar(frames: u64, wanted: bool) -> ProgressBar {
     if !wanted || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
@@ -148,8 +253,8 @@ fn progress_bar(frames: u64, wanted: bool) -> ProgressBar {
     bar
 }
 
-/// Writes `{ "<cloth>": [[x, y, z], …] }` with positions rounded to float32, as logged.
-fn dump_final(path: &Path, sim: &Simulation) -> anyhow::Result<()> {
+/// `{ "<cloth>": [[x, y, z], …] }` with positions rounded to float32, as logged.
+fn dump_final(sim: &Simulation) -> anyhow::Result<String> {
     let mut map = serde_json::Map::new();
     for (i, c) in sim.scene.cloths.iter().enumerate() {
         let pts: Vec<[f32; 3]> = sim
@@ -159,10 +264,9 @@ fn dump_final(path: &Path, sim: &Simulation) -> anyhow::Result<()> {
             .collect();
         map.insert(c.name.clone(), serde_json::to_value(pts)?);
     }
-    let text = serde_json::to_string(&serde_json::json!({
+    Ok(serde_json::to_string(&serde_json::json!({
         "frame": sim.frame(),
         "time": sim.time(),
         "cloths": map,
-    }))?;
-    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+    }))?)
 }

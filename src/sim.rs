@@ -1,6 +1,8 @@
 //! A scene's solvers stepped in lockstep, one frame at a time.
 
 use std::ops::Range;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use weft_scene::{Scene, SolverGroup};
@@ -53,6 +55,18 @@ impl Simulation {
             places,
             frame: 0,
         })
+    }
+
+    /// Lets every solver poll `stop` once per substep (see `Solver::set_stop`).
+    pub fn set_stop(&mut self, stop: Arc<AtomicBool>) {
+        for g in &mut self.groups {
+            g.solver.set_stop(Arc::clone(&stop));
+        }
+    }
+
+    /// Whether `e` is a stop (the frame in progress abandoned), not a failure.
+    pub fn interrupted(&self, e: &SolverError) -> bool {
+        matches!(e, SolverError::Interrupted { .. })
     }
 
     /// Frames stepped so far.

@@ -306,7 +306,11 @@ fn file_stem(name: &str) -> String {
 }
 
 /// Runs `weft render`.
-pub fn render(scene: Scene, plan: &VideoPlan<'_>, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
+pub fn render(
+    scene: Scene,
+    plan: &VideoPlan<'_>,
+    stop: &Arc<AtomicBool>,
+) -> anyhow::Result<ExitCode> {
     if plan.every == 0 || plan.frames / plan.every == 0 {
         bail!(
             "nothing to render: --frames {} with --every {} gives no image",
@@ -319,6 +323,10 @@ pub fn render(scene: Scene, plan: &VideoPlan<'_>, stop: &AtomicBool) -> anyhow::
         .with_context(|| format!("cannot create output directory {}", plan.out.display()))?;
     let gpu = Gpu::headless().context("cannot render")?;
     let mut sim = Simulation::new(scene)?;
+    // From here a signal raises the flag (the solver sees it within a substep) and the images
+    // rendered so far are kept.
+    sim.set_stop(Arc::clone(stop));
+    let _polling = crate::stop::Polling::start();
     let mut rec = VideoRecorder::new(&gpu, &sim, plan.out, plan.size, plan.every, plan.options)?;
     eprintln!(
         "weft: rendering {} on {} at {}x{}, every {} frame(s) of {}",
@@ -346,6 +354,11 @@ pub fn render(scene: Scene, plan: &VideoPlan<'_>, stop: &AtomicBool) -> anyhow::
             break;
         }
         if let Err(e) = sim.step() {
+            if sim.interrupted(&e) {
+                eprintln!("weft: interrupted after {} frames", sim.frame());
+                code = ExitCode::from(EXIT_INTERRUPTED);
+                break;
+            }
             bar.finish_and_clear();
             eprintln!("weft: error: {e}");
             eprintln!(
@@ -361,13 +374,13 @@ pub fn render(scene: Scene, plan: &VideoPlan<'_>, stop: &AtomicBool) -> anyhow::
     bar.finish_and_clear();
     let images = rec.images();
     let written = rec.finish()?;
-    println!(
+    say!(
         "wrote {images} PNG frame(s) to {}/frame_*.png",
         plan.out.display()
-    );
+    )?;
     for w in written {
         let size = std::fs::metadata(&w).map(|m| m.len()).unwrap_or(0);
-        println!("wrote {} ({size} bytes)", w.display());
+        say!("wrote {} ({size} bytes)", w.display())?;
     }
     Ok(code)
 }

@@ -65,7 +65,7 @@ fn nan_and_negative_values_are_rejected_with_their_lines() {
     );
     assert!(
         err.contains(&format!(
-            "{path}:11: cloth.flag.mass: must be finite and > 0, got -1"
+            "{path}:11: cloth.flag.mass: out of range: must be in [1e-6, 1e6] kg"
         )),
         "{err}"
     );
@@ -100,7 +100,7 @@ fn malformed_cloth_mesh_names_scene_key_and_obj_line() {
         "{err}"
     );
     assert!(
-        err.contains("shirt.obj:4: face uses vertex 6, but only 3 vertices"),
+        err.contains("shirt.obj:4: face uses vertex 7 (OBJ counts from 1), but only 3 vertices"),
         "{err}"
     );
 }

@@ -75,10 +75,11 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
                 let _ = std::fs::remove_file(p);
             }
             anyhow::bail!(
-                "cannot open a window: {e}\n  \
+                "cannot open a window: {}\n  \
                  The viewer needs a display (DISPLAY or WAYLAND_DISPLAY); none is usable here.\n  \
                  Use `weft run [SCENE]` to simulate headless (with --out FILE.mcap to log it), \
-                 or `weft render` to draw a scene to image files."
+                 or `weft render` to draw a scene to image files.",
+                without_source_location(&e.to_string())
             );
         }
     };
@@ -123,6 +124,19 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// `message` without the "os error at <source file>:<line>: " prefix winit puts on its OS
+/// errors: a user has no use for the library's internal source path.
+fn without_source_location(message: &str) -> &str {
+    message
+        .strip_prefix("os error at ")
+        .and_then(|rest| {
+            // "<file>:<line>: <error>": skip to the text after the line number.
+            let (_, after) = rest.split_once(": ")?;
+            Some(after)
+        })
+        .unwrap_or(message)
 }
 
 /// Where the panel looks for scenes: beside the opened scene file, else `assets/scenes`.

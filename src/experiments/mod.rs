@@ -8,6 +8,7 @@ mod spec;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, bail};
@@ -15,6 +16,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::cli::ExperimentArgs;
+use crate::output::{Named, Output, refuse_clashes};
 use crate::record::{RecordOptions, Recorder, Status};
 use crate::sim::Simulation;
 use metrics::Meter;
@@ -62,10 +64,66 @@ fn slug(s: &str) -> String {
     out.trim_matches('-').chars().take(60).collect()
 }
 
+/// Queues longer than this are run only with `--yes`.
+pub const ASK_ABOVE_RUNS: u64 = 1000;
+/// Queues longer than this are refused outright (their plan alone would fill memory).
+pub const MAX_RUNS: u64 = 1_000_000;
+/// `--jobs` above this many per core is cut to it.
+pub const JOBS_PER_CORE: usize = 4;
+
+/// The status of a planned run that never started (interrupted queue, other shard).
+pub const NOT_RUN: &str = "not run";
+
+/// The path of run `index`'s result under `out`.
+pub fn result_path(out: &Path, index: usize) -> PathBuf {
+    out.join("results").join(format!("run-{index}.json"))
+}
+
+/// The finished result of `r` under `out`, if there is one (complete or diverged: an
+/// interrupted run is run again).
+fn finished_result(out: &Path, r: &PlannedRun) -> Option<RunResult> {
+    let text = std::fs::read_to_string(result_path(out, r.index)).ok()?;
+    let res: RunResult = serde_json::from_str(&text).ok()?;
+    (res.series == r.series
+        && res.label == r.label
+        && (res.status == "complete" || res.status.starts_with("diverged")))
+    .then_some(res)
+}
+
 /// Runs `weft experiments`.
-pub fn run(args: &ExperimentArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
+pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
     let spec = Spec::load(&args.file)?;
+    // Everything that can be refused is refused before a directory is made or a run starts.
+    let shard = args.shard.as_deref().map(parse_shard).transpose()?;
+    let count = spec.count();
+    if count > MAX_RUNS {
+        bail!(
+            "{}: the queue holds {count} runs, more than {MAX_RUNS}: split the sweep",
+            args.file.display()
+        );
+    }
+    if count > ASK_ABOVE_RUNS && !args.yes && !args.report_only {
+        bail!(
+            "{}: the queue holds {count} runs (more than {ASK_ABOVE_RUNS}); run it with --yes \
+             if that is what you meant",
+            args.file.display()
+        );
+    }
     let runs = spec.expand()?;
+    spec.check_plots(&runs)
+        .with_context(|| format!("{}", args.file.display()))?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = match args.jobs {
+        Some(j) if j as usize > JOBS_PER_CORE * cores => {
+            eprintln!(
+                "weft: --jobs {j} cut to {} ({JOBS_PER_CORE} per core on {cores} cores)",
+                JOBS_PER_CORE * cores
+            );
+            JOBS_PER_CORE * cores
+        }
+        Some(j) => j as usize,
+        None => cores,
+    };
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .file
@@ -74,28 +132,51 @@ pub fn run(args: &ExperimentArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode>
             .unwrap_or_else(|| "experiments".into());
         PathBuf::from("experiments-out").join(stem)
     });
+    let scene_path = spec.scene_path(&args.file);
+    // The report's files may not be an input (the experiments file, the scene).
+    let report_files = report::files(&spec, &out);
+    refuse_clashes(
+        &[
+            Named {
+                role: "the experiments file",
+                path: &args.file,
+            },
+            Named {
+                role: "the scene",
+                path: &scene_path,
+            },
+        ],
+        &report_files
+            .iter()
+            .map(|(role, path)| Named { role, path })
+            .collect::<Vec<_>>(),
+    )?;
     std::fs::create_dir_all(out.join("results"))
         .and_then(|()| std::fs::create_dir_all(out.join("runs")))
         .with_context(|| format!("cannot create {}", out.display()))?;
     let mut failed = false;
     if !args.report_only {
-        let shard = args.shard.as_deref().map(parse_shard).transpose()?;
-        let mine: Vec<&PlannedRun> = runs
+        let mut mine: Vec<&PlannedRun> = runs
             .iter()
             .filter(|r| shard.is_none_or(|(k, n)| r.index % n == k))
             .collect();
-        let scene_path = spec.scene_path(&args.file);
+        if args.resume {
+            let before = mine.len();
+            mine.retain(|r| finished_result(&out, r).is_none());
+            eprintln!(
+                "weft: --resume: {} of {before} runs already have results",
+                before - mine.len()
+            );
+        }
         // Validate every run's scene before simulating any.
+        let limits = args.limits.limits();
         let mut scenes = Vec::new();
         for r in &mine {
-            match weft_scene::load(&scene_path, &r.overrides) {
+            match weft_scene::load_with(&scene_path, &r.overrides, &limits) {
                 Ok(s) => scenes.push(s),
                 Err(e) => bail!("run {} ({} {}):\n{e}", r.index, r.series, r.label),
             }
         }
-        let jobs = args
-            .jobs
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
         eprintln!(
             "weft: {}: {} of {} runs{}, {} at a time, into {}",
             args.file.display(),
@@ -113,10 +194,25 @@ pub fn run(args: &ExperimentArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode>
             .transpose()
             .context("cannot render (--render)")?;
         let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+        // From here a signal raises the flag: running runs close their logs, runs not yet
+        // started are left `not run`.
+        let _polling = crate::stop::Polling::start();
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
                 .zip(scenes)
-                .map(|(r, scene)| execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop))
+                .map(|(r, scene)| {
+                    if stop.load(Ordering::SeqCst) {
+                        return Ok(not_run(r));
+                    }
+                    let result = execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)?;
+                    // Written as soon as the run ends, so a killed queue keeps what it did.
+                    let path = result_path(&out, r.index);
+                    crate::output::write_file(
+                        &path,
+                        serde_json::to_string_pretty(&result)?.as_bytes(),
+                    )?;
+                    Ok(result)
+                })
                 .collect()
         });
         for (r, res) in mine.iter().zip(results) {
@@ -127,9 +223,6 @@ pub fn run(args: &ExperimentArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode>
                         r.index, r.series, r.label, result.status
                     );
                     failed |= result.status != "complete";
-                    let path = out.join("results").join(format!("run-{}.json", r.index));
-                    std::fs::write(&path, serde_json::to_string_pretty(&result)?)
-                        .with_context(|| format!("cannot write {}", path.display()))?;
                 }
                 Err(e) => {
                     eprintln!(
@@ -152,6 +245,18 @@ pub fn run(args: &ExperimentArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode>
     })
 }
 
+/// The result of a run that never started.
+fn not_run(r: &PlannedRun) -> RunResult {
+    RunResult {
+        index: r.index,
+        series: r.series.clone(),
+        label: r.label.clone(),
+        status: NOT_RUN.into(),
+        metrics: Default::default(),
+        mcap: None,
+    }
+}
+
 fn execute(
     spec: &Spec,
     r: &PlannedRun,
@@ -159,7 +264,7 @@ fn execute(
     out: &Path,
     mcap: bool,
     gpu: Option<&weft_render::Gpu>,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
 ) -> anyhow::Result<RunResult> {
     let dt = scene.settings.dt;
     let frames = match (spec.frames, spec.duration) {
@@ -168,20 +273,24 @@ fn execute(
         (None, None) => 1,
     };
     let mut sim = Simulation::new(scene)?;
+    sim.set_stop(Arc::clone(stop));
     let rel = format!(
         "runs/{:03}-{}.mcap",
         r.index,
         slug(&format!("{} {}", r.series, r.label))
     );
-    let mut rec = if mcap {
-        let file = crate::run::create_output(&out.join(&rel))?;
-        let options = RecordOptions {
-            mesh_every: 0,
-            timing: false,
-        };
-        Some(Recorder::new(file, &sim, frames, options)?)
-    } else {
-        None
+    let log = mcap.then(|| Output::create(&out.join(&rel))).transpose()?;
+    let mut rec = match &log {
+        Some(o) => {
+            let options = RecordOptions {
+                mesh_every: 0,
+                timing: false,
+            };
+            let rec = Recorder::new(o.handle()?, &sim, frames, options)
+                .with_context(|| format!("writing {}", o.target().display()))?;
+            Some(rec)
+        }
+        None => None,
     };
     // With --render: about 30 images per simulated second, into the run's own directory.
     let mut video = gpu
@@ -216,6 +325,10 @@ fn execute(
                         v.frame(&sim)?;
                     }
                 }
+                Err(e) if sim.interrupted(&e) => {
+                    status = Status::Interrupted;
+                    break;
+                }
                 Err(e) => {
                     status = Status::Diverged(e.to_string());
                     break;
@@ -224,10 +337,13 @@ fn execute(
         }
         Ok(())
     })();
-    if let Some(rec) = rec {
+    if let (Some(rec), Some(log)) = (rec, log) {
         rec.finish(&status, sim.frame())?;
+        logged?;
+        log.commit()?;
+    } else {
+        logged?;
     }
-    logged?;
     if let Some(v) = video
         && !matches!(status, Status::Diverged(_))
     {

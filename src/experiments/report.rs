@@ -1,13 +1,14 @@
 //! The summary of an experiments queue: CSV, Markdown and plots, from every run result present.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
 use crate::experiments::plot;
 use crate::experiments::spec::{PlannedRun, Spec};
-use crate::experiments::{Row, RunResult};
+use crate::experiments::{NOT_RUN, Row, RunResult, result_path};
+use crate::output::Output;
 
 fn fmt(v: Option<f64>) -> String {
     match v {
@@ -17,19 +18,46 @@ fn fmt(v: Option<f64>) -> String {
     }
 }
 
-/// Reads `results/run-*.json` under `out` and writes `summary.csv`, `summary.md` and the plots.
+/// The files the report writes under `out`, with what they are called in messages.
+pub fn files(spec: &Spec, out: &Path) -> Vec<(&'static str, PathBuf)> {
+    let mut v = vec![
+        ("the summary", out.join("summary.csv")),
+        ("the summary", out.join("summary.md")),
+    ];
+    v.extend(spec.plot.iter().map(|p| ("a plot", out.join(&p.file))));
+    v
+}
+
+/// Reads `results/run-*.json` under `out` and writes `summary.csv`, `summary.md` and the plots;
+/// a planned run with no result is listed as `not run`, with no values.
 pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()> {
     let mut rows = Vec::new();
+    let mut with_results = 0;
     for r in runs {
-        let path = out.join("results").join(format!("run-{}.json", r.index));
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            continue;
+        let path = result_path(out, r.index);
+        let found = match std::fs::read_to_string(&path) {
+            Ok(text) => {
+                let result: RunResult = serde_json::from_str(&text)
+                    .with_context(|| format!("cannot parse {}", path.display()))?;
+                (result.label == r.label && result.series == r.series).then_some(result)
+            }
+            Err(_) => None,
         };
-        let result: RunResult = serde_json::from_str(&text)
-            .with_context(|| format!("cannot parse {}", path.display()))?;
-        if result.label == r.label && result.series == r.series {
-            rows.push(Row { run: r, result });
-        }
+        let result = match found {
+            Some(result) if result.status != NOT_RUN => {
+                with_results += 1;
+                result
+            }
+            _ => RunResult {
+                index: r.index,
+                series: r.series.clone(),
+                label: r.label.clone(),
+                status: NOT_RUN.into(),
+                metrics: Default::default(),
+                mcap: None,
+            },
+        };
+        rows.push(Row { run: r, result });
     }
     let names: Vec<&str> = spec.metrics.iter().map(|m| m.name()).collect();
     let mut csv = format!("index,series,swept,status,{}\n", names.join(","));
@@ -40,7 +68,7 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
         } else {
             &spec.title
         },
-        rows.len(),
+        with_results,
         runs.len(),
         names.join(" | "),
         "---|".repeat(names.len())
@@ -79,13 +107,34 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
                 .join(" | ")
         );
     }
-    std::fs::write(out.join("summary.csv"), &csv)?;
-    std::fs::write(out.join("summary.md"), &md)?;
-    print!("{md}");
+    crate::output::write_file(&out.join("summary.csv"), csv.as_bytes())?;
+    crate::output::write_file(&out.join("summary.md"), md.as_bytes())?;
+    // Plots first, so a closed or full standard output never costs a plot. Only complete runs
+    // are plotted: an interrupted run's values cover part of its time.
+    let complete: Vec<Row<'_>> = rows
+        .iter()
+        .filter(|r| r.result.status == "complete")
+        .map(|r| Row {
+            run: r.run,
+            result: r.result.clone(),
+        })
+        .collect();
+    let mut drawn = Vec::new();
     for p in &spec.plot {
         let path = out.join(&p.file);
-        plot::draw(p, &rows, &path).with_context(|| format!("plotting {}", path.display()))?;
-        println!("plot: {}", path.display());
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+        }
+        let png = Output::create(&path)?;
+        plot::draw(p, &complete, png.partial())
+            .with_context(|| format!("plotting {}", path.display()))?;
+        png.commit()?;
+        drawn.push(path);
+    }
+    say!("{}", md.trim_end())?;
+    for path in drawn {
+        say!("plot: {}", path.display())?;
     }
     Ok(())
 }

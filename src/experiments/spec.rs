@@ -177,6 +177,57 @@ impl Spec {
         weft_scene::Scene::dir_of(experiments_file).join(&self.scene)
     }
 
+    /// How many runs the queue holds (saturating), counted without expanding it.
+    pub fn count(&self) -> u64 {
+        self.series
+            .iter()
+            .map(|s| {
+                s.vary
+                    .values()
+                    .fold(1u64, |n, v| n.saturating_mul(v.len() as u64))
+            })
+            .fold(0u64, u64::saturating_add)
+    }
+
+    /// Refuses a plot whose `x` is neither a swept key nor a metric, or whose `file` would land
+    /// outside the output directory (absolute, or climbing out with `..`).
+    pub fn check_plots(&self, runs: &[PlannedRun]) -> anyhow::Result<()> {
+        for (i, p) in self.plot.iter().enumerate() {
+            let swept = runs.iter().any(|r| r.x.contains_key(&p.x));
+            if !swept && Metric::from_name(&p.x).is_none() {
+                let mut keys: Vec<&str> = self
+                    .series
+                    .iter()
+                    .flat_map(|s| s.vary.keys().map(String::as_str))
+                    .collect();
+                keys.sort_unstable();
+                keys.dedup();
+                bail!(
+                    "plot[{i}].x: `{}` is neither a swept key ({}) nor a metric",
+                    weft_scene::elide(&p.x),
+                    if keys.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        keys.join(", ")
+                    }
+                );
+            }
+            let file = Path::new(&p.file);
+            let inside = !p.file.is_empty()
+                && file
+                    .components()
+                    .all(|c| matches!(c, std::path::Component::Normal(_)));
+            if !inside {
+                bail!(
+                    "plot[{i}].file: `{}` must be a relative path inside the output directory \
+                     (no leading `/`, no `..`)",
+                    weft_scene::elide(&p.file)
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Every run, in queue order.
     pub fn expand(&self) -> anyhow::Result<Vec<PlannedRun>> {
         let ov = |k: &str, v: &Value| -> anyhow::Result<Override> {

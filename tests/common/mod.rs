@@ -116,3 +116,59 @@ pub fn read_log(path: &Path) -> Log {
         attachments,
     }
 }
+
+/// Sends `signal` (e.g. "INT", "TERM", "KILL") to process `pid`.
+pub fn signal(pid: u32, signal: &str) {
+    let ok = Command::new("kill")
+        .args([format!("-{signal}"), pid.to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(ok.success(), "kill -{signal} {pid} failed");
+}
+
+/// Waits until `ready()` holds, polling every 20 ms, for at most `limit`; false on timeout.
+pub fn wait_for(limit: std::time::Duration, mut ready: impl FnMut() -> bool) -> bool {
+    let start = std::time::Instant::now();
+    while start.elapsed() < limit {
+        if ready() {
+            return true;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    ready()
+}
+
+/// Waits for `child` to exit within `limit`; kills it and fails the test otherwise. Returns its
+/// output and how long it took.
+pub fn exits_within(
+    child: std::process::Child,
+    limit: std::time::Duration,
+) -> (Output, std::time::Duration) {
+    let start = std::time::Instant::now();
+    let pid = child.id();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(child.wait_with_output());
+    });
+    match rx.recv_timeout(limit) {
+        Ok(out) => (out.expect("waits"), start.elapsed()),
+        Err(_) => {
+            let _ = Command::new("kill")
+                .args(["-KILL", &pid.to_string()])
+                .status();
+            panic!("weft (pid {pid}) did not exit within {limit:?}");
+        }
+    }
+}
+
+/// The partial file a run writes before renaming it to `target` (`a.mcap` → `a.partial.mcap`).
+pub fn partial(target: &Path) -> PathBuf {
+    let stem = target.file_stem().expect("stem").to_string_lossy();
+    let ext = target.extension().expect("extension").to_string_lossy();
+    target.with_file_name(format!("{stem}.partial.{ext}"))
+}
+
+/// A bigger scene: a `n`×`n` cloth, so a frame takes a while and a log grows chunk by chunk.
+pub fn big(n: usize) -> String {
+    SMALL.replace("resolution = [8, 8]", &format!("resolution = [{n}, {n}]"))
+}

@@ -26,7 +26,10 @@ pub enum MeshError {
         reason: String,
     },
     /// A vertex coordinate is NaN or infinite.
-    #[error("{path}:{line}: vertex {vertex} has a non-finite coordinate")]
+    #[error(
+        "{path}:{line}: vertex {} (OBJ counts from 1) has a non-finite coordinate",
+        .vertex + 1
+    )]
     NonFiniteVertex {
         /// The file (or `<memory>`).
         path: PathBuf,
@@ -36,7 +39,11 @@ pub enum MeshError {
         vertex: usize,
     },
     /// A face refers to a vertex that does not exist.
-    #[error("{path}:{line}: face uses vertex {index}, but only {vertices} vertices are defined")]
+    #[error(
+        "{path}:{line}: face uses vertex {} (OBJ counts from 1), but only {vertices} vertices \
+         are defined",
+        .index + 1
+    )]
     IndexOutOfRange {
         /// The file (or `<memory>`).
         path: PathBuf,
@@ -58,7 +65,12 @@ pub enum MeshError {
         triangle: usize,
     },
     /// More than two triangles share one edge.
-    #[error("{path}:{line}: edge {a}-{b} is shared by more than two triangles (non-manifold mesh)")]
+    #[error(
+        "{path}:{line}: edge {}-{} (vertices counted from 1) is shared by more than two \
+         triangles (non-manifold mesh)",
+        u64::from(*.a) + 1,
+        u64::from(*.b) + 1
+    )]
     NonManifoldEdge {
         /// The file (or `<memory>`).
         path: PathBuf,

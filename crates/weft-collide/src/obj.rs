@@ -45,9 +45,24 @@ pub fn parse_obj(text: &str, path: impl AsRef<Path>) -> Result<TriangleMesh, Mes
                 }
                 let mut xyz = [0.0f32; 3];
                 for (slot, word) in xyz.iter_mut().zip(&coords) {
-                    *slot = word
-                        .parse()
-                        .map_err(|_| malformed(line, format!("`{word}` is not a number")))?;
+                    let v: f64 = word.parse().map_err(|_| {
+                        malformed(line, format!("`{}` is not a number", short(word)))
+                    })?;
+                    // Coordinates are stored as float32: a finite value beyond its range is
+                    // out of range, not "non-finite" (NaN and infinities are reported as such
+                    // by the mesh check).
+                    if v.is_finite() && v.abs() > f64::from(f32::MAX) {
+                        return Err(malformed(
+                            line,
+                            format!(
+                                "coordinate `{}` is out of range (an OBJ vertex is read as \
+                                 float32: |v| <= {:e})",
+                                short(word),
+                                f32::MAX
+                            ),
+                        ));
+                    }
+                    *slot = v as f32;
                 }
                 vertices.push(Vec3::from(xyz));
                 vertex_lines.push(line);
@@ -57,7 +72,7 @@ pub fn parse_obj(text: &str, path: impl AsRef<Path>) -> Result<TriangleMesh, Mes
                 for word in words {
                     let first = word.split('/').next().unwrap_or("");
                     let index: i64 = first.parse().map_err(|_| {
-                        malformed(line, format!("`{word}` is not a vertex reference"))
+                        malformed(line, format!("`{}` is not a vertex reference", short(word)))
                     })?;
                     // OBJ indices are 1-based; negative ones count back from the last vertex.
                     let resolved = match index {
@@ -96,6 +111,17 @@ pub fn parse_obj(text: &str, path: impl AsRef<Path>) -> Result<TriangleMesh, Mes
     })
 }
 
+/// The longest word an error echoes whole.
+const LONGEST_WORD: usize = 64;
+
+/// `word`, cut to [`LONGEST_WORD`] characters and `…` when longer.
+fn short(word: &str) -> String {
+    match word.char_indices().nth(LONGEST_WORD) {
+        Some((at, _)) => format!("{}…", &word[..at]),
+        None => word.to_owned(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,5 +133,30 @@ mod tests {
         let m = parse_obj(text, "quad.obj").expect("valid OBJ");
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(m.vertices.len(), 4);
+    }
+
+    #[test]
+    fn messages_count_vertices_from_one_and_keep_values_short() {
+        let missing = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "m.obj")
+            .expect_err("vertex 9 does not exist")
+            .to_string();
+        assert!(missing.contains("m.obj:4: face uses vertex 9"), "{missing}");
+        let far = parse_obj("v 0 0 0\nv 1e308 0 0\nv 0 1 0\nf 1 2 3\n", "m.obj")
+            .expect_err("1e308 overflows float32")
+            .to_string();
+        assert!(
+            far.contains("m.obj:2") && far.contains("out of range"),
+            "{far}"
+        );
+        assert!(!far.contains("non-finite"), "{far}");
+        let huge = format!("v {} 0 0\n", "9".repeat(100_000) + "x");
+        let long = parse_obj(&huge, "m.obj")
+            .expect_err("not a number")
+            .to_string();
+        assert!(
+            long.len() < 300 && long.contains('…'),
+            "{} chars",
+            long.len()
+        );
     }
 }

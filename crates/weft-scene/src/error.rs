@@ -38,13 +38,37 @@ impl fmt::Display for SceneError {
                 line: Some(l),
             } => write!(f, "{path}:{l}: ")?,
             Origin::File { path, line: None } => write!(f, "{path}: ")?,
-            Origin::CommandLine => write!(f, "command line (--set {}): ", self.key)?,
+            Origin::CommandLine => write!(f, "command line (--set {}): ", elide(&self.key))?,
         }
         if !self.key.is_empty() {
-            write!(f, "{}: ", self.key)?;
+            write!(f, "{}: ", elide(&self.key))?;
         }
-        f.write_str(&self.message)
+        f.write_str(&elide(&self.message))
     }
+}
+
+/// The longest run of non-blank characters a message shows whole.
+pub const LONGEST_WORD: usize = 64;
+
+/// `s` with every run of non-blank characters longer than [`LONGEST_WORD`] cut to that many
+/// and `…`, so an error never echoes a huge bad value in full.
+pub fn elide(s: &str) -> String {
+    let mut out = String::with_capacity(s.len().min(4096));
+    let mut run = 0;
+    for ch in s.chars() {
+        if ch.is_whitespace() {
+            run = 0;
+            out.push(ch);
+            continue;
+        }
+        run += 1;
+        if run <= LONGEST_WORD {
+            out.push(ch);
+        } else if run == LONGEST_WORD + 1 {
+            out.push('…');
+        }
+    }
+    out
 }
 
 /// Every problem found in a scene (at least one).

@@ -7,8 +7,10 @@ mod build;
 mod collide;
 mod error;
 pub mod family;
+mod limits;
 mod load;
 mod overrides;
+mod ranges;
 mod resolve;
 mod scene;
 pub mod schema;
@@ -16,9 +18,11 @@ mod source;
 
 pub use build::SolverGroup;
 pub use collide::collider_desc;
-pub use error::{Origin, SceneError, SceneErrors};
-pub use load::{from_text, load};
+pub use error::{LONGEST_WORD, Origin, SceneError, SceneErrors, elide};
+pub use limits::{BYTES_PER_PARTICLE, Limits, PER_PARTICLE_SELF_COLLISION, estimate_bytes, human};
+pub use load::{from_text, from_text_with, load, load_with};
 pub use overrides::{Override, parse_value};
 pub use scene::{
-    ClothSpec, ColliderSpec, DirFiles, Files, MapFiles, Scene, SelfCollisionSpec, ShapeSpec,
+    CappedDirFiles, ClothSpec, ColliderSpec, DEFAULT_MAX_FILE_BYTES, DirFiles, Files, MapFiles,
+    Scene, SelfCollisionSpec, ShapeSpec, read_regular,
 };

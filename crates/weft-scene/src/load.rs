@@ -6,17 +6,30 @@ use std::path::Path;
 use toml_edit::DocumentMut;
 
 use crate::error::{Origin, SceneError, SceneErrors};
+use crate::limits::{Limits, estimate_bytes, grid_particles, human};
 use crate::overrides::{self, Override};
 use crate::resolve::{Checker, resolve};
-use crate::scene::{DirFiles, Files, Scene};
+use crate::scene::{CappedDirFiles, Files, Scene, read_regular};
 use crate::schema::SceneFile;
 use crate::source::{Source, key_at, line_at};
 
 /// Loads and validates the scene file at `path` with `overrides` applied; mesh files are
-/// read relative to the scene's directory.
+/// read relative to the scene's directory. Files larger than
+/// [`DEFAULT_MAX_FILE_BYTES`](crate::DEFAULT_MAX_FILE_BYTES) are refused.
 pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneErrors> {
+    load_with(path, overrides, &Limits::default())
+}
+
+/// [`load`] within `limits`: files larger than `limits.max_file_bytes` are refused, and so is a
+/// scene whose estimated memory exceeds `limits.max_memory`, before its cloths are built.
+pub fn load_with(
+    path: &Path,
+    overrides: &[Override],
+    limits: &Limits,
+) -> Result<Scene, SceneErrors> {
+    let max_file_bytes = limits.max_file_bytes;
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let bytes = read_regular(path, max_file_bytes).map_err(|e| SceneError {
         origin: Origin::File {
             path: name.clone(),
             line: None,
@@ -24,7 +37,28 @@ pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneErrors> {
         key: String::new(),
         message: format!("cannot read the scene file: {e}"),
     })?;
-    from_text(&name, &text, overrides, &DirFiles(Scene::dir_of(path)))
+    let text = String::from_utf8(bytes).map_err(|e| SceneError {
+        origin: Origin::File {
+            path: name.clone(),
+            line: Some(line_at_byte(e.as_bytes(), e.utf8_error().valid_up_to())),
+        },
+        key: String::new(),
+        message: "not UTF-8 text".into(),
+    })?;
+    let files = CappedDirFiles {
+        dir: Scene::dir_of(path),
+        max_bytes: max_file_bytes,
+    };
+    from_text_with(&name, &text, overrides, &files, limits)
+}
+
+/// 1-based line of byte `at` in `bytes`.
+fn line_at_byte(bytes: &[u8], at: usize) -> usize {
+    bytes[..at.min(bytes.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// Validates scene `text` (called `name` in messages) with `overrides`, reading meshes from `files`.
@@ -33,6 +67,17 @@ pub fn from_text(
     text: &str,
     overrides: &[Override],
     files: &dyn Files,
+) -> Result<Scene, SceneErrors> {
+    from_text_with(name, text, overrides, files, &Limits::default())
+}
+
+/// [`from_text`] within `limits` (see [`load_with`]).
+pub fn from_text_with(
+    name: &str,
+    text: &str,
+    overrides: &[Override],
+    files: &dyn Files,
+    limits: &Limits,
 ) -> Result<Scene, SceneErrors> {
     let file_error = |line: Option<usize>, message: String| SceneError {
         origin: Origin::File {
@@ -59,11 +104,50 @@ pub fn from_text(
             None => file_error(e.span().map(|s| line_at(&effective, s.start)), message),
         }
     })?;
+    if let Some((cap, origin)) = &limits.max_memory {
+        let grids = grid_particles(&file);
+        let total: u64 = grids.iter().map(|(_, n)| n).sum();
+        let need = estimate_bytes(total, file.self_collision.is_some());
+        if need > *cap
+            && let Some((largest, _)) = grids.iter().max_by_key(|(_, n)| *n)
+        {
+            return Err(src
+                .error(
+                    &format!("cloth.{largest}.resolution"),
+                    format!(
+                        "the scene's cloths hold {total} particles, about {} once built, more \
+                         than the {} allowed ({origin}); lower the resolution, or raise the \
+                         limit with --max-memory",
+                        human(need),
+                        human(*cap)
+                    ),
+                )
+                .into());
+        }
+    }
     let mut checker = Checker::new(&src, files);
     let parts = resolve(&file, &mut checker);
     let Some(parts) = parts else {
         return Err(SceneErrors(checker.errors));
     };
+    if let Some((cap, origin)) = &limits.max_memory {
+        // Exact now, mesh cloths included.
+        let total: u64 = parts.cloths.iter().map(|c| c.mesh.len() as u64).sum();
+        let need = estimate_bytes(total, parts.self_collision.is_some());
+        if need > *cap {
+            return Err(src
+                .error(
+                    "cloth",
+                    format!(
+                        "the scene's cloths hold {total} particles, about {} once built, more \
+                         than the {} allowed ({origin}); raise the limit with --max-memory",
+                        human(need),
+                        human(*cap)
+                    ),
+                )
+                .into());
+        }
+    }
     Ok(Scene {
         name: name.to_owned(),
         source: text.to_owned(),

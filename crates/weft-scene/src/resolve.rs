@@ -11,7 +11,8 @@ use weft_solver::{
 };
 
 use crate::error::SceneError;
-use crate::family;
+use crate::family::{self, Field};
+use crate::ranges::{self, Range};
 use crate::scene::{ClothSpec, ColliderSpec, Files, SelfCollisionSpec, ShapeSpec};
 use crate::schema::{
     ClothSection, ColliderSection, MotionSpec, OrientationName, PartSection, PinSpec, SceneFile,
@@ -29,9 +30,13 @@ pub(crate) struct Checker<'a> {
     pub errors: Vec<SceneError>,
 }
 
-fn show(v: f64) -> String {
+/// A number for a message: plain when short, else in exponent form (1.797e308 is not written
+/// out as 309 digits).
+pub(crate) fn show(v: f64) -> String {
     if v.is_nan() {
         "NaN".into()
+    } else if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
     } else {
         format!("{v}")
     }
@@ -68,6 +73,25 @@ impl<'a> Checker<'a> {
         result.is_ok()
     }
 
+    /// Checks `v` against a physical range, naming the range and its reason.
+    fn within(&mut self, key: &str, v: f64, range: &Range) -> bool {
+        if v.is_nan() || v.is_infinite() {
+            return self.check(key, v, false, &format!("finite and {}", range.expected()));
+        }
+        let good = range.holds(v);
+        if !good {
+            self.bad(
+                key,
+                format!(
+                    "out of range: must be {}, got {}",
+                    range.expected(),
+                    show(v)
+                ),
+            );
+        }
+        good
+    }
+
     fn non_negative(&mut self, key: &str, v: f64) -> bool {
         self.check(key, v, v >= 0.0, "finite and >= 0")
     }
@@ -81,6 +105,15 @@ impl<'a> Checker<'a> {
             self.bad(
                 key,
                 format!("every component must be finite, got {}", show(*c)),
+            );
+        } else if let Some(c) = v.iter().find(|c| !ranges::COORDINATE.holds(**c)) {
+            self.bad(
+                key,
+                format!(
+                    "out of range: every component must be {}, got {}",
+                    ranges::COORDINATE.expected(),
+                    show(*c)
+                ),
             );
         }
         DVec3::from_array(v)
@@ -119,10 +152,28 @@ impl<'a> Checker<'a> {
         self.read.insert(path.to_owned(), bytes);
         // One OBJ reader serves colliders and cloths; its errors name the file and line.
         match weft_collide::parse_obj(&text, path) {
-            Ok(m) => Some((
-                m.vertices.iter().map(|p| p.as_dvec3() * scale).collect(),
-                m.triangles,
-            )),
+            Ok(m) => {
+                let positions: Vec<DVec3> =
+                    m.vertices.iter().map(|p| p.as_dvec3() * scale).collect();
+                let far = positions
+                    .iter()
+                    .position(|p| !p.is_finite() || p.abs().max_element() > ranges::COORDINATE.hi);
+                if let Some(v) = far {
+                    self.bad(
+                        key,
+                        format!(
+                            "`{path}` vertex {} (counting from 1) scaled by {} lies at {}: out of \
+                             range, every coordinate must be {}",
+                            v + 1,
+                            show(scale),
+                            positions[v],
+                            ranges::COORDINATE.expected()
+                        ),
+                    );
+                    return None;
+                }
+                Some((positions, m.triangles))
+            }
             Err(e) => {
                 self.bad(key, format!("bad mesh: {e}"));
                 None
@@ -175,7 +226,7 @@ impl<'a> Checker<'a> {
 pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedParts> {
     let sim = &file.sim;
     let dt = sim.dt.0;
-    c.positive("sim.dt", dt);
+    c.within("sim.dt", dt, &ranges::DT);
     let count = |c: &mut Checker<'_>, key: &str, v: i64| -> u32 {
         if !(1..=100_000).contains(&v) {
             c.bad(key, format!("must be an integer in 1..=100000, got {v}"));
@@ -186,9 +237,24 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
     };
     let substeps = count(c, "sim.substeps", sim.substeps);
     let iterations = count(c, "sim.iterations", sim.iterations);
+    let sweeps = u64::from(substeps) * u64::from(iterations);
+    if sweeps > ranges::SWEEPS_PER_FRAME {
+        c.bad(
+            "sim.iterations",
+            format!(
+                "substeps x iterations = {sweeps} constraint sweeps per frame, more than {}: \
+                 one frame would take minutes (no scene needs that many)",
+                ranges::SWEEPS_PER_FRAME
+            ),
+        );
+    }
     let gravity = c.vector("sim.gravity", sim.gravity);
-    c.non_negative("sim.damping", sim.damping);
-    c.positive("sim.divergence_bound", sim.divergence_bound);
+    c.within("sim.damping", sim.damping, &ranges::RATE);
+    c.within(
+        "sim.divergence_bound",
+        sim.divergence_bound,
+        &ranges::DIVERGENCE_BOUND,
+    );
     let settings = Settings {
         method: sim.method.into(),
         dt,
@@ -200,7 +266,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
     let mut wind = Wind::default();
     if let Some(w) = &file.wind {
         wind.velocity = c.vector("wind.velocity", w.velocity);
-        c.non_negative("wind.drag", w.drag);
+        c.within("wind.drag", w.drag, &ranges::RATE);
         wind.drag = w.drag;
         if let Some(a) = &w.aero {
             c.non_negative("wind.aero.air_density", a.air_density);
@@ -328,11 +394,11 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             Mass::Total(1.0)
         }
         (Some(m), None) => {
-            c.positive(&k("mass"), m);
+            c.within(&k("mass"), m, &ranges::MASS);
             Mass::Total(m)
         }
         (None, Some(d)) => {
-            c.positive(&k("density"), d);
+            c.within(&k("density"), d, &ranges::DENSITY);
             Mass::Density(d)
         }
         (None, None) => Mass::Total(1.0),
@@ -350,16 +416,30 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             );
         }
     }
+    for &(fam, setting) in &settings {
+        let field = setting.field();
+        let range = match field {
+            Field::Compliance => &ranges::COMPLIANCE,
+            Field::Damping | Field::SpringDamping => &ranges::DAMPING,
+            Field::SpringStiffness => &ranges::SPRING_STIFFNESS,
+            Field::Enabled | Field::PbdStiffness => continue,
+        };
+        if let Some(v) = setting.number()
+            && (field.rule())(v).is_ok()
+        {
+            c.within(&k(&family::key(fam, field)), v, range);
+        }
+    }
     family::apply(&settings, &mut params);
     let thickness = s.thickness.unwrap_or(0.005);
-    c.non_negative(&k("thickness"), thickness);
+    c.within(&k("thickness"), thickness, &ranges::THICKNESS);
     let motion = c.motion(&k("motion"), &s.motion);
     let mesh = if let Some(path) = &s.mesh {
         c.unused(&k("resolution"), &s.resolution, "by a mesh cloth");
         c.unused(&k("size"), &s.size, "by a mesh cloth");
         c.unused(&k("orientation"), &s.orientation, "by a mesh cloth");
         let scale = s.scale.unwrap_or(1.0);
-        c.positive(&k("scale"), scale);
+        c.within(&k("scale"), scale, &ranges::SCALE);
         let mut indices = Vec::new();
         for (i, p) in pins.iter().enumerate() {
             match p {
@@ -391,8 +471,8 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             );
         }
         let [w, h] = s.size.unwrap_or([1.0, 1.0]);
-        c.positive(&k("size"), w);
-        c.positive(&k("size"), h);
+        c.within(&k("size"), w, &ranges::SIZE);
+        c.within(&k("size"), h, &ranges::SIZE);
         let mut grid_pins = Vec::new();
         for (i, p) in pins.iter().enumerate() {
             let key = format!("{}[{i}]", k("pins"));
@@ -576,7 +656,7 @@ fn collider(c: &mut Checker<'_>, i: usize, s: &ColliderSection) -> Option<Collid
     let spec = match s.shape {
         ShapeKind::Mesh => {
             let scale = s.scale.unwrap_or(1.0);
-            c.positive(&k("scale"), scale);
+            c.within(&k("scale"), scale, &ranges::SCALE);
             match &s.mesh {
                 Some(path) => c
                     .read_mesh(&k("mesh"), path, scale)

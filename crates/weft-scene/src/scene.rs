@@ -15,14 +15,62 @@ pub trait Files {
     fn read(&self, path: &str) -> Result<Vec<u8>, String>;
 }
 
-/// Files relative to a directory (the scene file's own).
+/// Files relative to a directory (the scene file's own), at most
+/// [`DEFAULT_MAX_FILE_BYTES`] each.
 #[derive(Clone, Debug)]
 pub struct DirFiles(pub PathBuf);
 
 impl Files for DirFiles {
     fn read(&self, path: &str) -> Result<Vec<u8>, String> {
-        std::fs::read(self.0.join(path)).map_err(|e| e.to_string())
+        read_regular(&self.0.join(path), DEFAULT_MAX_FILE_BYTES)
     }
+}
+
+/// Files relative to a directory, at most `max_bytes` each.
+#[derive(Clone, Debug)]
+pub struct CappedDirFiles {
+    /// The directory paths are relative to.
+    pub dir: PathBuf,
+    /// The largest file read (bytes).
+    pub max_bytes: u64,
+}
+
+impl Files for CappedDirFiles {
+    fn read(&self, path: &str) -> Result<Vec<u8>, String> {
+        read_regular(&self.dir.join(path), self.max_bytes)
+    }
+}
+
+/// The largest scene or mesh file read unless the caller raises it: 256 MiB (an OBJ of about
+/// eight million vertices).
+pub const DEFAULT_MAX_FILE_BYTES: u64 = 256 << 20;
+
+/// Reads `path` if it is a regular file of at most `max_bytes`: a FIFO, a device or a directory
+/// is refused before it is opened (opening a FIFO would wait for a writer; `/dev/zero` never
+/// ends).
+pub fn read_regular(path: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err("not a regular file (a FIFO, device or directory is never read)".into());
+    }
+    let too_big = |n: u64| {
+        format!(
+            "the file holds {n} bytes, more than the limit of {max_bytes} (raise it with \
+             --max-file-size)"
+        )
+    };
+    if meta.len() > max_bytes {
+        return Err(too_big(meta.len()));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(max_bytes.saturating_add(1)).read_to_end(&mut bytes))
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
 }
 
 /// Files held in memory (e.g. the attachments of an MCAP log).

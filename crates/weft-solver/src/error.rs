@@ -100,6 +100,12 @@ pub enum SolverError {
         /// The bound that was crossed (m).
         bound: f64,
     },
+    /// The stop flag (see `Solver::set_stop`) was raised inside a frame, which was abandoned.
+    #[error("stopped inside frame {frame}")]
+    Interrupted {
+        /// The frame that was abandoned (0-based).
+        frame: u64,
+    },
     /// A particle index that does not exist.
     #[error("particle {index} does not exist (the solver has {count})")]
     NoSuchParticle {

@@ -1,6 +1,8 @@
 //! The solver: one step loop shared by every method.
 
 use std::ops::Range;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -69,6 +71,8 @@ pub struct Solver {
     force: Vec<DVec3>,
     time: f64,
     frame: u64,
+    /// Raised by the caller to abandon the frame in progress (polled once per substep).
+    stop: Option<Arc<AtomicBool>>,
 }
 
 impl Solver {
@@ -104,7 +108,22 @@ impl Solver {
             accel: scratch,
             time: 0.0,
             frame: 0,
+            stop: None,
         }
+    }
+
+    /// A flag polled once per substep: once raised, the frame in progress stops at the next
+    /// substep and [`Solver::step_with`] returns [`SolverError::Interrupted`]. The solver never
+    /// lowers it; what raises it (a signal, a button) is the caller's business.
+    pub fn set_stop(&mut self, flag: Arc<AtomicBool>) {
+        self.stop = Some(flag);
+    }
+
+    /// Whether the stop flag is raised.
+    fn stopping(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
     /// The particle store (read-only: only the step loop and its hook move particles).
@@ -286,13 +305,16 @@ impl Solver {
     pub fn step_with(&mut self, hook: &mut dyn SubstepHook) -> Result<StepStats, SolverError> {
         let s = self.settings;
         let rule = s.method.strategy().rule(s.h());
-        let stats = rayon::scope(|_| match rule {
+        let (stats, whole) = rayon::scope(|_| match rule {
             Some(rule) if !hook.is_active() && self.fusable() => {
-                self.frame_fused(rule);
-                StepStats::default()
+                (StepStats::default(), self.frame_fused(rule))
             }
             _ => self.frame_general(hook),
         });
+        if !whole {
+            // Stopped inside the frame: the state is part of a frame; time and frame stay.
+            return Err(SolverError::Interrupted { frame: self.frame });
+        }
         if let Some(g) = &mut self.grab {
             g.from = g.target;
         }
@@ -326,15 +348,25 @@ impl Solver {
         time
     }
 
-    /// One frame with every substep phase inside the domains' parallel regions.
-    fn frame_fused(&mut self, rule: Rule) {
+    /// One frame with every substep phase inside the domains' parallel regions; false when the
+    /// stop flag cut it short.
+    fn frame_fused(&mut self, rule: Rule) -> bool {
         let s = self.settings;
         let h = s.h();
         let inv_h = 1.0 / h;
         let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
         self.domains.prepare(&self.params, rule);
         let lambda = self.domains.mode().lambda;
+        let mut whole = true;
         for k in 0..s.substeps {
+            if self.stopping() {
+                if k == 0 {
+                    // Nothing loaded into the domains yet: the store is as it was.
+                    return false;
+                }
+                whole = false;
+                break;
+            }
             self.substep_targets(k);
             let step = Integration {
                 h,
@@ -365,10 +397,12 @@ impl Solver {
             &mut p.prev_positions,
             &mut p.velocities,
         );
+        whole
     }
 
-    /// One frame of the general loop: every phase on the particle store, the hook in between.
-    fn frame_general(&mut self, hook: &mut dyn SubstepHook) -> StepStats {
+    /// One frame of the general loop: every phase on the particle store, the hook in between;
+    /// false when the stop flag cut it short.
+    fn frame_general(&mut self, hook: &mut dyn SubstepHook) -> (StepStats, bool) {
         let s = self.settings;
         let h = s.h();
         let strategy = s.method.strategy();
@@ -377,7 +411,12 @@ impl Solver {
         if let Some(rule) = rule {
             self.domains.prepare(&self.params, rule);
         }
+        let mut whole = true;
         for k in 0..s.substeps {
+            if self.stopping() {
+                whole = false;
+                break;
+            }
             let time = self.substep_targets(k);
             let ctx = SubstepContext {
                 method: s.method,
@@ -465,7 +504,7 @@ impl Solver {
                     });
             }
         }
-        stats
+        (stats, whole)
     }
 
     fn check_divergence(&self, frame: u64) -> Result<(), SolverError> {
