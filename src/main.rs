@@ -9,6 +9,7 @@ mod record;
 mod replay;
 mod run;
 mod sim;
+mod stability;
 mod video;
 
 use std::process::ExitCode;
@@ -108,9 +109,10 @@ fn render_command(args: &cli::RenderArgs, stop: &AtomicBool) -> anyhow::Result<E
 fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
     match weft_scene::load(&args.scene, &args.set) {
         Ok(scene) => {
-            if let Err(e) = scene.build() {
-                return Ok(report(&e.into()));
-            }
+            let groups = match scene.build() {
+                Ok(g) => g,
+                Err(e) => return Ok(report(&e.into())),
+            };
             let methods: Vec<&str> = scene.methods().iter().map(|m| m.name()).collect();
             println!(
                 "{}: ok ({} cloth(s), {} collider(s), methods: {})",
@@ -119,6 +121,17 @@ fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
                 scene.colliders.len(),
                 methods.join(", ")
             );
+            for g in &groups {
+                for i in 0..g.solver.cloths().len() {
+                    if let Some(v) = stability::verdict(&g.solver, i) {
+                        if v.ok {
+                            println!("  {}", v.text);
+                        } else {
+                            println!("  warning: {}", v.text);
+                        }
+                    }
+                }
+            }
             Ok(ExitCode::SUCCESS)
         }
         Err(e) => Ok(report(&e)),

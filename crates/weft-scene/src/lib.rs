@@ -8,6 +8,7 @@ mod collide;
 mod error;
 pub mod family;
 mod load;
+pub mod material;
 mod overrides;
 mod resolve;
 mod scene;

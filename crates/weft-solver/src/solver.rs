@@ -14,6 +14,7 @@ use crate::motion::KinematicPin;
 use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
 use crate::settings::Settings;
+use crate::stability::{StabilityBound, bound};
 
 /// A cloth inside a solver: its particle range and its mesh in global particle indices.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,6 +70,9 @@ pub struct Solver {
     force: Vec<DVec3>,
     time: f64,
     frame: u64,
+    /// Stability bounds of each cloth and of the whole solver, computed when first asked for
+    /// and cleared when parameters change.
+    stability: std::sync::OnceLock<(Vec<StabilityBound>, StabilityBound)>,
 }
 
 /// Particles per parallel task in the general loop's per-particle passes (and the external
@@ -110,6 +114,7 @@ impl Solver {
             accel: scratch,
             time: 0.0,
             frame: 0,
+            stability: std::sync::OnceLock::new(),
         }
     }
 
@@ -210,6 +215,7 @@ impl Solver {
         params.validate()?;
         let base = cloth * Family::COUNT;
         self.params[base..base + Family::COUNT].copy_from_slice(&params.families);
+        self.stability = std::sync::OnceLock::new();
         Ok(())
     }
 
@@ -237,6 +243,34 @@ impl Solver {
         self.grab = None;
         self.time = 0.0;
         self.frame = 0;
+    }
+
+    /// The explicit-spring stability bound of cloth `cloth` (see [`StabilityBound`]),
+    /// linearised at its rest state with the current spring parameters; it limits the substep
+    /// of [`Method::MassSpring`](crate::Method::MassSpring) only.
+    pub fn stability(&self, cloth: usize) -> Option<StabilityBound> {
+        self.stability_all().0.get(cloth).copied()
+    }
+
+    /// Every cloth's bound and the whole solver's, computed once per parameter change.
+    fn stability_all(&self) -> &(Vec<StabilityBound>, StabilityBound) {
+        self.stability.get_or_init(|| {
+            let of = |range: Range<usize>| {
+                bound(
+                    &self.constraints,
+                    &self.initial.positions,
+                    &self.initial.inv_masses,
+                    &self.params,
+                    range,
+                )
+            };
+            let cloths = self
+                .cloths
+                .iter()
+                .map(|c| of(c.particles.clone()))
+                .collect();
+            (cloths, of(0..self.particles.len()))
+        })
     }
 
     /// |C| over the distance-like constraints at the current positions (m).
@@ -411,6 +445,7 @@ impl Solver {
                 &self.constraints,
                 &self.particles,
                 &self.params,
+                h,
                 &mut self.force,
                 &mut self.accel,
             );
@@ -501,6 +536,8 @@ impl Solver {
                 particle,
                 position: self.particles.positions[particle],
                 bound,
+                h: self.settings.h(),
+                stability: self.stability_all().1,
             }),
             None => Ok(()),
         }
