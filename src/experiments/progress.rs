@@ -28,7 +28,12 @@ impl QueueProgress {
 
     /// Counts one finished run and shows `line` above the bar.
     pub fn done(&self, line: &str) {
-        self.bar.println(line);
+        // A hidden bar prints nothing, so off a terminal the line goes to stderr directly.
+        if self.bar.is_hidden() {
+            eprintln!("{line}");
+        } else {
+            self.bar.println(line);
+        }
         self.bar.inc(1);
     }
 
