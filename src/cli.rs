@@ -8,7 +8,7 @@ use weft_solver::Method;
 
 use crate::limits::LimitArgs;
 
-/// Real-time cloth simulation with XPBD, PBD and mass-spring.
+/// Real-time cloth simulation with XPBD, PBD, mass-spring and implicit mass-spring.
 ///
 /// With no command, opens the interactive viewer on the built-in default scene
 /// (assets/scenes/hanging.toml); `weft run` runs scenes headless.
@@ -67,7 +67,7 @@ pub struct RunArgs {
     /// Override a scene key: `--set sim.substeps=20` (repeatable; values are TOML, else strings).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<Override>,
-    /// Shorthand for `--set sim.method=…` (xpbd, pbd or mass-spring).
+    /// Shorthand for `--set sim.method=…` (xpbd, pbd, mass-spring or implicit-mass-spring).
     #[arg(long)]
     pub method: Option<Method>,
     /// Write every cloth's final positions (as float32) to this JSON file.
@@ -115,7 +115,7 @@ pub struct ViewArgs {
     /// Override a scene key: `--set sim.substeps=20` (repeatable; values are TOML, else strings).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<Override>,
-    /// Shorthand for `--set sim.method=…` (xpbd, pbd or mass-spring).
+    /// Shorthand for `--set sim.method=…` (xpbd, pbd, mass-spring or implicit-mass-spring).
     #[arg(long)]
     pub method: Option<Method>,
     /// Log the session to this MCAP file (as `weft run --out`, plus an `/interaction` channel).

@@ -16,6 +16,7 @@ mod replay;
 mod run;
 mod sim;
 mod stop;
+mod stability;
 mod video;
 mod view;
 
@@ -143,9 +144,10 @@ fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Res
 fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
     match weft_scene::load_with(&args.scene, &args.set, &args.limits.limits()) {
         Ok(scene) => {
-            if let Err(e) = scene.build() {
-                return Ok(report(&e.into()));
-            }
+            let groups = match scene.build() {
+                Ok(g) => g,
+                Err(e) => return Ok(report(&e.into())),
+            };
             let methods: Vec<&str> = scene.methods().iter().map(|m| m.name()).collect();
             say!(
                 "{}: ok ({} cloth(s), {} collider(s), methods: {})",
@@ -154,6 +156,17 @@ fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
                 scene.colliders.len(),
                 methods.join(", ")
             )?;
+            for g in &groups {
+                for i in 0..g.solver.cloths().len() {
+                    if let Some(v) = stability::verdict(&g.solver, i) {
+                        if v.ok {
+                            say!("  {}", v.text)?;
+                        } else {
+                            say!("  warning: {}", v.text)?;
+                        }
+                    }
+                }
+            }
             Ok(ExitCode::SUCCESS)
         }
         Err(e) => Ok(report(&e)),

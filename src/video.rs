@@ -75,6 +75,8 @@ pub struct VideoRecorder<'g> {
     gif_stride: u64,
     gif_delay_ms: u32,
     fps: f64,
+    /// The last image written (kept to mark a divergence).
+    last: Option<image::RgbaImage>,
 }
 
 impl<'g> VideoRecorder<'g> {
@@ -123,6 +125,7 @@ impl<'g> VideoRecorder<'g> {
             gif_stride,
             gif_delay_ms,
             fps: 1.0 / (sim.scene.settings.dt * every as f64),
+            last: None,
         })
     }
 
@@ -137,17 +140,41 @@ impl<'g> VideoRecorder<'g> {
             return Ok(());
         }
         let image = self.draw(sim)?;
+        self.write(image)
+    }
+
+    /// Writes one image as the next PNG (and GIF frame, every `gif_stride`).
+    fn write(&mut self, image: image::RgbaImage) -> anyhow::Result<()> {
         let png = self.dir.join(format!("frame_{:05}.png", self.images));
         save_png(&image, &png).with_context(|| format!("cannot write {}", png.display()))?;
         if self.images % self.gif_stride == 0
             && let Some(gif) = self.gif.as_mut()
         {
             let delay = Delay::from_numer_denom_ms(self.gif_delay_ms, 1);
-            gif.encode_frame(Frame::from_parts(image, 0, 0, delay))
+            gif.encode_frame(Frame::from_parts(image.clone(), 0, 0, delay))
                 .with_context(|| format!("cannot write {}", self.gif_partial.display()))?;
         }
         self.images += 1;
+        self.last = Some(image);
         Ok(())
+    }
+
+    /// Completes a run that diverged: the frames up to the divergence, then one second of the
+    /// last of them framed in red, and `diverged.txt` holding `message`, next to the video.
+    pub fn finish_diverged(mut self, message: &str) -> anyhow::Result<Vec<PathBuf>> {
+        if let Some(last) = self.last.take() {
+            let marked = mark_diverged(last);
+            let hold = self.fps.round().max(1.0) as u64;
+            for _ in 0..hold {
+                self.write(marked.clone())?;
+            }
+        }
+        let note = self.dir.join("diverged.txt");
+        std::fs::write(&note, format!("{message}\n"))
+            .with_context(|| format!("cannot write {}", note.display()))?;
+        let mut files = self.finish()?;
+        files.push(note);
+        Ok(files)
     }
 
     /// Draws the current state offscreen and reads it back.
@@ -212,39 +239,7 @@ impl<'g> VideoRecorder<'g> {
 
     /// Encodes the PNGs as H.264 with ffmpeg when it is on PATH; logs and skips otherwise.
     fn mp4(&self) -> anyhow::Result<Option<PathBuf>> {
-        let path = self.dir.join(format!("{}.mp4", self.name));
-        let partial = self.dir.join(format!(".{}.partial.mp4", self.name));
-        let status = Command::new("ffmpeg")
-            .args(["-y", "-loglevel", "error", "-framerate"])
-            .arg(format!("{:.6}", self.fps))
-            .arg("-i")
-            .arg(self.dir.join("frame_%05d.png"))
-            .args([
-                "-c:v",
-                "libx264",
-                "-pix_fmt",
-                "yuv420p",
-                "-vf",
-                "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-            ])
-            .arg(&partial)
-            .status();
-        match status {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                eprintln!("weft: ffmpeg is not on PATH: skipping {}", path.display());
-                Ok(None)
-            }
-            Err(e) => Err(e).context("cannot run ffmpeg"),
-            Ok(s) if !s.success() => {
-                let _ = std::fs::remove_file(&partial);
-                bail!("ffmpeg failed ({s}) encoding {}", path.display())
-            }
-            Ok(_) => {
-                std::fs::rename(&partial, &path)
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-                Ok(Some(path))
-            }
-        }
+        encode_mp4(&self.dir, &self.name, self.fps)
     }
 }
 
@@ -255,6 +250,66 @@ impl Drop for VideoRecorder<'_> {
             let _ = std::fs::remove_file(&self.gif_partial);
         }
     }
+}
+
+/// `dir/frame_%05d.png` encoded as `dir/<name>.mp4` (H.264) at `fps` when ffmpeg is on PATH;
+/// logs and returns `None` otherwise.
+pub fn encode_mp4(dir: &Path, name: &str, fps: f64) -> anyhow::Result<Option<PathBuf>> {
+    let path = dir.join(format!("{name}.mp4"));
+    let partial = dir.join(format!(".{name}.partial.mp4"));
+    let status = Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-framerate"])
+        .arg(format!("{fps:.6}"))
+        .arg("-i")
+        .arg(dir.join("frame_%05d.png"))
+        .args([
+            "-c:v",
+            "libx264",
+            "-pix_fmt",
+            "yuv420p",
+            "-vf",
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+        ])
+        .arg(&partial)
+        .status();
+    match status {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            eprintln!("weft: ffmpeg is not on PATH: skipping {}", path.display());
+            Ok(None)
+        }
+        Err(e) => Err(e).context("cannot run ffmpeg"),
+        Ok(s) if !s.success() => {
+            let _ = std::fs::remove_file(&partial);
+            bail!("ffmpeg failed ({s}) encoding {}", path.display())
+        }
+        Ok(_) => {
+            std::fs::rename(&partial, &path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            Ok(Some(path))
+        }
+    }
+}
+
+/// Width of the red frame that marks a diverged run's last image (px).
+pub const DIVERGED_BORDER: u32 = 12;
+
+/// `image` framed in red and dimmed inside: the mark of a run that diverged after it.
+pub fn mark_diverged(mut image: image::RgbaImage) -> image::RgbaImage {
+    let (w, h) = image.dimensions();
+    for (x, y, p) in image.enumerate_pixels_mut() {
+        let edge = x < DIVERGED_BORDER
+            || y < DIVERGED_BORDER
+            || x + DIVERGED_BORDER >= w
+            || y + DIVERGED_BORDER >= h;
+        if edge {
+            *p = image::Rgba([220, 30, 30, 255]);
+        } else {
+            p.0[0] = p.0[0] / 2 + 100;
+            p.0[1] /= 2;
+            p.0[2] /= 2;
+        }
+    }
+    image
 }
 
 /// Writes `image` as a PNG with the strongest compression (about half the default's size).
@@ -397,6 +452,15 @@ mod tests {
             let e = parse_size(bad).expect_err(bad);
             assert!(e.contains(bad), "{e}");
         }
+    }
+
+    #[test]
+    fn a_diverged_frame_is_framed_in_red_and_dimmed() {
+        let img = image::RgbaImage::from_pixel(100, 80, image::Rgba([200, 200, 200, 255]));
+        let m = mark_diverged(img);
+        assert_eq!(m.get_pixel(0, 0).0, [220, 30, 30, 255]);
+        assert_eq!(m.get_pixel(99, 40).0, [220, 30, 30, 255]);
+        assert_eq!(m.get_pixel(50, 40).0, [200, 100, 100, 255]);
     }
 
     #[test]

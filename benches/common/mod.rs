@@ -46,7 +46,7 @@ pub fn reference_overrides(n: usize, method: Method) -> Vec<String> {
         format!("cloth.reference.resolution=[{n}, {n}]"),
         format!("sim.method={}", method.name()),
     ];
-    if method == Method::MassSpring {
+    if matches!(method, Method::MassSpring | Method::ImplicitMassSpring) {
         let probe = load("reference.toml", &ov);
         let m = probe.cloths[0]
             .mesh
@@ -72,7 +72,7 @@ pub fn reference(n: usize, method: Method) -> SolverGroup {
 pub fn evaluations_per_frame(g: &SolverGroup) -> u64 {
     let s = g.solver.settings();
     let per_substep = match s.method {
-        Method::MassSpring => 1,
+        Method::MassSpring | Method::ImplicitMassSpring => 1,
         _ => u64::from(s.iterations),
     };
     g.solver.constraints().len() as u64 * u64::from(s.substeps) * per_substep

@@ -144,6 +144,18 @@ fn scene_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out
         let r = session.set_method(m);
         note(state, r);
     }
+    for g in &session.sim.groups {
+        for i in 0..g.solver.cloths().len() {
+            if let Some(v) = crate::stability::verdict(&g.solver, i) {
+                let color = if v.ok {
+                    ui.visuals().weak_text_color()
+                } else {
+                    egui::Color32::from_rgb(255, 110, 110)
+                };
+                ui.colored_label(color, v.text);
+            }
+        }
+    }
     ui.horizontal(|ui| {
         let paused = session.clock.paused();
         let buttons = [

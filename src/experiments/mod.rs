@@ -2,7 +2,9 @@
 //! shard of it), logs each run to MCAP, and writes a summary table and plots.
 
 mod metrics;
+mod montage;
 mod plot;
+mod progress;
 mod report;
 mod spec;
 
@@ -197,41 +199,59 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         // From here a signal raises the flag: running runs close their logs, runs not yet
         // started are left `not run`.
         let _polling = crate::stop::Polling::start();
+        let bar = progress::QueueProgress::new(mine.len());
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
                 .zip(scenes)
                 .map(|(r, scene)| {
                     if stop.load(Ordering::SeqCst) {
+                        bar.done(&format!("  run {:>3} {} {}: {NOT_RUN}", r.index, r.series, r.label));
                         return Ok(not_run(r));
                     }
-                    let result = execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)?;
-                    // Written as soon as the run ends, so a killed queue keeps what it did.
-                    let path = result_path(&out, r.index);
-                    crate::output::write_file(
-                        &path,
-                        serde_json::to_string_pretty(&result)?.as_bytes(),
-                    )?;
-                    Ok(result)
+                    let res = execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)
+                        .and_then(|result| {
+                            // Written as soon as the run ends, so a killed queue keeps what it did.
+                            let path = result_path(&out, r.index);
+                            crate::output::write_file(
+                                &path,
+                                serde_json::to_string_pretty(&result)?.as_bytes(),
+                            )?;
+                            Ok(result)
+                        });
+                    bar.done(&match &res {
+                        Ok(x) => format!(
+                            "  run {:>3} {} {}: {}",
+                            r.index, r.series, r.label, x.status
+                        ),
+                        Err(e) => format!(
+                            "  run {:>3} {} {}: error: {e:#}",
+                            r.index, r.series, r.label
+                        ),
+                    });
+                    res
                 })
                 .collect()
         });
+        bar.finish();
+        let mut tiles: Vec<(String, montage::Tile)> = Vec::new();
         for (r, res) in mine.iter().zip(results) {
             match res {
                 Ok(result) => {
-                    eprintln!(
-                        "  run {:>3} {} {}: {}",
-                        r.index, r.series, r.label, result.status
-                    );
+                    tiles.push((
+                        r.series.clone(),
+                        montage::Tile {
+                            label: r.label.clone(),
+                            dir: out.join(run_dir(r)),
+                            diverged: result.status.starts_with("diverged"),
+                        },
+                    ));
                     failed |= result.status != "complete";
                 }
-                Err(e) => {
-                    eprintln!(
-                        "  run {:>3} {} {}: error: {e:#}",
-                        r.index, r.series, r.label
-                    );
-                    failed = true;
-                }
+                Err(_) => failed = true,
             }
+        }
+        if gpu.is_some() {
+            write_montages(&spec.title, tiles, &out)?;
         }
     }
     report::write(&spec, &runs, &out)?;
@@ -257,6 +277,46 @@ fn not_run(r: &PlannedRun) -> RunResult {
     }
 }
 
+/// A run's folder (and, with `.mcap`, its log) relative to the output directory.
+fn run_dir(r: &PlannedRun) -> String {
+    format!(
+        "runs/{:03}-{}",
+        r.index,
+        slug(&format!("{} {}", r.series, r.label))
+    )
+}
+
+/// One side-by-side video per series, of its runs in queue order (`series/<series>/`).
+fn write_montages(
+    title: &str,
+    tiles: Vec<(String, montage::Tile)>,
+    out: &Path,
+) -> anyhow::Result<()> {
+    let mut names: Vec<String> = Vec::new();
+    for (s, _) in &tiles {
+        if !names.contains(s) {
+            names.push(s.clone());
+        }
+    }
+    for name in names {
+        let of: Vec<montage::Tile> = tiles
+            .iter()
+            .filter(|(s, _)| *s == name)
+            .map(|(_, t)| montage::Tile {
+                label: t.label.clone(),
+                dir: t.dir.clone(),
+                diverged: t.diverged,
+            })
+            .collect();
+        let dir = out.join("series").join(slug(&name));
+        let files = montage::write(&format!("{title}: {name}"), &of, &dir)?;
+        for f in files {
+            eprintln!("  series {name}: {}", f.display());
+        }
+    }
+    Ok(())
+}
+
 fn execute(
     spec: &Spec,
     r: &PlannedRun,
@@ -274,11 +334,7 @@ fn execute(
     };
     let mut sim = Simulation::new(scene)?;
     sim.set_stop(Arc::clone(stop));
-    let rel = format!(
-        "runs/{:03}-{}.mcap",
-        r.index,
-        slug(&format!("{} {}", r.series, r.label))
-    );
+    let rel = format!("{}.mcap", run_dir(r));
     let log = mcap.then(|| Output::create(&out.join(&rel))).transpose()?;
     let mut rec = match &log {
         Some(o) => {
@@ -344,10 +400,12 @@ fn execute(
     } else {
         logged?;
     }
-    if let Some(v) = video
-        && !matches!(status, Status::Diverged(_))
-    {
-        v.finish()?;
+    // A run that diverged keeps its frames up to the divergence, marked.
+    if let Some(v) = video {
+        match &status {
+            Status::Diverged(m) => v.finish_diverged(m)?,
+            _ => v.finish()?,
+        };
     }
     let metrics = meter
         .values(&sim)

@@ -107,6 +107,7 @@ pub fn method_color(method: weft_solver::Method) -> Color {
         weft_solver::Method::Xpbd => (0.25, 0.55, 0.95),
         weft_solver::Method::Pbd => (0.95, 0.55, 0.2),
         weft_solver::Method::MassSpring => (0.4, 0.8, 0.35),
+        weft_solver::Method::ImplicitMassSpring => (0.75, 0.4, 0.85),
     };
     Color { r, g, b, a: 1.0 }
 }

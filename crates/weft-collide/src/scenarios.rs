@@ -33,7 +33,7 @@ pub fn method_setup(method: Method) -> (Settings, ClothParams) {
     match method {
         Method::Xpbd => {}
         Method::Pbd => settings.iterations = 4,
-        Method::MassSpring => {
+        Method::MassSpring | Method::ImplicitMassSpring => {
             settings.substeps = 40;
             params = params
                 .edit(Family::Stretch, |f| {

@@ -9,6 +9,7 @@ mod error;
 pub mod family;
 mod limits;
 mod load;
+pub mod material;
 mod overrides;
 mod ranges;
 mod resolve;

@@ -11,7 +11,7 @@ use weft_solver::{
 };
 
 use crate::error::SceneError;
-use crate::family::{self, Field};
+use crate::family::{self, Field, Setting};
 use crate::ranges::{self, Range};
 use crate::scene::{ClothSpec, ColliderSpec, Files, SelfCollisionSpec, ShapeSpec};
 use crate::schema::{
@@ -290,7 +290,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
     let cloths: Vec<ClothSpec> = file
         .cloth
         .iter()
-        .filter_map(|(name, section)| cloth(c, name, section, settings.method))
+        .filter_map(|(name, section)| cloth(c, name, section, &settings))
         .collect();
     let colliders: Vec<ColliderSpec> = file
         .collider
@@ -378,7 +378,12 @@ fn named_pin(name: &str) -> Option<Pin> {
     })
 }
 
-fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> Option<ClothSpec> {
+fn cloth(
+    c: &mut Checker<'_>,
+    name: &str,
+    s: &ClothSection,
+    settings: &Settings,
+) -> Option<ClothSpec> {
     let k = |field: &str| format!("cloth.{name}.{field}");
     let before = c.errors.len();
     if !valid_name(name) {
@@ -387,7 +392,17 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             "a cloth name may hold only letters, digits, `_` and `-`",
         );
     }
-    let method = s.method.map(Method::from).unwrap_or(default);
+    let method = s.method.map(Method::from).unwrap_or(settings.method);
+    let material = s
+        .material
+        .as_ref()
+        .and_then(|m| match crate::material::resolve(m) {
+            Ok(m) => Some(m),
+            Err((field, message)) => {
+                c.bad(&k(&field), message);
+                None
+            }
+        });
     let mass = match (s.mass, s.density) {
         (Some(_), Some(_)) => {
             c.bad(&k("density"), "give `mass` or `density`, not both");
@@ -401,13 +416,13 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             c.within(&k("density"), d, &ranges::DENSITY);
             Mass::Density(d)
         }
-        (None, None) => Mass::Total(1.0),
+        (None, None) => material.map_or(Mass::Total(1.0), |m| Mass::Density(m.density)),
     };
     let center = c.vector(&k("center"), s.center.unwrap_or_default());
     let pins = s.pins.clone().unwrap_or_default();
     let mut params = ClothParams::default();
-    let settings = s.family_settings();
-    for &(fam, setting) in &settings {
+    let entries = s.family_settings();
+    for &(fam, setting) in &entries {
         if let Some(v) = setting.number() {
             c.rule(
                 &k(&family::key(fam, setting.field())),
@@ -416,7 +431,7 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             );
         }
     }
-    for &(fam, setting) in &settings {
+    for &(fam, setting) in &entries {
         let field = setting.field();
         let range = match field {
             Field::Compliance => &ranges::COMPLIANCE,
@@ -430,7 +445,6 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
             c.within(&k(&family::key(fam, field)), v, range);
         }
     }
-    family::apply(&settings, &mut params);
     let thickness = s.thickness.unwrap_or(0.005);
     c.within(&k("thickness"), thickness, &ranges::THICKNESS);
     let motion = c.motion(&k("motion"), &s.motion);
@@ -517,6 +531,26 @@ fn cloth(c: &mut Checker<'_>, name: &str, s: &ClothSection, default: Method) -> 
         .map_err(|e| mesh_error(c, name, &e, false))
         .ok()?
     };
+    if let Some(m) = material {
+        params = m.params(&mesh, settings, &params);
+    }
+    family::apply(&entries, &mut params);
+    // Spring constants not given in the file scale with the cloth's particle masses, so the
+    // explicit mass-spring method is stable at the default substeps (weft_solver::spring_defaults).
+    let unset: Vec<weft_solver::Family> = weft_solver::Family::ALL
+        .into_iter()
+        .filter(|&f| {
+            !entries
+                .iter()
+                .any(|&(g, setting)| g == f && matches!(setting, Setting::SpringStiffness(_)))
+        })
+        .collect();
+    if c.errors.len() == before && material.is_none() {
+        match weft_solver::stable_spring_defaults(&mesh, &params, &unset) {
+            Ok(p) => params = p,
+            Err(e) => c.bad(&format!("cloth.{name}"), e.to_string()),
+        }
+    }
     (c.errors.len() == before).then(|| ClothSpec {
         name: name.to_owned(),
         method,

@@ -33,7 +33,7 @@ pub struct SceneFile {
     pub self_collision: Option<SelfCollisionSection>,
 }
 
-/// A method name: `xpbd`, `pbd` or `mass-spring`.
+/// A method name: `xpbd`, `pbd`, `mass-spring` or `implicit-mass-spring` (alias `implicit`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum MethodName {
@@ -44,6 +44,9 @@ pub enum MethodName {
     Pbd,
     /// Mass-spring.
     MassSpring,
+    /// Implicit (backward Euler) mass-spring.
+    #[serde(alias = "implicit")]
+    ImplicitMassSpring,
 }
 
 impl From<MethodName> for weft_solver::Method {
@@ -52,6 +55,7 @@ impl From<MethodName> for weft_solver::Method {
             MethodName::Xpbd => weft_solver::Method::Xpbd,
             MethodName::Pbd => weft_solver::Method::Pbd,
             MethodName::MassSpring => weft_solver::Method::MassSpring,
+            MethodName::ImplicitMassSpring => weft_solver::Method::ImplicitMassSpring,
         }
     }
 }
@@ -104,7 +108,7 @@ impl<'de> Deserialize<'de> for Seconds {
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimSection {
-    /// Default method of every cloth: `xpbd`, `pbd` or `mass-spring`.
+    /// Default method of every cloth: `xpbd`, `pbd`, `mass-spring` or `implicit-mass-spring`.
     #[serde(default)]
     pub method: MethodName,
     /// Frame time step (s); a number or `"1/60"`.
@@ -383,6 +387,10 @@ cloth_section! {
         /// Collision thickness (m).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub thickness: Option<f64>,
+        /// Fabric in physical units: a preset name or a table (see [`crate::material`]); the
+        /// family keys override what it derives.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub material: Option<crate::material::MaterialSpec>,
     }
     families {
         Stretch: stretch_enabled, stretch_compliance, stretch_damping,

@@ -5,6 +5,7 @@ use thiserror::Error;
 
 use crate::method::Method;
 pub use crate::params::ParamError;
+use crate::stability::StabilityBound;
 
 /// A cloth mesh that cannot be simulated.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -86,7 +87,8 @@ pub enum SolverError {
     /// The simulation blew up: a position became non-finite or left the sane bound.
     #[error(
         "{method} simulation diverged at frame {frame}: particle {particle} reached {position} \
-         (bound {bound} m); lower the stiffness or the time step, or add substeps"
+         (divergence bound {bound} m){}",
+        limit_hint(*.method, *.h, .stability)
     )]
     Diverged {
         /// The method that was running.
@@ -99,6 +101,10 @@ pub enum SolverError {
         position: DVec3,
         /// The bound that was crossed (m).
         bound: f64,
+        /// The substep length (s).
+        h: f64,
+        /// The explicit-spring stability bound of the whole solver (every cloth).
+        stability: StabilityBound,
     },
     /// The stop flag (see `Solver::set_stop`) was raised inside a frame, which was abandoned.
     #[error("stopped inside frame {frame}")]
@@ -140,4 +146,43 @@ pub enum BuildError {
         /// Number of masses.
         masses: usize,
     },
+}
+
+/// Which limit a divergence passed: the springs' stability limit, or none the solver knows.
+fn limit_hint(method: Method, h: f64, b: &StabilityBound) -> String {
+    let (sure, mode) = (b.max_substep(), b.mode_max_substep());
+    let ms = |s: f64| s * 1e3;
+    if !method.is_explicit() {
+        return "; lower the stiffness or the time step, or add substeps".to_owned();
+    }
+    if h >= mode {
+        format!(
+            "; substep h = {:.3} ms is past the springs' stability limit h < {:.3} ms of their \
+             highest mode ω = {:.0} rad/s (semi-implicit Euler needs h²ω² + 2hγ < 4; \
+             guaranteed below {:.3} ms by Gershgorin's bound ω ≤ {:.0} rad/s): soften the \
+             springs or add substeps",
+            ms(h),
+            ms(mode),
+            b.mode_omega,
+            ms(sure),
+            b.omega
+        )
+    } else if h >= sure {
+        format!(
+            "; substep h = {:.3} ms is inside the springs' highest-mode limit {:.3} ms but past \
+             the guaranteed one, {:.3} ms (Gershgorin bound ω ≤ {:.0} rad/s)",
+            ms(h),
+            ms(mode),
+            ms(sure),
+            b.omega
+        )
+    } else {
+        format!(
+            "; substep h = {:.3} ms was inside the springs' guaranteed stability limit {:.3} ms \
+             (ω ≤ {:.0} rad/s), so contact, pins, forces or stretched tethers drove it",
+            ms(h),
+            ms(sure),
+            b.omega
+        )
+    }
 }

@@ -16,13 +16,17 @@ mod error;
 mod forces;
 mod grid;
 mod hook;
+mod material;
 mod method;
 mod methods;
 mod motion;
 mod params;
 mod particles;
+mod presets;
 mod settings;
 mod solver;
+mod spring_defaults;
+mod stability;
 mod topology;
 
 pub use builder::SolverBuilder;
@@ -33,12 +37,16 @@ pub use error::{BuildError, MeshError, ParamError, SolverError};
 pub use forces::{Aero, Forces, Wind};
 pub use grid::{Corner, Edge, GridDesc, Orientation, Pin};
 pub use hook::{SubstepContext, SubstepHook};
+pub use material::{Material, MaterialStiffness};
 pub use method::{Method, UnknownMethod};
 pub use motion::{KinematicPin, Motion, RigidTransform};
 pub use params::{ClothParams, Family, FamilyParams};
 pub use particles::Particles;
+pub use presets::{PRESETS, preset, preset_names};
 pub use settings::Settings;
 pub use solver::{Cloth, Solver, StepStats};
+pub use spring_defaults::{DEFAULT_SPRING_HW, DEFAULT_SPRING_SUBSTEP, stable_spring_defaults};
+pub use stability::StabilityBound;
 pub use topology::{EdgeWings, Topology};
 
 /// Re-export of the math library, so users share our `DVec3`.

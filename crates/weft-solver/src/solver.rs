@@ -17,6 +17,7 @@ use crate::motion::KinematicPin;
 use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
 use crate::settings::Settings;
+use crate::stability::{StabilityBound, bound};
 
 /// A cloth inside a solver: its particle range and its mesh in global particle indices.
 #[derive(Clone, Debug, PartialEq)]
@@ -73,6 +74,11 @@ pub struct Solver {
     frame: u64,
     /// Raised by the caller to abandon the frame in progress (polled once per substep).
     stop: Option<Arc<AtomicBool>>,
+    /// Stability bounds of each cloth and of the whole solver, computed when first asked for
+    /// and cleared when parameters change.
+    stability: std::sync::OnceLock<(Vec<StabilityBound>, StabilityBound)>,
+    /// The particles as built (rest state), for the stability bounds.
+    initial: Particles,
 }
 
 impl Solver {
@@ -97,6 +103,7 @@ impl Solver {
             forces,
             domains,
             targets: Vec::new(),
+            initial: particles.clone(),
             particles,
             cloths,
             all_triangles,
@@ -109,6 +116,7 @@ impl Solver {
             time: 0.0,
             frame: 0,
             stop: None,
+            stability: std::sync::OnceLock::new(),
         }
     }
 
@@ -218,6 +226,7 @@ impl Solver {
         params.validate()?;
         let base = cloth * Family::COUNT;
         self.params[base..base + Family::COUNT].copy_from_slice(&params.families);
+        self.stability = std::sync::OnceLock::new();
         Ok(())
     }
 
@@ -237,6 +246,34 @@ impl Solver {
     /// Frames stepped so far.
     pub fn frame(&self) -> u64 {
         self.frame
+    }
+
+    /// The explicit-spring stability bound of cloth `cloth` (see [`StabilityBound`]),
+    /// linearised at its rest state with the current spring parameters; it limits the substep
+    /// of [`Method::MassSpring`](crate::Method::MassSpring) only.
+    pub fn stability(&self, cloth: usize) -> Option<StabilityBound> {
+        self.stability_all().0.get(cloth).copied()
+    }
+
+    /// Every cloth's bound and the whole solver's, computed once per parameter change.
+    fn stability_all(&self) -> &(Vec<StabilityBound>, StabilityBound) {
+        self.stability.get_or_init(|| {
+            let of = |range: Range<usize>| {
+                bound(
+                    &self.constraints,
+                    &self.initial.positions,
+                    &self.initial.inv_masses,
+                    &self.params,
+                    range,
+                )
+            };
+            let cloths = self
+                .cloths
+                .iter()
+                .map(|c| of(c.particles.clone()))
+                .collect();
+            (cloths, of(0..self.particles.len()))
+        })
     }
 
     /// |C| over the distance-like constraints at the current positions (m).
@@ -431,6 +468,7 @@ impl Solver {
                 &self.constraints,
                 &self.particles,
                 &self.params,
+                h,
                 &mut self.force,
                 &mut self.accel,
             );
@@ -521,6 +559,8 @@ impl Solver {
                 particle,
                 position: self.particles.positions[particle],
                 bound,
+                h: self.settings.h(),
+                stability: self.stability_all().1,
             }),
             None => Ok(()),
         }

@@ -73,7 +73,7 @@ fn run_in_pool(threads: usize, method: Method, domain_size: usize) -> Vec<[u64; 
 #[test]
 fn results_are_bit_identical_across_thread_counts() {
     // 48² = 2304 particles in domains of 256: nine domains and their links.
-    for method in [Method::Xpbd, Method::Pbd, Method::MassSpring] {
+    for method in Method::ALL {
         let reference = run_in_pool(1, method, 256);
         assert_eq!(reference, run_in_pool(1, method, 256), "{method}: twice");
         assert_eq!(

@@ -102,3 +102,64 @@ fn a_nan_is_reported_with_its_particle_not_propagated() {
         other => panic!("expected divergence at frame 5, got {other:?}"),
     }
 }
+
+/// The soft cloth: 40², 1.6 m, 0.15 kg/m², pinned at two corners, springs of 100, 50
+/// and 5 N/m (stretch, shear, bend-distance), no damping.
+fn soft_grid(substeps: u32) -> weft_solver::Solver {
+    use weft_solver::{Family, GridDesc, Mass, Orientation};
+    let mesh = GridDesc {
+        resolution: (40, 40),
+        size: (1.6, 1.6),
+        orientation: Orientation::Horizontal,
+        mass: Mass::Density(0.15),
+        ..GridDesc::default()
+    }
+    .build()
+    .expect("valid grid");
+    let mut params = in_plane(0.0, 1.0, 100.0);
+    params.get_mut(Family::Shear).spring_stiffness = 50.0;
+    let bend = params.get_mut(Family::BendDistance);
+    bend.enabled = true;
+    bend.spring_stiffness = 5.0;
+    solver(
+        settings(Method::MassSpring, DT, substeps, 1),
+        Forces::default(),
+        &mesh,
+        params,
+    )
+}
+
+#[test]
+fn the_stability_bound_predicts_where_explicit_springs_explode() {
+    let b = soft_grid(1).stability(0).expect("one cloth");
+    // One spring's √(k/m) of an interior particle says far less than the grid's highest mode.
+    let m = 0.15 * (1.6f64 / 39.0).powi(2);
+    let one_spring = (100.0 / m).sqrt();
+    assert!(
+        b.mode_omega > 2.0 * one_spring,
+        "{} vs {one_spring}",
+        b.mode_omega
+    );
+    assert!(
+        b.mode_omega <= b.omega,
+        "the mode cannot exceed Gershgorin's bound"
+    );
+    // Below the guaranteed limit: 300 frames run. 15 % past the mode's limit: it explodes.
+    let safe = (DT / b.max_substep()).floor() as u32 + 1;
+    let mut s = soft_grid(safe);
+    run(&mut s, 300);
+    let past = (DT / (1.15 * b.mode_max_substep())).floor() as u32;
+    let mut s = soft_grid(past);
+    let err = (0..300)
+        .find_map(|_| s.step().err())
+        .unwrap_or_else(|| panic!("{past} substeps (h past the limit) must diverge"));
+    println!(
+        "highest mode ω = {:.0} rad/s (Gershgorin ≤ {:.0}); {safe} substeps run, {past} diverge: {err}",
+        b.mode_omega, b.omega
+    );
+    assert!(
+        err.to_string()
+            .contains("past the springs' stability limit"),
+        "{err}"
+    );
+}

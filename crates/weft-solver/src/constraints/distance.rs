@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::Shape;
+use super::{Shape, distance_curvature};
 
 /// Keeps two particles at a rest distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -21,5 +21,10 @@ impl Shape<2> for Distance {
         }
         let n = d / len;
         Some((len - self.rest, [n, -n]))
+    }
+
+    #[inline]
+    fn curvature_product(&self, p: &[DVec3; 2], dp: &[DVec3; 2]) -> [DVec3; 2] {
+        distance_curvature(p, dp)
     }
 }

@@ -4,11 +4,13 @@ mod block;
 mod dihedral;
 mod distance;
 pub(crate) mod lanes;
+mod linear;
 mod tether;
 
 pub(crate) use block::{Block, BlockBuilder, Rule};
 pub use dihedral::Dihedral;
 pub use distance::Distance;
+pub(crate) use linear::Springs;
 pub use tether::Tether;
 
 use glam::DVec3;
@@ -19,6 +21,27 @@ use crate::params::FamilyParams;
 pub trait Shape<const N: usize>: Copy + Send + Sync {
     /// Returns C and ∇C at `p`, or `None` when the constraint is inactive or degenerate there.
     fn evaluate(&self, p: &[DVec3; N]) -> Option<(f64, [DVec3; N])>;
+
+    /// The Hessian of C at `p` applied to `dp`, (∇²C) dp, where it has a closed form; zero
+    /// otherwise (the implicit method then uses ∇C ∇Cᵀ alone).
+    fn curvature_product(&self, _p: &[DVec3; N], _dp: &[DVec3; N]) -> [DVec3; N] {
+        [DVec3::ZERO; N]
+    }
+}
+
+/// (∇²C) dp of a distance C = |p₀ − p₁| − d: with n = (p₀ − p₁)/|p₀ − p₁|, the block
+/// ∂²C/∂p₀² = (I − n nᵀ)/|p₀ − p₁| and the others ± the same.
+#[inline]
+pub(crate) fn distance_curvature(p: &[DVec3; 2], dp: &[DVec3; 2]) -> [DVec3; 2] {
+    let d = p[0] - p[1];
+    let len = d.length();
+    if len < 1e-9 {
+        return [DVec3::ZERO; 2];
+    }
+    let n = d / len;
+    let r = dp[0] - dp[1];
+    let h = (r - n * n.dot(r)) / len;
+    [h, -h]
 }
 
 /// Every constraint of a solver: distance-like pairs, dihedral quadruples and tethers.

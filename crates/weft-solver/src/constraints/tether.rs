@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::Shape;
+use super::{Shape, distance_curvature};
 
 /// Keeps a particle within a maximum distance of its pinned anchor (`[particle, anchor]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -21,5 +21,10 @@ impl Shape<2> for Tether {
         }
         let n = d / len;
         Some((len - self.max_length, [n, -n]))
+    }
+
+    #[inline]
+    fn curvature_product(&self, p: &[DVec3; 2], dp: &[DVec3; 2]) -> [DVec3; 2] {
+        distance_curvature(p, dp)
     }
 }

@@ -16,6 +16,7 @@ impl Strategy for MassSpring {
         constraints: &ConstraintSet,
         particles: &Particles,
         params: &[FamilyParams],
+        _h: f64,
         force: &mut [DVec3],
         accel: &mut [DVec3],
     ) {

@@ -1,9 +1,11 @@
 //! One small strategy per method.
 
+mod implicit_mass_spring;
 mod mass_spring;
 mod pbd;
 mod xpbd;
 
+pub(crate) use implicit_mass_spring::ImplicitMassSpring;
 pub(crate) use mass_spring::MassSpring;
 pub(crate) use pbd::Pbd;
 pub(crate) use xpbd::Xpbd;

@@ -1,0 +1,63 @@
+//! `cloth.<name>.material`: presets, per-field overrides, family keys on top, and errors that
+//! name the key and line.
+
+use weft_scene::{MapFiles, from_text};
+use weft_solver::{Family, preset};
+
+fn scene(cloth: &str) -> Result<weft_scene::Scene, weft_scene::SceneErrors> {
+    let text = format!("[sim]\nsubsteps = 10\n\n[cloth.c]\nresolution = [16, 16]\n{cloth}\n");
+    from_text("t.toml", &text, &[], &MapFiles::default())
+}
+
+#[test]
+fn a_preset_sets_mass_and_every_method_and_turns_dihedral_bending_on() {
+    let s = scene("material = \"denim\"").expect("valid");
+    let c = &s.cloths[0];
+    let denim = preset("denim").expect("preset");
+    assert!(
+        (c.mesh.total_mass() - denim.density).abs() < 1e-12,
+        "1 m² of 400 g/m²"
+    );
+    let p = c.params;
+    assert!(p.get(Family::BendDihedral).enabled && !p.get(Family::BendDistance).enabled);
+    let st = p.get(Family::Stretch);
+    // Square cells: k = E − G per grid line; XPBD gets 1/k.
+    assert!((st.spring_stiffness - (denim.stretch - denim.shear)).abs() < 1e-6);
+    assert!((st.compliance * st.spring_stiffness - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn fields_and_family_keys_override_the_preset() {
+    let s = scene(
+        "material = { preset = \"cotton\", bending = 2e-5, density = 200 }\nshear_compliance = 0.5",
+    )
+    .expect("valid");
+    let c = &s.cloths[0];
+    assert!((c.mesh.total_mass() - 0.2).abs() < 1e-12);
+    let p = c.params;
+    assert!((p.get(Family::BendDihedral).spring_stiffness - 2e-5).abs() < 1e-15);
+    assert_eq!(p.get(Family::Shear).compliance, 0.5);
+}
+
+#[test]
+fn bad_materials_are_named_with_their_key_and_line() {
+    let e = scene("material = \"tweed\"")
+        .expect_err("unknown preset")
+        .to_string();
+    assert!(
+        e.contains("cloth.c.material") && e.contains("tweed") && e.contains("cotton"),
+        "{e}"
+    );
+    assert!(e.contains("t.toml:6"), "{e}");
+    let e = scene("material = { stretch = 100.0 }")
+        .expect_err("incomplete")
+        .to_string();
+    assert!(
+        e.contains("cloth.c.material.density") && e.contains("missing"),
+        "{e}"
+    );
+    let e = scene("material = { preset = \"silk\", shear = -1.0 }")
+        .expect_err("negative")
+        .to_string();
+    assert!(e.contains("cloth.c.material.shear"), "{e}");
+}

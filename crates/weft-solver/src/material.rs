@@ -1,0 +1,293 @@
+//! Fabrics in physical units, and the constraint parameters every method derives from them.
+//!
+//! A [`Material`] gives an area density and three membrane/plate stiffnesses; [`Material::params`]
+//! turns them into per-family parameters for a given mesh and time stepping, so the same fabric
+//! behaves the same at any resolution:
+//!
+//! * **Stretch** (mesh edges): Van Gelder's spring constant for a triangulated membrane,
+//!   k = E Σ A_t / |e|² over the triangles t beside edge e (Van Gelder 1998, "Approximate
+//!   simulation of elastic membranes by triangulated spring meshes", J. Graphics Tools 3(2),
+//!   eq. 8). On grids, whose quad diagonals carry the shear springs, the diagonals already add
+//!   G to the lattice's C₁₁ (below), so the grid lines get E − G: a square lattice of edge
+//!   springs k_s and diagonal springs k_d strained uniformly stores
+//!   W = ½ k_s (ε_xx² + ε_yy²) + ½ k_d ((ε_xx + ε_yy)² + 4 ε_xy²) per unit area
+//!   (Ostoja-Starzewski 2002, "Lattice models in micromechanics", Appl. Mech. Rev. 55(1), §2),
+//!   i.e. C₁₁ = k_s + k_d and C₆₆ = k_d.
+//! * **Shear** (both quad diagonals, length d, of a cell of area A): the same energy on a
+//!   rectangular cell gives C₆₆ = 2 k_d A / d², so k_d = G d² / (2A) (= G on square cells).
+//! * **Bending** (dihedral angle across each interior edge e, A_e the area of its two
+//!   triangles): k_θ = B |e|² / A_e (N·m/rad), the edge weight of the discrete-shells energy
+//!   (Grinspun et al. 2003, "Discrete shells", eq. 3, where |e|/h̄_e = 3|e|²/A_e; Bridson et al.
+//!   2003 weight their bending force by |e|²/A_e too), scaled so that a grid bent into a
+//!   cylinder of curvature κ about its grid lines stores ½ B κ² per unit area: there only the
+//!   grid lines fold, by θ = κL, each for L² of cloth, so ½ k_θ θ² = ½ B κ² L² gives k_θ = B
+//!   = B L²/A_e. The distance-based bending family is switched off.
+//!
+//! Each family keeps one value per cloth (the median over its constraints, i.e. the interior
+//! value on grids of square cells; boundary edges, which Van Gelder gives half, get the
+//! interior value too, and on rectangular cells the two directions of grid lines share one). XPBD gets compliance α = 1/k; both mass-spring methods get k; PBD gets the
+//! stiffness whose n iterations remove the fraction of C per substep that XPBD's first
+//! iteration removes, f = s / (s + α/h²) with s = Σ wᵢ |∇ᵢC|² at rest (Macklin et al. 2016,
+//! eq. 18), through Müller et al. 2007's k' = 1 − (1 − k)ⁿ: k = 1 − (1 − f)^{1/n}.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::cloth::ClothMesh;
+use crate::constraints::{Dihedral, Shape};
+use crate::error::ParamError;
+use crate::params::{ClothParams, Family};
+use crate::settings::Settings;
+use crate::topology::Topology;
+
+/// A fabric in physical units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Area density (kg/m²).
+    pub density: f64,
+    /// Membrane stretch stiffness E·thickness, the 2-D Young's modulus (N/m).
+    pub stretch: f64,
+    /// Membrane in-plane shear stiffness G·thickness (N/m).
+    pub shear: f64,
+    /// Bending stiffness per unit width, B (N·m).
+    pub bending: f64,
+}
+
+impl Material {
+    /// Checks every value is finite and positive.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for (name, value) in [
+            ("density", self.density),
+            ("stretch", self.stretch),
+            ("shear", self.shear),
+            ("bending", self.bending),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(ParamError {
+                    name: format!("material.{name}"),
+                    value,
+                    expected: "finite and > 0",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Per-constraint stiffness of each family on `mesh` (see the module documentation).
+    pub fn stiffness(&self, mesh: &ClothMesh) -> MaterialStiffness {
+        let p = &mesh.positions;
+        let area = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|i| p[i as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        };
+        let mut beside: HashMap<(u32, u32), f64> = HashMap::new();
+        for t in &mesh.triangles {
+            let at = area(t);
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *beside.entry((a.min(b), a.max(b))).or_default() += at;
+            }
+        }
+        let len2 = |a: u32, b: u32| p[a as usize].distance_squared(p[b as usize]);
+        let e_edges = if mesh.shear.is_empty() {
+            self.stretch
+        } else {
+            (self.stretch - self.shear).max(0.0)
+        };
+        let stretch: Vec<f64> = mesh
+            .stretch
+            .iter()
+            .filter_map(|&[a, b]| {
+                let at = beside.get(&(a.min(b), a.max(b)))?;
+                Some(e_edges * at / len2(a, b))
+            })
+            .collect();
+        let cell = match mesh.grid {
+            Some((nx, ny)) if nx > 1 && ny > 1 => {
+                mesh.triangles.iter().map(area).sum::<f64>() / ((nx - 1) * (ny - 1)) as f64
+            }
+            _ => 0.0,
+        };
+        let shear: Vec<f64> = mesh
+            .shear
+            .iter()
+            .filter(|_| cell > 0.0)
+            .map(|&[a, b]| self.shear * len2(a, b) / (2.0 * cell))
+            .collect();
+        let topo = Topology::new(&mesh.triangles);
+        let bending: Vec<f64> = topo
+            .wings
+            .iter()
+            .filter_map(|w| {
+                let [a, b] = w.edge;
+                let ae = beside.get(&(a.min(b), a.max(b)))?;
+                Some(self.bending * len2(a, b) / ae)
+            })
+            .collect();
+        MaterialStiffness {
+            stretch: median(stretch),
+            shear: median(shear),
+            bending: median(bending),
+        }
+    }
+
+    /// Constraint parameters of every method for `mesh` stepped with `settings`, starting from
+    /// `base` (its tether family and damping values are kept).
+    pub fn params(&self, mesh: &ClothMesh, settings: &Settings, base: &ClothParams) -> ClothParams {
+        let k = self.stiffness(mesh);
+        let h = settings.h();
+        let n = f64::from(settings.iterations.max(1));
+        let w: Vec<f64> = mesh
+            .masses
+            .iter()
+            .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
+            .collect();
+        let rest_dihedral = rest_weights_dihedral(mesh, &w);
+        let rest_distance = |pairs: &[[u32; 2]]| {
+            median(
+                pairs
+                    .iter()
+                    .map(|&[a, b]| w[a as usize] + w[b as usize])
+                    .collect(),
+            )
+        };
+        let mut out = *base;
+        let mut set = |family: Family, k: Option<f64>, s: Option<f64>| {
+            let p = out.get_mut(family);
+            let Some(k) = k else {
+                p.enabled = false;
+                return;
+            };
+            p.enabled = true;
+            p.spring_stiffness = k;
+            p.compliance = if k > 0.0 { 1.0 / k } else { f64::MAX };
+            let s = s.unwrap_or(0.0);
+            let f = if k > 0.0 {
+                s / (s + 1.0 / (k * h * h))
+            } else {
+                0.0
+            };
+            p.pbd_stiffness = (1.0 - (1.0 - f).powf(1.0 / n)).clamp(0.0, 1.0);
+        };
+        set(Family::Stretch, k.stretch, rest_distance(&mesh.stretch));
+        set(Family::Shear, k.shear, rest_distance(&mesh.shear));
+        set(Family::BendDistance, None, None);
+        set(Family::BendDihedral, k.bending, rest_dihedral);
+        out
+    }
+}
+
+/// Per-constraint stiffness of a material on one mesh (median over each family).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialStiffness {
+    /// Stretch springs (N/m); `None` without such constraints.
+    pub stretch: Option<f64>,
+    /// Shear springs (N/m).
+    pub shear: Option<f64>,
+    /// Dihedral springs (N·m/rad).
+    pub bending: Option<f64>,
+}
+
+/// Median of Σ wᵢ |∇ᵢθ|² over the dihedral constraints at rest.
+fn rest_weights_dihedral(mesh: &ClothMesh, w: &[f64]) -> Option<f64> {
+    let topo = Topology::new(&mesh.triangles);
+    let p = &mesh.positions;
+    median(
+        topo.wings
+            .iter()
+            .filter_map(|wing| {
+                let idx = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
+                let pos: [DVec3; 4] = idx.map(|i| p[i as usize]);
+                let rest = Dihedral::angle(&pos)?;
+                let (_, g) = Dihedral { rest }.evaluate(&pos)?;
+                Some(
+                    (0..4)
+                        .map(|k| w[idx[k] as usize] * g[k].length_squared())
+                        .sum(),
+                )
+            })
+            .collect(),
+    )
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[v.len() / 2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{GridDesc, Mass};
+
+    const CLOTH: Material = Material {
+        density: 0.2,
+        stretch: 1000.0,
+        shear: 50.0,
+        bending: 1e-5,
+    };
+
+    fn grid(n: usize, size: (f64, f64)) -> ClothMesh {
+        GridDesc {
+            resolution: (n, n),
+            size,
+            mass: Mass::Density(0.2),
+            ..GridDesc::default()
+        }
+        .build()
+        .expect("grid")
+    }
+
+    #[test]
+    fn spring_constants_do_not_depend_on_resolution_but_bending_is_per_edge() {
+        for n in [8, 16, 64] {
+            let k = CLOTH.stiffness(&grid(n, (1.0, 1.0)));
+            let (s, g, b) = (
+                k.stretch.expect("edges"),
+                k.shear.expect("diagonals"),
+                k.bending.expect("hinges"),
+            );
+            assert!((s - 950.0).abs() < 1e-9, "n = {n}: stretch {s}");
+            assert!((g - 50.0).abs() < 1e-9, "n = {n}: shear {g}");
+            // k_θ = B |e|²/A_e = B on square cells' grid lines.
+            assert!((b - 1e-5).abs() < 1e-15, "n = {n}: bending {b}");
+        }
+    }
+
+    #[test]
+    fn rectangular_cells_keep_the_shear_modulus() {
+        // Cells twice as wide as tall: every diagonal gets G d²/(2A). (The grid lines get
+        // (E−G)·Ly/Lx and (E−G)·Lx/Ly; one value per family can hold only one of them, which is
+        // why square cells are the ones that keep E exactly.)
+        let k = CLOTH.stiffness(&grid(9, (2.0, 1.0)));
+        let (lx, ly) = (0.25, 0.125);
+        let shear = k.shear.expect("diagonals");
+        assert!((shear - 50.0 * (lx * lx + ly * ly) / (2.0 * lx * ly)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn xpbd_gets_inverse_stiffness_and_pbd_the_same_fraction_per_substep() {
+        let mesh = grid(16, (1.0, 1.0));
+        let s1 = Settings {
+            iterations: 1,
+            ..Settings::default()
+        };
+        let p1 = CLOTH.params(&mesh, &s1, &ClothParams::default());
+        let st = p1.get(Family::Stretch);
+        assert!((st.compliance * st.spring_stiffness - 1.0).abs() < 1e-12);
+        assert!(!p1.get(Family::BendDistance).enabled && p1.get(Family::BendDihedral).enabled);
+        // More iterations: a smaller k per projection, the same fraction per substep.
+        let s4 = Settings {
+            iterations: 4,
+            ..Settings::default()
+        };
+        let p4 = CLOTH.params(&mesh, &s4, &ClothParams::default());
+        let (k1, k4) = (st.pbd_stiffness, p4.get(Family::Stretch).pbd_stiffness);
+        assert!(k4 < k1);
+        assert!(((1.0 - (1.0 - k4).powi(4)) - k1).abs() < 1e-12);
+    }
+}
