@@ -10,6 +10,7 @@ use glam::DVec3;
 use multiversion::multiversion;
 
 use super::layout::Chunk;
+use super::simd::SimdPath;
 use super::sweep::sweep;
 use crate::constraints::lanes::Coef;
 use crate::forces::Forces;
@@ -60,6 +61,8 @@ pub(crate) struct Domain {
     pub(super) chunks: Vec<Chunk>,
     /// For each colour: its range in `chunks` and where its scalar remainder starts.
     pub(super) plan: Vec<(Range<usize>, usize)>,
+    /// The kernel path its sweep and integration run on.
+    pub(super) path: SimdPath,
 }
 
 /// A domain's share of the global particle arrays.
@@ -209,13 +212,42 @@ fn end_velocities(x: &[f64], prev: &[f64], v: &mut [f64], w: &[f64], finish: Fin
     }
 }
 
-/// The per-particle part of [`Domain::integrate`], compiled like [`sweep`].
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
-    "x86_64+avx2+fma",
-    "aarch64+neon"
-))]
-fn advance<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+/// The per-particle part of [`Domain::integrate`] on the domain's kernel path, like [`sweep`].
+fn advance(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+    match dom.path {
+        SimdPath::Avx512 => advance_avx512(dom, step, finish),
+        SimdPath::Avx2 => advance_avx2(dom, step, finish),
+        SimdPath::Neon => advance_neon(dom, step, finish),
+        SimdPath::Scalar => advance_scalar(dom, step, finish),
+    }
+}
+
+/// [`advance`] compiled for AVX-512 (the baseline build where the CPU lacks it).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
+fn advance_avx512<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+/// [`advance`] compiled for AVX2 and FMA.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn advance_avx2<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+/// [`advance`] compiled for NEON.
+#[multiversion(targets("aarch64+neon"))]
+fn advance_neon<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+/// [`advance`] compiled for the baseline target.
+#[inline(never)]
+fn advance_scalar(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+#[inline(always)]
+fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
     let h = step.h;
     let f = step.forces;
     let w = &dom.w[..];

@@ -25,6 +25,7 @@
 mod domain;
 mod layout;
 mod order;
+mod simd;
 mod sweep;
 #[cfg(test)]
 mod tests;
@@ -40,6 +41,7 @@ use crate::params::FamilyParams;
 pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode};
 use layout::Layout;
 use order::Interior;
+pub use simd::{SIMD_ENV, SimdPath, UnknownSimdPath};
 use tree::{Job, LinkSet, fork, tree_node};
 
 /// How a solver's distance constraints are laid out for the parallel SIMD solve.
@@ -59,6 +61,8 @@ pub struct DomainStats {
     pub gathered: usize,
     /// Interior constraints solved one at a time (the tail of each colour).
     pub remainder: usize,
+    /// The kernel path the domains run on.
+    pub simd: SimdPath,
 }
 
 /// The distance constraints cut into domains, plus the links between them.
@@ -78,14 +82,16 @@ pub(crate) struct Domains {
 }
 
 impl Domains {
-    /// Cuts `block` (coloured distance constraints over `n` particles) into domains of `size`.
-    pub fn new(block: &Block<2, Distance>, n: usize, size: usize) -> Self {
+    /// Cuts `block` (coloured distance constraints over `n` particles) into domains of `size`,
+    /// solved on kernel path `path`.
+    pub fn new(block: &Block<2, Distance>, n: usize, size: usize, path: SimdPath) -> Self {
         let size = size.clamp(LANES, n.max(LANES)).next_multiple_of(LANES);
         let count = n.div_ceil(size).max(1);
         let mut list: Vec<Domain> = (0..count)
             .map(|d| {
                 let mut dom = Domain {
                     start: d * size,
+                    path,
                     ..Domain::default()
                 };
                 dom.resize(size.min(n - (d * size).min(n)));
@@ -129,6 +135,7 @@ impl Domains {
             domains: self.list.len(),
             domain_size: self.size,
             links: self.links.iter().map(|l| l.rest.len()).sum(),
+            simd: self.path(),
             ..DomainStats::default()
         };
         for d in &self.list {
@@ -146,6 +153,18 @@ impl Domains {
             }
         }
         s
+    }
+
+    /// The kernel path the domains run on.
+    pub fn path(&self) -> SimdPath {
+        self.list.first().map_or_else(SimdPath::default, |d| d.path)
+    }
+
+    /// Runs every domain on kernel path `path` from now on.
+    pub fn set_path(&mut self, path: SimdPath) {
+        for d in &mut self.list {
+            d.path = path;
+        }
     }
 
     /// Which optional terms the current coefficients need.

@@ -9,16 +9,47 @@ use multiversion::multiversion;
 
 use super::domain::{Domain, Mode, Pairs};
 use super::layout::{Chunk, Layout, load_ends, store_ends};
+use super::simd::SimdPath;
 use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
 
-/// [`Domain::project`], compiled for the widest vector unit the CPU has (picked at run time;
-/// every version does the same IEEE operations, so results do not depend on the CPU).
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
-    "x86_64+avx2+fma",
-    "aarch64+neon"
-))]
+/// [`Domain::project`] on the domain's kernel path (see [`SimdPath`]; every path does the same
+/// IEEE operations, so results depend neither on the CPU nor on the path).
 pub(super) fn sweep(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+    match dom.path {
+        SimdPath::Avx512 => sweep_avx512(dom, coef, mode),
+        SimdPath::Avx2 => sweep_avx2(dom, coef, mode),
+        SimdPath::Neon => sweep_neon(dom, coef, mode),
+        SimdPath::Scalar => sweep_scalar(dom, coef, mode),
+    }
+}
+
+/// [`sweep`] compiled for AVX-512 (the baseline build where the CPU lacks it).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
+fn sweep_avx512(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+    sweep_modes(dom, coef, mode);
+}
+
+/// [`sweep`] compiled for AVX2 and FMA.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn sweep_avx2(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+    sweep_modes(dom, coef, mode);
+}
+
+/// [`sweep`] compiled for NEON.
+#[multiversion(targets("aarch64+neon"))]
+fn sweep_neon(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+    sweep_modes(dom, coef, mode);
+}
+
+/// [`sweep`] compiled for the baseline target.
+#[inline(never)]
+fn sweep_scalar(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+    sweep_modes(dom, coef, mode);
+}
+
+/// The sweep with its optional terms chosen at compile time.
+#[inline(always)]
+fn sweep_modes(dom: &mut Domain, coef: &[Coef], mode: Mode) {
     match (mode.damped, mode.lambda) {
         (false, false) => sweep_with::<false, false>(dom, coef),
         (false, true) => sweep_with::<false, true>(dom, coef),

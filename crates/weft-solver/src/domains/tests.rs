@@ -76,7 +76,7 @@ fn global(d: &Domain, k: usize) -> (u32, u32) {
 fn every_constraint_is_solved_once_and_no_set_shares_a_particle() {
     for shuffle in [false, true] {
         let (block, n) = block(30, shuffle);
-        let domains = Domains::new(&block, n, 200);
+        let domains = Domains::new(&block, n, 200, SimdPath::Scalar);
         assert!(domains.list.len() > 3);
         let mut seen: Vec<(u32, u32)> = Vec::new();
         for d in &domains.list {
@@ -120,7 +120,7 @@ fn every_constraint_is_solved_once_and_no_set_shares_a_particle() {
 fn chunk_layouts_match_their_lanes_and_grids_mostly_load_with_unit_stride() {
     // Rows of 32 split into whole chunks (a row of 30 leaves a ragged end of 6 per row).
     let (block, n) = block(32, false);
-    let domains = Domains::new(&block, n, 4096);
+    let domains = Domains::new(&block, n, 4096, SimdPath::Scalar);
     for d in &domains.list {
         for c in &d.chunks {
             let (p, q) = (&d.pairs.p[c.start..], &d.pairs.q[c.start..]);
