@@ -36,6 +36,16 @@ pub(super) struct Chunk {
     pub layout: Layout,
     /// All lanes share one parameter group.
     pub uniform: bool,
+    /// All lanes share one rest length, [`Chunk::rest`].
+    pub same_rest: bool,
+    /// The first lane's particles (all a structured layout needs: the others follow from it).
+    pub p0: u32,
+    /// The first lane's second particle.
+    pub q0: u32,
+    /// The first lane's parameter group.
+    pub group: u32,
+    /// The first lane's rest length (m).
+    pub rest: f64,
 }
 
 /// Loads one end of a chunk: `idx` gives each lane's particle when gathered.

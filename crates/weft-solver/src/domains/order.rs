@@ -116,11 +116,20 @@ impl Domain {
                 if k + LANES > colour.end {
                     break;
                 }
+                // The chunk carries what its lanes share: a structured chunk of one group reads
+                // no per-lane indices or groups, and one whose rest lengths have the same bits
+                // no rest lengths either.
                 let g = &pairs.group[k..k + LANES];
+                let rest = &pairs.rest[k..k + LANES];
                 self.chunks.push(Chunk {
                     start: k,
                     layout: layout.unwrap_or(Layout::Gathered),
                     uniform: g.iter().all(|&x| x == g[0]),
+                    same_rest: rest.iter().all(|&x| x.to_bits() == rest[0].to_bits()),
+                    p0: pairs.p[k],
+                    q0: pairs.q[k],
+                    group: g[0],
+                    rest: rest[0],
                 });
                 k += LANES;
             }

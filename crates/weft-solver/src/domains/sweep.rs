@@ -8,7 +8,7 @@
 use multiversion::multiversion;
 
 use super::domain::{Domain, Mode, Pairs};
-use super::layout::{Chunk, Layout, load_ends, store_ends};
+use super::layout::{Chunk, Layout, layout_of, load_ends, store_ends};
 use super::simd::SimdPath;
 use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
 
@@ -127,7 +127,13 @@ fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8>(
     coef: &[Coef],
 ) {
     let r = chunk.start..chunk.start + LANES;
-    let (p, q) = (&pairs.p[r.clone()], &pairs.q[r.clone()]);
+    // A structured layout needs the first lane's particles only, kept in the chunk.
+    let (p0, q0) = ([chunk.p0], [chunk.q0]);
+    let (p, q): (&[u32], &[u32]) = if matches!(layout_of(LAYOUT), Layout::Gathered) {
+        (&pairs.p[r.clone()], &pairs.q[r.clone()])
+    } else {
+        (&p0, &q0)
+    };
     let mut e = Ends {
         p: [[0.0; LANES]; 3],
         q: [[0.0; LANES]; 3],
@@ -146,12 +152,14 @@ fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8>(
         e
     };
     let (wp, wq) = load_ends::<LAYOUT>(w, p, q);
-    let mut rest = [0.0; LANES];
-    rest.copy_from_slice(&pairs.rest[r.clone()]);
-    let groups = &pairs.group[r.clone()];
+    let mut rest = [chunk.rest; LANES];
+    if !chunk.same_rest {
+        rest.copy_from_slice(&pairs.rest[r.clone()]);
+    }
     let k = if chunk.uniform {
-        Coefs::splat(coef[groups[0] as usize])
+        Coefs::splat(coef[chunk.group as usize])
     } else {
+        let groups = &pairs.group[r.clone()];
         Coefs::from_fn(|l| coef[groups[l] as usize])
     };
     let mut lambda = [0.0; LANES];

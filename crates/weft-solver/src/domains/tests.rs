@@ -124,6 +124,17 @@ fn chunk_layouts_match_their_lanes_and_grids_mostly_load_with_unit_stride() {
     for d in &domains.list {
         for c in &d.chunks {
             let (p, q) = (&d.pairs.p[c.start..], &d.pairs.q[c.start..]);
+            // What the chunk carries for its lanes matches them.
+            assert_eq!((c.p0, c.q0), (p[0], q[0]));
+            assert_eq!(c.group, d.pairs.group[c.start]);
+            let rests = &d.pairs.rest[c.start..c.start + LANES];
+            if c.same_rest {
+                assert!(
+                    rests.iter().all(|&r| r == c.rest),
+                    "{rests:?} vs {}",
+                    c.rest
+                );
+            }
             for l in 0..LANES {
                 let (ep, eq) = match c.layout {
                     Layout::Contiguous => (p[0] + l as u32, q[0] + l as u32),
