@@ -4,6 +4,9 @@
 //! bending: `assets/scenes/reference.toml` with `cloth.reference.resolution=[N, N]`, at
 //! N = 64, 128, 256, each on a 1-thread and a 2-thread rayon pool.
 //!
+//! The kernel path (`WEFT_SIMD`, else the widest the CPU has) is printed first and checked to be
+//! the one the solvers run.
+//!
 //! Outside the timing it checks the workload is the one the peers run: N² particles and
 //! 2N(N−1) + 2(N−1)² constraints, which is 16,384 and exactly 64,770 at N = 128.
 
@@ -17,13 +20,15 @@ use criterion::{
 };
 use weft_solver::Method;
 
-use common::{evaluations_per_frame, reference};
+use common::{evaluations_per_frame, reference, simd_path};
 
 const SIZES: [usize; 3] = [64, 128, 256];
 const THREADS: [usize; 2] = [1, 2];
 
 fn reference_workload(c: &mut Criterion) {
+    let path = simd_path();
     let at_128 = reference(128, Method::Xpbd);
+    assert_eq!(at_128.solver.simd_path(), path);
     assert_eq!(at_128.solver.particles().len(), 16_384);
     assert_eq!(at_128.solver.constraints().len(), 64_770);
     let s = at_128.solver.settings();

@@ -11,6 +11,9 @@
 # (Taichi/Weft > 1: Weft is faster). Single-thread runs are pinned to one CPU (Taichi pins
 # itself; Weft through taskset) because cross-CPU wake-ups dominate otherwise on this VM.
 #
+# Weft runs on the widest kernel path the CPU has, or on the one WEFT_SIMD forces
+# (avx512|avx2|neon|scalar, passed through); the table names the path that ran.
+#
 # Prerequisite for the peers: bash scripts/peers/setup.sh   (venvs under /tmp/peers)
 # Usage: scripts/compare_peers.sh            (env: N=128 REPS=5 THREADS="1 2" FRAMES=30
 #                                            PEERS_DIR=scripts/peers PEERS_ROOT=/tmp/peers)
@@ -62,6 +65,7 @@ if [ -x "$venvs/venv-newton/bin/python" ]; then
 fi
 
 declare -A runs
+weft_path=""
 uptime >&2
 for rep in $(seq 1 "$REPS"); do
   for t in $THREADS; do
@@ -74,6 +78,7 @@ for rep in $(seq 1 "$REPS"); do
         echo "# $p threads=$t run $rep: no ms/frame line" >&2
         continue
       fi
+      [ "$p" = weft ] && weft_path="$(sed -nE 's/.* simd=([a-z0-9]+) .*/\1/p' <<< "$line")"
       echo "# run $rep $p threads=$t: median $med ms/frame" >&2
       runs["$p|$t"]="${runs["$p|$t"]:-} $med"
     done
@@ -90,6 +95,8 @@ ratio() { python3 -c 'import sys; print(f"{float(sys.argv[1]) / float(sys.argv[2
 
 echo
 echo "Reference workload, N = $N ($((N * N)) particles, $((2 * N * (N - 1) + 2 * (N - 1) * (N - 1))) constraints), 10 substeps × 1 iteration, $FRAMES frames per run, $REPS runs"
+echo
+echo "Weft's kernel path: ${weft_path:-unknown} (WEFT_SIMD=${WEFT_SIMD:-unset}); CPU: $(sed -nE 's/^model name\s*:\s*//p' /proc/cpuinfo | head -1)"
 echo
 echo "| solver | threads | runs | median ms/frame | best run | this / Weft |"
 echo "|---|---|---|---|---|---|"

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use weft_scene::{Override, Scene, SolverGroup};
-use weft_solver::Method;
+use weft_solver::{Method, SimdPath};
 
 /// Grid sizes N of the N×N cloths: 1,024 … 65,536 particles.
 pub const SIZES: [usize; 4] = [32, 64, 128, 256];
@@ -92,4 +92,15 @@ pub fn criterion_dir() -> PathBuf {
         .and_then(|exe| exe.ancestors().nth(3).map(Path::to_path_buf))
         .unwrap_or_else(|| PathBuf::from("target"))
         .join("criterion")
+}
+
+/// The kernel path the benches run on (`WEFT_SIMD`, else the widest this CPU has), printed once
+/// so that every figure names its path. A `WEFT_SIMD` that names no path stops the bench.
+pub fn simd_path() -> SimdPath {
+    let path = match SimdPath::from_env() {
+        Ok(asked) => SimdPath::resolve(asked),
+        Err(e) => panic!("WEFT_SIMD: {e}"),
+    };
+    println!("kernel path: {path} (WEFT_SIMD=avx512|avx2|neon|scalar forces one)");
+    path
 }

@@ -10,11 +10,15 @@
 //! ```
 //!
 //! The old positional form `-- N FRAMES` still works. `--threads 0` uses rayon's default pool.
+//! `--simd avx512|avx2|neon|scalar` (or `WEFT_SIMD=…`) forces the kernel path; the output names
+//! the path that ran.
 
 use std::process::ExitCode;
 use std::time::Instant;
 
-use weft_solver::{ClothParams, Edge, Family, Forces, GridDesc, Pin, Settings, SolverBuilder};
+use weft_solver::{
+    ClothParams, Edge, Family, Forces, GridDesc, Pin, Settings, SimdPath, SolverBuilder,
+};
 
 /// Command-line options.
 struct Options {
@@ -23,9 +27,10 @@ struct Options {
     warmup: usize,
     threads: usize,
     domain_size: usize,
+    simd: Option<SimdPath>,
 }
 
-const USAGE: &str = "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] [--domain-size D] | [N [FRAMES]]";
+const USAGE: &str = "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] [--domain-size D] [--simd avx512|avx2|neon|scalar] | [N [FRAMES]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
@@ -34,6 +39,7 @@ fn parse_args() -> Result<Options, String> {
         warmup: 3,
         threads: 1,
         domain_size: Settings::default().domain_size,
+        simd: SimdPath::from_env().map_err(|e| format!("WEFT_SIMD: {e}"))?,
     };
     let mut positional = 0;
     let mut args = std::env::args().skip(1);
@@ -51,6 +57,12 @@ fn parse_args() -> Result<Options, String> {
             "--warmup" => o.warmup = value("--warmup")?,
             "--threads" => o.threads = value("--threads")?,
             "--domain-size" => o.domain_size = value("--domain-size")?,
+            "--simd" => {
+                let v = args
+                    .next()
+                    .ok_or(format!("--simd needs a value\n{USAGE}"))?;
+                o.simd = Some(v.parse().map_err(|e| format!("--simd: {e}\n{USAGE}"))?);
+            }
             "-h" | "--help" => return Err(USAGE.to_owned()),
             _ if !a.starts_with('-') && positional < 2 => {
                 let v: usize = a
@@ -98,6 +110,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     }
     let settings = Settings {
         domain_size: o.domain_size,
+        simd: o.simd,
         ..Settings::default()
     };
     let mut b = SolverBuilder::new(settings, Forces::default())?;
@@ -115,6 +128,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         s.constraints().color_counts()
     );
     println!("{:?}", s.domain_stats());
+    if let Some(asked) = o.simd
+        && asked != s.simd_path()
+    {
+        println!(
+            "kernel path {asked} is not available on this CPU: running {}",
+            s.simd_path()
+        );
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(o.threads)
         .build()?;
@@ -140,8 +161,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let projections = (constraints as u64 * substeps * iterations) as f64;
     let r = s.residual();
     println!(
-        "{:<14} threads={threads} N={n:<4} particles={:<6} constraints={constraints:<6} substeps={substeps:<3} iters={iterations} frames={} seconds={:.3} ms/frame={mean:.3} (median {median:.3}) ns/proj={:.2} proj/s={:.4e}",
+        "{:<14} simd={:<6} threads={threads} N={n:<4} particles={:<6} constraints={constraints:<6} substeps={substeps:<3} iters={iterations} frames={} seconds={:.3} ms/frame={mean:.3} (median {median:.3}) ns/proj={:.2} proj/s={:.4e}",
         "weft-xpbd",
+        s.simd_path().name(),
         s.particles().len(),
         o.frames,
         total_ms / 1e3,

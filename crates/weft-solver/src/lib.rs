@@ -32,7 +32,7 @@ mod topology;
 pub use builder::SolverBuilder;
 pub use cloth::{ClothMesh, Mass};
 pub use constraints::Residual;
-pub use domains::DomainStats;
+pub use domains::{DomainStats, SIMD_ENV, SimdPath, UnknownSimdPath};
 pub use error::{BuildError, MeshError, ParamError, SolverError};
 pub use forces::{Aero, Forces, Wind};
 pub use grid::{Corner, Edge, GridDesc, Orientation, Pin};

@@ -1,5 +1,6 @@
 //! Time stepping settings.
 
+use crate::domains::SimdPath;
 use crate::error::ParamError;
 use crate::method::Method;
 
@@ -20,6 +21,10 @@ pub struct Settings {
     /// constraints concurrently; constraints across domains are solved after them, serially.
     /// The split, and so the result, depends on this and the mesh, never on the thread count.
     pub domain_size: usize,
+    /// The kernel path of the constraint sweep: `None` takes `WEFT_SIMD` (`avx512`, `avx2`,
+    /// `neon` or `scalar`, read once) or else the widest path the CPU runs; a path the CPU
+    /// lacks falls back to the widest one it has. Changes the speed, never the result.
+    pub simd: Option<SimdPath>,
 }
 
 impl Default for Settings {
@@ -31,6 +36,7 @@ impl Default for Settings {
             iterations: 1,
             divergence_bound: 1.0e4,
             domain_size: 4096,
+            simd: None,
         }
     }
 }

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use crate::chunk::CHUNK;
 use crate::constraints::{ConstraintSet, Residual, Rule};
-use crate::domains::{DomainStats, Domains, Finish, Integration};
+use crate::domains::{DomainStats, Domains, Finish, Integration, SimdPath};
 use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
 use crate::hook::{SubstepContext, SubstepHook};
@@ -97,7 +97,12 @@ impl Solver {
             .iter()
             .flat_map(|c| c.triangles.iter().copied())
             .collect();
-        let domains = Domains::new(&constraints.distance, particles.len(), settings.domain_size);
+        let domains = Domains::new(
+            &constraints.distance,
+            particles.len(),
+            settings.domain_size,
+            SimdPath::resolve(settings.simd),
+        );
         Self {
             settings,
             forces,
@@ -159,6 +164,11 @@ impl Solver {
         &self.constraints
     }
 
+    /// The kernel path the constraint sweep runs on (see [`Settings::simd`]).
+    pub fn simd_path(&self) -> SimdPath {
+        self.domains.path()
+    }
+
     /// How the distance constraints are cut into domains and SIMD chunks.
     pub fn domain_stats(&self) -> DomainStats {
         self.domains.stats()
@@ -177,7 +187,10 @@ impl Solver {
                 &self.constraints.distance,
                 self.particles.len(),
                 settings.domain_size,
+                SimdPath::resolve(settings.simd),
             );
+        } else if settings.simd != self.settings.simd {
+            self.domains.set_path(SimdPath::resolve(settings.simd));
         }
         self.settings = settings;
         Ok(())

@@ -24,6 +24,15 @@ pub(crate) enum Rule {
     Pbd,
 }
 
+impl Rule {
+    /// XPBD's time-step compliance α̃ = α/h² and damping γ = α̃ β̃ / h = α β / h (with
+    /// β̃ = h² β) of one family at substep `h` (Macklin et al. 2016, eqs. 4 and 26).
+    #[inline]
+    pub(crate) fn xpbd_terms(p: &FamilyParams, h: f64) -> (f64, f64) {
+        (p.compliance / (h * h), p.compliance * p.damping / h)
+    }
+}
+
 /// Constraints of one shape, sorted by colour; arrays are indexed by constraint.
 #[derive(Clone, Debug)]
 pub(crate) struct Block<const N: usize, S> {
@@ -130,9 +139,7 @@ fn correction<const N: usize, S: Shape<N>>(
     let w_grad2: f64 = (0..N).map(|k| wi[k] * grad[k].length_squared()).sum();
     let dl = match rule {
         Rule::Xpbd { h } => {
-            // α̃ = α/h², γ = α̃ β̃ / h = α β / h with β̃ = h² β  (Macklin et al. 2016, eq. 26).
-            let alpha = p.compliance / (h * h);
-            let gamma = p.compliance * p.damping / h;
+            let (alpha, gamma) = Rule::xpbd_terms(p, h);
             let grad_dx: f64 = if gamma > 0.0 {
                 (0..N)
                     .map(|k| grad[k].dot(pos[k] - prev[idx[k] as usize]))

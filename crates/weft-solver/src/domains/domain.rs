@@ -1,0 +1,271 @@
+//! One domain: its particles as struct-of-arrays, the fused integration and the velocity update.
+
+// Lane and axis loops index several arrays in step; written as index loops on purpose so
+// that each compiles to one vector operation per axis.
+#![allow(clippy::needless_range_loop)]
+
+use std::ops::Range;
+
+use glam::DVec3;
+use multiversion::multiversion;
+
+use super::layout::Chunk;
+use super::simd::SimdPath;
+use super::sweep::sweep;
+use crate::constraints::lanes::Coef;
+use crate::forces::Forces;
+
+/// Distance constraints as struct-of-arrays.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Pairs {
+    /// First end (local index).
+    pub p: Vec<u32>,
+    /// Second end (local index).
+    pub q: Vec<u32>,
+    /// Rest length (m).
+    pub rest: Vec<f64>,
+    /// Parameter group.
+    pub group: Vec<u32>,
+    /// XPBD multiplier.
+    pub lambda: Vec<f64>,
+}
+
+impl Pairs {
+    pub(super) fn push(&mut self, p: u32, q: u32, rest: f64, group: u32) {
+        self.p.push(p);
+        self.q.push(q);
+        self.rest.push(rest);
+        self.group.push(group);
+        self.lambda.push(0.0);
+    }
+}
+
+/// One domain: its particles (struct-of-arrays, local indices) and interior constraints.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Domain {
+    /// Global index of the first particle.
+    pub(super) start: usize,
+    /// Positions per axis (m).
+    pub(super) x: [Vec<f64>; 3],
+    /// Positions at the start of the substep per axis (m).
+    pub(super) prev: [Vec<f64>; 3],
+    /// Velocities per axis (m/s).
+    pub(super) v: [Vec<f64>; 3],
+    /// Inverse masses (1/kg).
+    pub(super) w: Vec<f64>,
+    /// Interior constraints in local indices, sorted by colour, group and particle.
+    pub(super) pairs: Pairs,
+    /// Range of each colour in `pairs`.
+    pub(super) colours: Vec<Range<usize>>,
+    /// Full chunks of every colour, in order.
+    pub(super) chunks: Vec<Chunk>,
+    /// For each colour: its range in `chunks` and where its scalar remainder starts.
+    pub(super) plan: Vec<(Range<usize>, usize)>,
+    /// The kernel path its sweep and integration run on.
+    pub(super) path: SimdPath,
+}
+
+/// A domain's share of the global particle arrays.
+pub(crate) struct AosChunk<'a> {
+    /// Positions.
+    pub x: &'a [DVec3],
+    /// Velocities.
+    pub v: &'a [DVec3],
+    /// Inverse masses.
+    pub w: &'a [f64],
+}
+
+/// Per-substep inputs of the fused integration.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Integration<'a> {
+    /// Substep length (s).
+    pub h: f64,
+    /// External forces (gravity and linear wind drag; no aerodynamics).
+    pub forces: &'a Forces,
+    /// Kinematic pins as (global particle, position at the substep's end).
+    pub pins: &'a [(usize, DVec3)],
+}
+
+impl Domain {
+    pub(super) fn len(&self) -> usize {
+        self.w.len()
+    }
+
+    pub(super) fn resize(&mut self, n: usize) {
+        for a in 0..3 {
+            self.x[a].resize(n, 0.0);
+            self.prev[a].resize(n, 0.0);
+            self.v[a].resize(n, 0.0);
+        }
+        self.w.resize(n, 0.0);
+    }
+
+    /// Copies positions, velocities and inverse masses in from the global arrays.
+    pub fn load(&mut self, aos: &AosChunk<'_>) {
+        for (i, (x, v)) in aos.x.iter().zip(aos.v).enumerate() {
+            for a in 0..3 {
+                self.x[a][i] = x[a];
+                self.v[a][i] = v[a];
+            }
+        }
+        self.w.copy_from_slice(aos.w);
+    }
+
+    /// Copies positions (and, when `prev` is given, previous positions) in.
+    pub(super) fn load_positions(&mut self, x: &[DVec3], prev: Option<&[DVec3]>, w: &[f64]) {
+        for (i, p) in x.iter().enumerate() {
+            for a in 0..3 {
+                self.x[a][i] = p[a];
+            }
+        }
+        if let Some(prev) = prev {
+            for (i, p) in prev.iter().enumerate() {
+                for a in 0..3 {
+                    self.prev[a][i] = p[a];
+                }
+            }
+        }
+        self.w.copy_from_slice(w);
+    }
+
+    /// Copies positions back out.
+    pub(super) fn store_positions(&self, x: &mut [DVec3]) {
+        for (i, p) in x.iter_mut().enumerate() {
+            *p = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
+        }
+    }
+
+    /// Copies positions, previous positions and velocities back out.
+    pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3]) {
+        for i in 0..self.len() {
+            x[i] = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
+            prev[i] = DVec3::new(self.prev[0][i], self.prev[1][i], self.prev[2][i]);
+            v[i] = DVec3::new(self.v[0][i], self.v[1][i], self.v[2][i]);
+        }
+    }
+
+    /// The PBD velocity update v = (x − x_prev)/h, then global damping v ← v e^(−c h) of free
+    /// particles when `keep` is given — the same arithmetic as the solver's general loop.
+    pub fn finish_velocities(&mut self, finish: Finish) {
+        let w = &self.w[..];
+        for a in 0..3 {
+            end_velocities(&self.x[a], &self.prev[a], &mut self.v[a], w, finish);
+        }
+    }
+
+    /// Ends the previous substep when `finish` is given (v = (x − x_prev)/h, then damping
+    /// v ← v·keep of free particles), then predicts with semi-implicit Euler, a = g + c_d (v_wind
+    /// − v), and applies the pins — the same arithmetic, particle by particle, as the solver's
+    /// general loop. Clears the multipliers when `lambda`.
+    pub fn integrate(&mut self, step: &Integration<'_>, finish: Option<Finish>, lambda: bool) {
+        advance(self, step, finish);
+        let range = self.start..self.start + self.len();
+        for &(i, p) in step.pins {
+            if range.contains(&i) {
+                for a in 0..3 {
+                    self.x[a][i - self.start] = p[a];
+                }
+            }
+        }
+        if lambda {
+            self.pairs.lambda.fill(0.0);
+        }
+    }
+
+    /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
+    pub fn project(&mut self, coef: &[Coef], mode: Mode) {
+        sweep(self, coef, mode);
+    }
+}
+
+/// Which optional terms a sweep evaluates; both off gives the same bits as both on with
+/// γ = 0 and α̃ = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Mode {
+    /// Some group has XPBD damping (γ > 0): read previous positions.
+    pub damped: bool,
+    /// Some group has compliance (α̃ > 0): keep multipliers.
+    pub lambda: bool,
+}
+
+/// How a fused substep ends the previous one: 1/h and the damping factor, if any.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Finish {
+    /// 1/h (1/s).
+    pub inv_h: f64,
+    /// Velocity factor e^(−c h) of global damping, if any.
+    pub keep: Option<f64>,
+}
+
+/// One axis of the PBD velocity update v = (x − x_prev)/h, then global damping v ← v·keep of
+/// free particles — the solver's general loop does the same arithmetic.
+#[inline(always)]
+fn end_velocities(x: &[f64], prev: &[f64], v: &mut [f64], w: &[f64], finish: Finish) {
+    let (x, prev, v) = (&x[..w.len()], &prev[..w.len()], &mut v[..w.len()]);
+    for i in 0..w.len() {
+        v[i] = (x[i] - prev[i]) * finish.inv_h;
+    }
+    if let Some(keep) = finish.keep {
+        for i in 0..w.len() {
+            v[i] = if w[i] > 0.0 { v[i] * keep } else { v[i] };
+        }
+    }
+}
+
+/// The per-particle part of [`Domain::integrate`] on the domain's kernel path, like [`sweep`].
+fn advance(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+    match dom.path {
+        SimdPath::Avx512 => advance_avx512(dom, step, finish),
+        SimdPath::Avx2 => advance_avx2(dom, step, finish),
+        SimdPath::Neon => advance_neon(dom, step, finish),
+        SimdPath::Scalar => advance_scalar(dom, step, finish),
+    }
+}
+
+/// [`advance`] compiled for AVX-512 (the baseline build where the CPU lacks it).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
+fn advance_avx512<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+/// [`advance`] compiled for AVX2 and FMA.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn advance_avx2<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+/// [`advance`] compiled for NEON.
+#[multiversion(targets("aarch64+neon"))]
+fn advance_neon<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+/// [`advance`] compiled for the baseline target.
+#[inline(never)]
+fn advance_scalar(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+    advance_body(dom, step, finish);
+}
+
+#[inline(always)]
+fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+    let h = step.h;
+    let f = step.forces;
+    let w = &dom.w[..];
+    for a in 0..3 {
+        let (g, wv, drag) = (f.gravity[a], f.wind.velocity[a], f.wind.drag);
+        let (x, v, prev) = (&mut dom.x[a][..], &mut dom.v[a][..], &mut dom.prev[a][..]);
+        let (x, v, prev) = (&mut x[..w.len()], &mut v[..w.len()], &mut prev[..w.len()]);
+        if let Some(finish) = finish {
+            end_velocities(x, prev, v, w, finish);
+        }
+        for i in 0..w.len() {
+            prev[i] = x[i];
+            let acc = g + drag * (wv - v[i]);
+            let vi = v[i] + acc * h;
+            let xi = x[i] + vi * h;
+            let free = w[i] > 0.0;
+            v[i] = if free { vi } else { v[i] };
+            x[i] = if free { xi } else { x[i] };
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! How the eight constraints of a chunk reach their particles: unit-stride windows where the
+//! particles are consecutive, gathers elsewhere.
+
+// Lane and axis loops index several arrays in step; written as index loops on purpose so
+// that each compiles to one vector operation per axis.
+#![allow(clippy::needless_range_loop)]
+
+use crate::constraints::lanes::LANES;
+
+/// How the eight constraints of a chunk reach their particles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Layout {
+    /// p = p₀ + l and q = q₀ + l: two unit-stride loads per axis.
+    Contiguous,
+    /// p = p₀ + 2l and q = p + 1: one unit-stride load of 16 particles, de-interleaved.
+    Paired,
+    /// p = p₀ + (0, 1, 4, 5, 8, 9, 12, 13) and q = p + 2 (every other pair of a row's
+    /// two-apart bending pairs): one unit-stride load of 16 particles, permuted.
+    Quad,
+    /// p = p₀ + 4l and q = p + 2 (two-apart bending pairs at every other vertex): one
+    /// unit-stride load of 31 particles, permuted.
+    Spaced,
+    /// p = p₀ + 2l and q = q₀ + 2l with the two 15-particle windows apart: two unit-stride
+    /// loads, even slots taken (a diagonal family on alternating-diagonal grids).
+    Strided,
+    /// Anything else: one load per lane.
+    Gathered,
+}
+
+/// A full chunk of [`LANES`] constraints.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Chunk {
+    /// First constraint of the chunk.
+    pub start: usize,
+    /// How its lanes reach their particles.
+    pub layout: Layout,
+    /// All lanes share one parameter group.
+    pub uniform: bool,
+    /// All lanes share one rest length, [`Chunk::rest`].
+    pub same_rest: bool,
+    /// The first lane's particles (all a structured layout needs: the others follow from it).
+    pub p0: u32,
+    /// The first lane's second particle.
+    pub q0: u32,
+    /// The first lane's parameter group.
+    pub group: u32,
+    /// The first lane's rest length (m).
+    pub rest: f64,
+}
+
+/// Loads one end of a chunk: `idx` gives each lane's particle when gathered.
+#[inline(always)]
+fn gather(src: &[f64], idx: &[u32]) -> [f64; LANES] {
+    std::array::from_fn(|l| src[idx[l] as usize])
+}
+
+#[inline(always)]
+fn scatter(dst: &mut [f64], idx: &[u32], val: &[f64; LANES]) {
+    for l in 0..LANES {
+        dst[idx[l] as usize] = val[l];
+    }
+}
+
+/// Both ends of a chunk from one array (positions, previous positions or inverse masses).
+#[inline(always)]
+pub(super) fn load_ends<const LAYOUT: u8>(
+    src: &[f64],
+    p: &[u32],
+    q: &[u32],
+) -> ([f64; LANES], [f64; LANES]) {
+    match layout_of(LAYOUT) {
+        Layout::Contiguous => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            let mut a = [0.0; LANES];
+            let mut b = [0.0; LANES];
+            a.copy_from_slice(&src[p0..p0 + LANES]);
+            b.copy_from_slice(&src[q0..q0 + LANES]);
+            (a, b)
+        }
+        Layout::Paired => {
+            let p0 = p[0] as usize;
+            let s = &src[p0..p0 + 2 * LANES];
+            (
+                std::array::from_fn(|l| s[2 * l]),
+                std::array::from_fn(|l| s[2 * l + 1]),
+            )
+        }
+        Layout::Quad => {
+            let p0 = p[0] as usize;
+            let s = &src[p0..p0 + 2 * LANES];
+            (
+                std::array::from_fn(|l| s[QUAD[l]]),
+                std::array::from_fn(|l| s[QUAD[l] + 2]),
+            )
+        }
+        Layout::Spaced => {
+            let p0 = p[0] as usize;
+            let s = &src[p0..p0 + SPACED];
+            (
+                std::array::from_fn(|l| s[4 * l]),
+                std::array::from_fn(|l| s[4 * l + 2]),
+            )
+        }
+        Layout::Strided => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            let (sp, sq) = (&src[p0..p0 + STRIDED], &src[q0..q0 + STRIDED]);
+            (
+                std::array::from_fn(|l| sp[2 * l]),
+                std::array::from_fn(|l| sq[2 * l]),
+            )
+        }
+        Layout::Gathered => (gather(src, p), gather(src, q)),
+    }
+}
+
+/// Offsets of the first ends in a [`Layout::Quad`] chunk.
+pub(super) const QUAD: [usize; LANES] = [0, 1, 4, 5, 8, 9, 12, 13];
+
+/// Window of a [`Layout::Spaced`] chunk: first ends at 0, 4, …, 28, second ends 2 further.
+pub(super) const SPACED: usize = 4 * LANES - 1;
+
+/// Window of a [`Layout::Strided`] end: lanes at even offsets 0..=14.
+pub(super) const STRIDED: usize = 2 * LANES - 1;
+
+#[inline(always)]
+pub(super) fn store_ends<const LAYOUT: u8>(
+    dst: &mut [f64],
+    p: &[u32],
+    q: &[u32],
+    a: &[f64; LANES],
+    b: &[f64; LANES],
+) {
+    match layout_of(LAYOUT) {
+        Layout::Contiguous => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            dst[p0..p0 + LANES].copy_from_slice(a);
+            dst[q0..q0 + LANES].copy_from_slice(b);
+        }
+        Layout::Paired => {
+            let p0 = p[0] as usize;
+            let s = &mut dst[p0..p0 + 2 * LANES];
+            for l in 0..LANES {
+                s[2 * l] = a[l];
+                s[2 * l + 1] = b[l];
+            }
+        }
+        Layout::Quad => {
+            let p0 = p[0] as usize;
+            let s = &mut dst[p0..p0 + 2 * LANES];
+            for l in 0..LANES {
+                s[QUAD[l]] = a[l];
+                s[QUAD[l] + 2] = b[l];
+            }
+        }
+        Layout::Spaced => {
+            // Read, replace the chunk's slots, write back: the other slots (odd offsets) are
+            // particles no lane of this chunk touches, so they keep their values.
+            let p0 = p[0] as usize;
+            let mut win = [0.0; SPACED];
+            win.copy_from_slice(&dst[p0..p0 + SPACED]);
+            for l in 0..LANES {
+                win[4 * l] = a[l];
+                win[4 * l + 2] = b[l];
+            }
+            dst[p0..p0 + SPACED].copy_from_slice(&win);
+        }
+        Layout::Strided => {
+            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            for (start, v) in [(p0, a), (q0, b)] {
+                // Read, replace the even slots, write the window back: the odd slots are
+                // particles no other lane of this chunk touches, so they keep their values.
+                let mut win = [0.0; STRIDED];
+                win.copy_from_slice(&dst[start..start + STRIDED]);
+                for l in 0..LANES {
+                    win[2 * l] = v[l];
+                }
+                dst[start..start + STRIDED].copy_from_slice(&win);
+            }
+        }
+        Layout::Gathered => {
+            scatter(dst, p, a);
+            scatter(dst, q, b);
+        }
+    }
+}
+
+/// The layout a `const` layout number stands for (const generics take no enums on stable).
+#[inline(always)]
+pub(super) const fn layout_of(n: u8) -> Layout {
+    match n {
+        0 => Layout::Contiguous,
+        1 => Layout::Paired,
+        2 => Layout::Quad,
+        3 => Layout::Strided,
+        4 => Layout::Spaced,
+        _ => Layout::Gathered,
+    }
+}
+
+/// The unit-stride layout eight independent constraints fit, if any.
+pub(super) fn structured_layout(p: &[u32], q: &[u32]) -> Option<Layout> {
+    let all = |f: &dyn Fn(usize) -> bool| (0..LANES).all(f);
+    if all(&|l| p[l] == p[0] + l as u32 && q[l] == q[0] + l as u32) {
+        Some(Layout::Contiguous)
+    } else if all(&|l| p[l] == p[0] + 2 * l as u32 && q[l] == p[l] + 1) {
+        Some(Layout::Paired)
+    } else if all(&|l| p[l] == p[0] + QUAD[l] as u32 && q[l] == p[l] + 2) {
+        Some(Layout::Quad)
+    } else if all(&|l| p[l] == p[0] + 4 * l as u32 && q[l] == p[l] + 2) {
+        Some(Layout::Spaced)
+    } else if all(&|l| p[l] == p[0] + 2 * l as u32 && q[l] == q[0] + 2 * l as u32)
+        && p[0].abs_diff(q[0]) as usize >= STRIDED
+    {
+        Some(Layout::Strided)
+    } else {
+        None
+    }
+}

@@ -1,0 +1,304 @@
+//! Domain decomposition of the distance constraints for parallel, SIMD Gauss–Seidel.
+//!
+//! Particles are cut into contiguous index ranges of `size` particles (domains). A distance
+//! constraint whose two particles lie in one domain is *interior*: each domain keeps its own
+//! struct-of-arrays copy of its particles and projects its interior constraints colour by colour,
+//! eight at a time, without touching any other domain — so domains run on any threads, in any
+//! order, with no synchronisation. Constraints across domains (*links*, a few per cent on
+//! meshes with local particle order) are projected in a fork–join tree over the domains, each
+//! link once both its domains are done (see [`fork`]). The split
+//! depends on `size` and the mesh only, never on the thread count: results are bit-identical
+//! for 1, 2 or 64 threads.
+//!
+//! Inside a domain, constraints fall into conflict-free sets (see `Domain::order`), sorted by
+//! particle index, so that on structured meshes eight consecutive constraints usually touch
+//! eight consecutive particles (`Layout::Contiguous`, e.g. a row of vertical grid edges) or a
+//! window of 15–31 consecutive ones (`Layout::Paired`, `Quad`, `Spaced`, `Strided`): those
+//! chunks load and store with unit stride, and anything else is gathered lane by lane.
+
+//!
+//! The module's parts: [`domain`] (a domain's particles, integration and velocity update),
+//! [`order`] (colouring and chunking of a domain's constraints), [`layout`] (how a chunk's
+//! lanes reach their particles), [`sweep`] (the Gauss–Seidel sweep over a domain's chunks)
+//! and [`tree`] (the fork–join tree and the links between domains).
+
+mod domain;
+mod layout;
+mod order;
+mod simd;
+mod sweep;
+#[cfg(test)]
+mod tests;
+mod tree;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::constraints::lanes::{Coef, LANES};
+use crate::constraints::{Block, Distance, Rule};
+use crate::params::FamilyParams;
+
+pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode};
+use layout::Layout;
+use order::Interior;
+pub use simd::{SIMD_ENV, SimdPath, UnknownSimdPath};
+use tree::{Job, LinkSet, fork, tree_node};
+
+/// How a solver's distance constraints are laid out for the parallel SIMD solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DomainStats {
+    /// Number of domains.
+    pub domains: usize,
+    /// Particles per domain.
+    pub domain_size: usize,
+    /// Constraints across domains, solved serially after them.
+    pub links: usize,
+    /// Interior constraints in chunks of 8 with unit-stride ends.
+    pub contiguous: usize,
+    /// Interior constraints in chunks of 8 loaded from 16-particle windows and permuted.
+    pub strided: usize,
+    /// Interior constraints in chunks of 8 loaded lane by lane.
+    pub gathered: usize,
+    /// Interior constraints solved one at a time (the tail of each colour).
+    pub remainder: usize,
+    /// The kernel path the domains run on.
+    pub simd: SimdPath,
+}
+
+/// The distance constraints cut into domains, plus the links between them.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Domains {
+    /// Particles per domain (the last may hold fewer).
+    size: usize,
+    /// The domains, in particle order.
+    list: Vec<Domain>,
+    /// Links of each internal node of the fork–join tree over the domains, in preorder (a
+    /// node, then its left subtree, then its right one, so every subtree is one sub-slice).
+    links: Vec<LinkSet>,
+    /// Multiplier-step coefficients per parameter group, refreshed every frame.
+    coef: Vec<Coef>,
+    /// Which optional terms the coefficients need.
+    mode: Mode,
+}
+
+impl Domains {
+    /// Cuts `block` (coloured distance constraints over `n` particles) into domains of `size`,
+    /// solved on kernel path `path`.
+    pub fn new(block: &Block<2, Distance>, n: usize, size: usize, path: SimdPath) -> Self {
+        let size = size.clamp(LANES, n.max(LANES)).next_multiple_of(LANES);
+        let count = n.div_ceil(size).max(1);
+        let mut list: Vec<Domain> = (0..count)
+            .map(|d| {
+                let mut dom = Domain {
+                    start: d * size,
+                    path,
+                    ..Domain::default()
+                };
+                dom.resize(size.min(n - (d * size).min(n)));
+                dom
+            })
+            .collect();
+        let mut links = vec![LinkSet::default(); count - 1];
+        let locate = |i: u32| ((i as usize / size) as u32, (i as usize % size) as u32);
+        let mut interior: Vec<Vec<Interior>> = vec![Vec::new(); count];
+        for k in block.colors.iter().flat_map(|c| c.clone()) {
+            let [p, q] = block.particles[k];
+            let (dp, dq) = (locate(p), locate(q));
+            let (rest, group) = (block.shapes[k].rest, block.group[k]);
+            if dp.0 == dq.0 {
+                // C and its corrections are symmetric in the two ends: store p < q.
+                let (p, q) = (dp.1.min(dq.1), dp.1.max(dq.1));
+                interior[dp.0 as usize].push(Interior { p, q, rest, group });
+            } else {
+                let set = &mut links[tree_node(dp.0 as usize, dq.0 as usize, count)];
+                set.ends.push([dp, dq]);
+                set.rest.push(rest);
+                set.group.push(group);
+                set.lambda.push(0.0);
+            }
+        }
+        for (dom, cons) in list.iter_mut().zip(interior) {
+            dom.order(cons);
+        }
+        Self {
+            size,
+            list,
+            links,
+            coef: Vec::new(),
+            mode: Mode::default(),
+        }
+    }
+
+    /// How the distance constraints were laid out.
+    pub fn stats(&self) -> DomainStats {
+        let mut s = DomainStats {
+            domains: self.list.len(),
+            domain_size: self.size,
+            links: self.links.iter().map(|l| l.rest.len()).sum(),
+            simd: self.path(),
+            ..DomainStats::default()
+        };
+        for d in &self.list {
+            for c in &d.chunks {
+                match c.layout {
+                    Layout::Contiguous => s.contiguous += LANES,
+                    Layout::Paired | Layout::Quad | Layout::Spaced | Layout::Strided => {
+                        s.strided += LANES
+                    }
+                    Layout::Gathered => s.gathered += LANES,
+                }
+            }
+            for ((_, tail), colour) in d.plan.iter().zip(&d.colours) {
+                s.remainder += colour.end - tail;
+            }
+        }
+        s
+    }
+
+    /// The kernel path the domains run on.
+    pub fn path(&self) -> SimdPath {
+        self.list.first().map_or_else(SimdPath::default, |d| d.path)
+    }
+
+    /// Runs every domain on kernel path `path` from now on.
+    pub fn set_path(&mut self, path: SimdPath) {
+        for d in &mut self.list {
+            d.path = path;
+        }
+    }
+
+    /// Which optional terms the current coefficients need.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Sets the per-group coefficients for `rule` (with every group's parameters).
+    pub fn prepare(&mut self, params: &[FamilyParams], rule: Rule) {
+        self.coef.clear();
+        self.mode = Mode::default();
+        for p in params {
+            let c = match (p.enabled, rule) {
+                (false, _) => Coef {
+                    k: 0.0,
+                    alpha: 1.0,
+                    gamma: 0.0,
+                },
+                (true, Rule::Xpbd { h }) => {
+                    let (alpha, gamma) = Rule::xpbd_terms(p, h);
+                    Coef {
+                        k: 1.0,
+                        alpha,
+                        gamma,
+                    }
+                }
+                (true, Rule::Pbd) => Coef {
+                    k: p.pbd_stiffness,
+                    alpha: 0.0,
+                    gamma: 0.0,
+                },
+            };
+            if p.enabled {
+                self.mode.damped |= c.gamma > 0.0;
+                self.mode.lambda |= c.alpha > 0.0;
+            }
+            self.coef.push(c);
+        }
+    }
+
+    /// Projects every domain and link once; coefficients from [`Self::prepare`].
+    pub fn project(&mut self) {
+        self.project_with(|_, _| {});
+    }
+
+    /// Runs `before` on every domain, then projects every domain and link once, all in one
+    /// fork–join tree over the domains (see [`fork`]).
+    pub fn project_after<F>(&mut self, x: &[DVec3], v: &[DVec3], w: &[f64], before: F)
+    where
+        F: Fn(&mut Domain, &AosChunk<'_>) + Sync,
+    {
+        let size = self.size;
+        let n = x.len();
+        self.project_with(|d, index| {
+            let r = index * size..((index + 1) * size).min(n);
+            let aos = AosChunk {
+                x: &x[r.clone()],
+                v: &v[r.clone()],
+                w: &w[r],
+            };
+            before(d, &aos);
+        });
+    }
+
+    fn project_with<F>(&mut self, before: F)
+    where
+        F: Fn(&mut Domain, usize) + Sync,
+    {
+        let Self {
+            list,
+            links,
+            coef,
+            mode,
+            ..
+        } = self;
+        let job = Job {
+            before: &before,
+            coef,
+            mode: *mode,
+        };
+        fork(list, 0, links, &job);
+    }
+
+    /// Clears the link multipliers (the domains clear theirs when integrating).
+    pub fn reset_link_multipliers(&mut self) {
+        for set in &mut self.links {
+            set.lambda.fill(0.0);
+        }
+    }
+
+    /// One sweep on global arrays: copy in, project domains and links, copy positions out.
+    /// `prev` is needed only for XPBD damping. Clears every multiplier first when `fresh`.
+    pub fn project_global(&mut self, x: &mut [DVec3], prev: &[DVec3], w: &[f64], fresh: bool) {
+        let size = self.size;
+        let damped = self.mode.damped;
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks(size))
+            .zip(prev.par_chunks(size))
+            .zip(w.par_chunks(size))
+            .for_each(|(((d, x), prev), w)| {
+                d.load_positions(x, damped.then_some(prev), w);
+                if fresh {
+                    d.pairs.lambda.fill(0.0);
+                }
+            });
+        if fresh {
+            self.reset_link_multipliers();
+        }
+        self.project();
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks_mut(size))
+            .for_each(|(d, x)| d.store_positions(x));
+    }
+
+    /// Ends a fused frame: velocity update and damping, then copies the state back out.
+    pub fn finish(
+        &mut self,
+        inv_h: f64,
+        keep: Option<f64>,
+        x: &mut [DVec3],
+        prev: &mut [DVec3],
+        v: &mut [DVec3],
+    ) {
+        let size = self.size;
+        self.list
+            .par_iter_mut()
+            .zip(x.par_chunks_mut(size))
+            .zip(prev.par_chunks_mut(size))
+            .zip(v.par_chunks_mut(size))
+            .for_each(|(((d, x), prev), v)| {
+                d.finish_velocities(Finish { inv_h, keep });
+                d.store(x, prev, v);
+            });
+    }
+}

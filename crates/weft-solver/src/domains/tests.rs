@@ -1,0 +1,158 @@
+//! Tests of the domain split, the constraint order and the chunk layouts.
+
+use super::layout::QUAD;
+use super::*;
+use crate::{ClothMesh, ClothParams, Family, Forces, GridDesc, Mass, Settings, SolverBuilder};
+
+/// An `n` × `n` grid with stretch, shear and bend-distance; `shuffle` renumbers its
+/// particles pseudo-randomly, so that index offsets stop being regular (the greedy path).
+fn block(n: usize, shuffle: bool) -> (Block<2, Distance>, usize) {
+    let grid = GridDesc {
+        resolution: (n, n),
+        ..GridDesc::default()
+    }
+    .build()
+    .expect("valid grid");
+    let n = grid.positions.len();
+    let perm: Vec<u32> = if shuffle {
+        (0..n as u64)
+            .map(|i| ((i * 7919 + 13) % n as u64) as u32)
+            .collect()
+    } else {
+        (0..n as u32).collect()
+    };
+    let mut positions = vec![DVec3::ZERO; n];
+    for (i, &j) in perm.iter().enumerate() {
+        positions[j as usize] = grid.positions[i];
+    }
+    let triangles = grid
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| perm[i as usize]))
+        .collect();
+    let mesh = ClothMesh::from_triangles(positions, triangles, Mass::Total(1.0), vec![])
+        .expect("valid mesh");
+    let params = ClothParams::default().edit(Family::BendDistance, |p| p.enabled = true);
+    let mut b = SolverBuilder::new(Settings::default(), Forces::default()).expect("valid");
+    b.add_cloth("c", &mesh, params, 0.0).expect("valid");
+    (b.build().constraints().distance.clone(), n)
+}
+
+/// Preorder list of the internal nodes' (lo, mid, hi) over `lo..hi`, as `fork` walks them.
+fn nodes(lo: usize, hi: usize, out: &mut Vec<(usize, usize, usize)>) {
+    if hi - lo < 2 {
+        return;
+    }
+    let mid = lo + (hi - lo) / 2;
+    out.push((lo, mid, hi));
+    nodes(lo, mid, out);
+    nodes(mid, hi, out);
+}
+
+#[test]
+fn a_link_goes_to_the_tree_node_that_splits_its_two_domains() {
+    for count in 1..24 {
+        let mut list = Vec::new();
+        nodes(0, count, &mut list);
+        assert_eq!(list.len(), count - 1);
+        for a in 0..count {
+            for b in a + 1..count {
+                let (lo, mid, hi) = list[tree_node(b, a, count)];
+                assert!(
+                    lo <= a && a < mid && mid <= b && b < hi,
+                    "{a} {b} of {count}"
+                );
+            }
+        }
+    }
+}
+
+fn global(d: &Domain, k: usize) -> (u32, u32) {
+    let s = d.start as u32;
+    (s + d.pairs.p[k], s + d.pairs.q[k])
+}
+
+#[test]
+fn every_constraint_is_solved_once_and_no_set_shares_a_particle() {
+    for shuffle in [false, true] {
+        let (block, n) = block(30, shuffle);
+        let domains = Domains::new(&block, n, 200, SimdPath::Scalar);
+        assert!(domains.list.len() > 3);
+        let mut seen: Vec<(u32, u32)> = Vec::new();
+        for d in &domains.list {
+            for colour in &d.colours {
+                let mut used: Vec<u32> = colour
+                    .clone()
+                    .flat_map(|k| {
+                        let (p, q) = global(d, k);
+                        [p, q]
+                    })
+                    .collect();
+                let len = used.len();
+                used.sort_unstable();
+                used.dedup();
+                assert_eq!(
+                    used.len(),
+                    len,
+                    "a set shares a particle (shuffle {shuffle})"
+                );
+                seen.extend(colour.clone().map(|k| global(d, k)));
+            }
+        }
+        let size = domains.size as u32;
+        for [(dp, ip), (dq, iq)] in domains.links.iter().flat_map(|l| &l.ends) {
+            assert_ne!(dp, dq);
+            let (p, q) = (dp * size + ip, dq * size + iq);
+            seen.push((p.min(q), p.max(q)));
+        }
+        let mut expected: Vec<(u32, u32)> = block
+            .particles
+            .iter()
+            .map(|&[p, q]| (p.min(q), p.max(q)))
+            .collect();
+        expected.sort_unstable();
+        seen.sort_unstable();
+        assert_eq!(seen, expected, "shuffle {shuffle}");
+    }
+}
+
+#[test]
+fn chunk_layouts_match_their_lanes_and_grids_mostly_load_with_unit_stride() {
+    // Rows of 32 split into whole chunks (a row of 30 leaves a ragged end of 6 per row).
+    let (block, n) = block(32, false);
+    let domains = Domains::new(&block, n, 4096, SimdPath::Scalar);
+    for d in &domains.list {
+        for c in &d.chunks {
+            let (p, q) = (&d.pairs.p[c.start..], &d.pairs.q[c.start..]);
+            // What the chunk carries for its lanes matches them.
+            assert_eq!((c.p0, c.q0), (p[0], q[0]));
+            assert_eq!(c.group, d.pairs.group[c.start]);
+            let rests = &d.pairs.rest[c.start..c.start + LANES];
+            if c.same_rest {
+                assert!(
+                    rests.iter().all(|&r| r == c.rest),
+                    "{rests:?} vs {}",
+                    c.rest
+                );
+            }
+            for l in 0..LANES {
+                let (ep, eq) = match c.layout {
+                    Layout::Contiguous => (p[0] + l as u32, q[0] + l as u32),
+                    Layout::Paired => (p[0] + 2 * l as u32, p[0] + 2 * l as u32 + 1),
+                    Layout::Quad => (p[0] + QUAD[l] as u32, p[0] + QUAD[l] as u32 + 2),
+                    Layout::Strided => (p[0] + 2 * l as u32, q[0] + 2 * l as u32),
+                    Layout::Spaced => (p[0] + 4 * l as u32, p[0] + 4 * l as u32 + 2),
+                    Layout::Gathered => (p[l], q[l]),
+                };
+                assert_eq!((p[l], q[l]), (ep, eq), "{:?}", c.layout);
+            }
+        }
+    }
+    let s = domains.stats();
+    let structured = s.contiguous + s.strided;
+    assert!(
+        structured as f64 > 0.7 * block.len() as f64,
+        "{s:?} of {}",
+        block.len()
+    );
+}
