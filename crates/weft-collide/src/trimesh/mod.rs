@@ -1,0 +1,253 @@
+//! Particle–triangle-mesh contact in closed form and in f64: the closest point on a triangle
+//! (`closest`), pseudo-normals that tell inside from outside (`normals`), a flat BVH that is
+//! refitted when the mesh deforms (`bvh`), continuous collision against still and moving
+//! triangles (`ccd`), per-particle candidate lists kept with a skin (`candidates`) and the
+//! vertex animations that drive deforming meshes (`deforming`).
+
+pub(crate) mod bvh;
+pub(crate) mod candidates;
+pub(crate) mod ccd;
+pub(crate) mod closest;
+pub(crate) mod deforming;
+pub(crate) mod normals;
+#[cfg(test)]
+mod vs_parry;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use bvh::{Bvh, box_distance_squared};
+use closest::{Closest, closest_on_triangle};
+use normals::{Topology, face_normal, pseudo_normal};
+
+/// One triangle at the end of the substep: its corners and unit normal (what the contact
+/// loops read, kept together for the cache).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Face {
+    /// Corners a, b, c (m, the collider's frame).
+    pub corners: [DVec3; 3],
+    /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
+    pub normal: DVec3,
+}
+
+impl Face {
+    fn new(corners: [DVec3; 3]) -> Self {
+        Self {
+            corners,
+            normal: face_normal(corners[0], corners[1], corners[2]),
+        }
+    }
+}
+
+/// A closest point on the mesh: triangle, point, signed distance (negative inside a closed
+/// mesh) and outward unit normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct MeshPoint {
+    /// Triangle index (storage order).
+    pub triangle: usize,
+    /// The closest point on that triangle.
+    pub closest: Closest,
+    /// Signed distance (m).
+    pub distance: f64,
+    /// Unit normal pointing from the surface to the particle's side (outward if inside).
+    pub normal: DVec3,
+}
+
+/// A triangle mesh in the collider's frame, with its vertices at the start and end of the
+/// substep (equal unless it deforms), per-triangle faces at the end, topology and BVH.
+#[derive(Clone, Debug)]
+pub(crate) struct MeshGeometry {
+    /// Triangles in BVH storage order.
+    pub triangles: Vec<[u32; 3]>,
+    /// Rest vertices (m), as given.
+    pub rest: Vec<DVec3>,
+    /// Vertices at the start of the substep.
+    pub start: Vec<DVec3>,
+    /// Vertices at the end of the substep: the current surface.
+    pub end: Vec<DVec3>,
+    /// Faces at the end of the substep, in storage order.
+    pub faces: Vec<Face>,
+    /// Adjacency and closedness.
+    pub topology: Topology,
+    /// Boxes of the triangles over the substep (start and end).
+    pub bvh: Bvh,
+    /// A bound on how far any vertex moved, summed over the substeps so far (m).
+    pub travel: f64,
+    /// The bound before the current substep.
+    pub travel_before: f64,
+    /// Whether the vertices moved in the current substep.
+    pub moving: bool,
+}
+
+impl MeshGeometry {
+    /// Builds the geometry of `vertices` and `triangles` (already validated).
+    pub fn new(vertices: &[DVec3], triangles: &[[u32; 3]]) -> Self {
+        let boxes: Vec<(DVec3, DVec3)> = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| vertices[i as usize]);
+                (a.min(b).min(c), a.max(b).max(c))
+            })
+            .collect();
+        let (bvh, order) = Bvh::build(&boxes);
+        let triangles: Vec<[u32; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
+        let topology = Topology::new(vertices.len(), &triangles);
+        let mut geometry = Self {
+            faces: Vec::new(),
+            triangles,
+            rest: vertices.to_vec(),
+            start: vertices.to_vec(),
+            end: vertices.to_vec(),
+            topology,
+            bvh,
+            travel: 0.0,
+            travel_before: 0.0,
+            moving: false,
+        };
+        geometry.faces = geometry.compute_faces();
+        geometry
+    }
+
+    fn compute_faces(&self) -> Vec<Face> {
+        let end = &self.end;
+        self.triangles
+            .par_iter()
+            .with_min_len(1024)
+            .map(|t| Face::new(t.map(|i| end[i as usize])))
+            .collect()
+    }
+
+    /// Whether the mesh is closed and consistently wound.
+    pub fn closed(&self) -> bool {
+        self.topology.closed
+    }
+
+    /// Starts a substep with the surface moving from the current vertices to `next`
+    /// (same length, finite; checked by the caller): refits the BVH to the swept boxes.
+    pub fn advance(&mut self, next: &[DVec3]) {
+        std::mem::swap(&mut self.start, &mut self.end);
+        self.end.copy_from_slice(next);
+        let moved = self
+            .start
+            .iter()
+            .zip(&self.end)
+            .map(|(a, b)| (*b - *a).length_squared())
+            .fold(0.0, f64::max)
+            .sqrt();
+        self.moving = moved > 0.0;
+        self.travel_before = self.travel;
+        self.travel += moved;
+        if !self.moving {
+            return;
+        }
+        self.faces = self.compute_faces();
+        let (start, end, triangles) = (&self.start, &self.end, &self.triangles);
+        self.bvh.refit(|i| {
+            let t = triangles[i];
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            for v in t {
+                for p in [start[v as usize], end[v as usize]] {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            (lo, hi)
+        });
+    }
+
+    /// Triangle `t`'s corners at the start of the substep.
+    pub fn start_corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.start[i as usize])
+    }
+
+    /// The (not normalised) pseudo-normal of `feature` of triangle `t` at the end of the
+    /// substep.
+    pub fn pseudo_normal(&self, t: usize, feature: closest::Feature) -> DVec3 {
+        pseudo_normal(
+            &self.topology,
+            &self.triangles,
+            t,
+            feature,
+            |u| self.faces[u].normal,
+            |u, k| self.faces[u].corners[k],
+        )
+    }
+
+    /// Signed answer for the closest point `c` of triangle `t` to `x` at distance² `d2`:
+    /// for a closed mesh the sign of (x − q) · pseudo-normal (Bærentzen & Aanæs 2005,
+    /// Theorem 1), else positive.
+    pub fn signed(&self, x: DVec3, t: usize, c: Closest, d2: f64) -> MeshPoint {
+        let delta = x - c.point;
+        let len = d2.sqrt();
+        let pn = self.pseudo_normal(t, c.feature);
+        let inside = self.closed() && delta.dot(pn) < 0.0;
+        let normal = if len > 1e-12 {
+            if inside { -delta / len } else { delta / len }
+        } else {
+            pn.normalize_or(self.faces[t].normal)
+        };
+        MeshPoint {
+            triangle: t,
+            closest: c,
+            distance: if inside { -len } else { len },
+            normal,
+        }
+    }
+
+    /// The closest point of the whole mesh to `x` within `max_dist` (BVH branch and bound).
+    pub fn nearest(&self, x: DVec3, max_dist: f64) -> Option<MeshPoint> {
+        let faces = &self.faces;
+        let limit = if max_dist.is_finite() {
+            max_dist * max_dist
+        } else {
+            f64::INFINITY
+        };
+        let (t, d2, c) = self.bvh.nearest(x, limit, |t| {
+            let [a, b, cc] = faces[t].corners;
+            let c = closest_on_triangle(x, a, b, cc);
+            Some(((x - c.point).length_squared(), c))
+        })?;
+        Some(self.signed(x, t, c, d2))
+    }
+
+    /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
+    /// a fixed order.
+    pub fn within(&self, x: DVec3, radius: f64, out: &mut Vec<u32>) {
+        let r2 = radius * radius;
+        let faces = &self.faces;
+        self.bvh.visit(
+            |lo, hi| box_distance_squared(x, lo, hi) <= r2,
+            |t| {
+                let [a, b, c] = faces[t].corners;
+                if (x - closest_on_triangle(x, a, b, c).point).length_squared() <= r2 {
+                    out.push(t as u32);
+                }
+            },
+        );
+    }
+
+    /// The mesh's box at the end of the substep (of the swept boxes while it moves).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.bvh.bounds()
+    }
+
+    /// The first crossing of the segment `from → to` with the current surface (the entry into
+    /// a closed mesh, any crossing of an open one): (fraction, unit normal facing `from`).
+    pub fn sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
+        let (lo, hi) = (from.min(to), from.max(to));
+        let closed = self.closed();
+        let mut best: Option<(f64, DVec3)> = None;
+        self.bvh.visit(
+            |l, h| l.cmple(hi).all() && h.cmpge(lo).all(),
+            |t| {
+                let f = &self.faces[t];
+                if let Some(c) = ccd::segment_crossing(from, to, f.corners, f.normal, closed)
+                    && best.is_none_or(|b| c.t < b.0)
+                {
+                    best = Some((c.t, f.normal * c.side));
+                }
+            },
+        );
+        best
+    }
+}
