@@ -143,6 +143,15 @@ impl CollisionWorld {
             .sum()
     }
 
+    /// Triangles now listed for triangle-mesh contacts, over all particles and mesh
+    /// colliders.
+    pub fn mesh_list_entries(&self) -> usize {
+        self.mesh_lists
+            .iter()
+            .flat_map(|chunk| chunk.iter().map(ChunkLists::entries))
+            .sum()
+    }
+
     /// Whether collider `c` goes through the world's own mesh contacts.
     fn own_mesh(&self, c: &Collider) -> bool {
         c.mesh().is_some() && (!self.parry_meshes || c.is_deforming())

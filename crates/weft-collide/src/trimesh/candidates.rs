@@ -43,6 +43,9 @@ pub(crate) struct ChunkLists {
     inside: Vec<bool>,
     /// The particle's position after the last projection (collider frame, end pose).
     last: Vec<DVec3>,
+    /// The triangle each particle touched last (tested first: it tightens the search), or
+    /// `u32::MAX`.
+    hint: Vec<u32>,
     /// Each particle's list: `tris[start .. start + len]`.
     range: Vec<(u32, u32)>,
     /// The lists, end to end; rebuilt lists are appended and the arena compacted when half
@@ -63,11 +66,17 @@ impl ChunkLists {
             travel: vec![0.0; n],
             inside: vec![false; n],
             last: vec![DVec3::ZERO; n],
+            hint: vec![u32::MAX; n],
             range: vec![(0, 0); n],
             tris: Vec::new(),
             live: 0,
             builds: 0,
         }
+    }
+
+    /// Triangles listed, over all particles of the chunk.
+    pub fn entries(&self) -> usize {
+        self.live
     }
 
     /// Drops stale entries once they are more than half the arena.
@@ -168,7 +177,7 @@ impl MeshFrame<'_> {
         let old = lists.range[j];
         lists.live -= old.1 as usize;
         let start = lists.tris.len();
-        g.within(x, radius, &mut lists.tris);
+        let nearest = g.within(x, radius, &mut lists.tris);
         let len = lists.tris.len() - start;
         lists.live += len;
         lists.range[j] = (start as u32, len as u32);
@@ -177,22 +186,9 @@ impl MeshFrame<'_> {
         let closed = g.closed();
         let (lo, hi) = g.bounds();
         let outside_box = box_distance_squared(x, lo, hi).sqrt();
-        let (clearance, inside) = if len > 0 {
-            let inside = closed && {
-                // The nearest listed triangle is the nearest of all (it is within R).
-                let mut best = (f64::INFINITY, 0usize, None);
-                for &t in &lists.tris[start..] {
-                    let [a, b, c] = g.faces[t as usize].corners;
-                    let q = closest_on_triangle(x, a, b, c);
-                    let d2 = (x - q.point).length_squared();
-                    if d2 < best.0 {
-                        best = (d2, t as usize, Some(q));
-                    }
-                }
-                best.2
-                    .is_some_and(|q| g.signed(x, best.1, q, best.0).distance < 0.0)
-            };
-            (radius, inside)
+        let (clearance, inside) = if let Some(p) = nearest {
+            // The nearest listed triangle is the nearest of all (it is within R).
+            (radius, p.distance < 0.0)
         } else if !closed || outside_box > 0.0 {
             (radius.max(outside_box), false)
         } else {
@@ -210,11 +206,24 @@ impl MeshFrame<'_> {
 
     /// The earliest crossing of the path `from → x` with a listed triangle: (crossing,
     /// triangle).
-    fn first_crossing(&self, list: &[u32], from: DVec3, x: DVec3) -> Option<(Crossing, usize)> {
+    fn first_crossing(
+        &self,
+        list: &[u32],
+        from: DVec3,
+        x: DVec3,
+        r: f64,
+    ) -> Option<(Crossing, usize)> {
         let g = self.geometry;
         let closed = g.closed();
         let moving = self.fresh && g.moving;
-        if !moving && from == x {
+        // A path shorter than r/2 (relative to the surface) cannot cross it from r away,
+        // where the last projection left the particle (as the closed-form shapes' sweep).
+        let surface = if moving {
+            g.travel - g.travel_before
+        } else {
+            0.0
+        };
+        if (x - from).length() + surface <= 0.5 * r {
             return None;
         }
         let mut best: Option<(Crossing, usize)> = None;
@@ -273,7 +282,7 @@ impl MeshFrame<'_> {
         self.ensure(lists, j, xl, from, r);
         let (s, len) = lists.range[j];
         if let Some((c, t)) =
-            self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl)
+            self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl, r)
         {
             let f = &g.faces[t];
             let [a, b, cc] = f.corners;
@@ -281,24 +290,50 @@ impl MeshFrame<'_> {
             moved(&mut xl, x, hit + f.normal * (c.side * r));
             out.swept += 1;
         }
+        // After a push by δ every distance drops by at most δ: a round is needed again only
+        // if the runner-up of the last one (a lower bound on its distance) was within r + δ.
+        let mut again = true;
         for _ in 0..ROUNDS {
+            if !again {
+                break;
+            }
             self.ensure(lists, j, xl, from, r);
             let (s, len) = lists.range[j];
             let mut best: Option<(f64, usize, super::closest::Closest)> = None;
             let mut bound = r * r;
-            for &t in &lists.tris[s as usize..(s + len) as usize] {
-                let f = &g.faces[t as usize];
-                let h = f.normal.dot(xl - f.corners[0]);
-                // The plane is at least as far as the triangle.
-                if h >= r || h <= -r {
-                    continue;
-                }
+            let mut second = f64::INFINITY;
+            let x32 = xl.as_vec3();
+            let hint = lists.hint[j];
+            if let Some(f) = g.faces.get(hint as usize) {
                 let [a, b, c] = f.corners;
                 let q = closest_on_triangle(xl, a, b, c);
                 let d2 = (xl - q.point).length_squared();
                 if d2 < bound {
                     bound = d2;
+                    best = Some((d2, hint as usize, q));
+                }
+            }
+            for &t in &lists.tris[s as usize..(s + len) as usize] {
+                if t == hint {
+                    continue;
+                }
+                // Cheap reject: the plane and edge lines are no farther than the triangle.
+                let lower = f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin));
+                if lower >= bound {
+                    second = second.min(lower);
+                    continue;
+                }
+                let [a, b, c] = g.faces[t as usize].corners;
+                let q = closest_on_triangle(xl, a, b, c);
+                let d2 = (xl - q.point).length_squared();
+                if d2 < bound {
+                    if best.is_some() {
+                        second = second.min(bound);
+                    }
+                    bound = d2;
                     best = Some((d2, t as usize, q));
+                } else {
+                    second = second.min(d2);
                 }
             }
             let hit = match best {
@@ -323,10 +358,12 @@ impl MeshFrame<'_> {
                 }
                 None => break,
             };
+            lists.hint[j] = hit.triangle as u32;
             let depth = r - hit.distance;
             if depth <= 1e-6 * r.max(1e-3) {
                 break;
             }
+            again = second.sqrt() - depth < r;
             let to = xl + hit.normal * depth;
             moved(&mut xl, x, to);
             // Relative tangential displacement over the substep against the surface's own
@@ -336,6 +373,8 @@ impl MeshFrame<'_> {
             let tangential = rel - n * n.dot(rel);
             let correction = self.friction.correction(tangential, depth);
             if correction != DVec3::ZERO {
+                // A tangential move of |correction| ≤ the slip: distances drop by at most it.
+                again |= second.sqrt() - depth - correction.length() < r;
                 *x -= correction;
                 xl = self.to_local(self.pose, *x);
             }

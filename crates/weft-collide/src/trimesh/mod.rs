@@ -20,22 +20,78 @@ use bvh::{Bvh, box_distance_squared};
 use closest::{Closest, closest_on_triangle};
 use normals::{Topology, face_normal, pseudo_normal};
 
-/// One triangle at the end of the substep: its corners and unit normal (what the contact
-/// loops read, kept together for the cache).
+/// One triangle at the end of the substep: its corners, unit normal and in-plane outward
+/// edge normals (what the contact loops read, kept together for the cache).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Face {
     /// Corners a, b, c (m, the collider's frame).
     pub corners: [DVec3; 3],
     /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
     pub normal: DVec3,
+    /// Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
+    pub edges: [DVec3; 3],
 }
 
 impl Face {
     fn new(corners: [DVec3; 3]) -> Self {
+        let normal = face_normal(corners[0], corners[1], corners[2]);
+        let edge = |k: usize| {
+            (corners[(k + 1) % 3] - corners[k])
+                .cross(normal)
+                .normalize_or_zero()
+        };
         Self {
             corners,
-            normal: face_normal(corners[0], corners[1], corners[2]),
+            normal,
+            edges: [edge(0), edge(1), edge(2)],
         }
+    }
+
+    /// A lower bound on the squared distance from `x` to the triangle: the squared distance
+    /// to its plane plus the square of the farthest in-plane distance beyond an edge's line.
+    #[inline]
+    pub fn distance_squared_bound(&self, x: DVec3) -> f64 {
+        let h = self.normal.dot(x - self.corners[0]);
+        let beyond = self.edges[0]
+            .dot(x - self.corners[0])
+            .max(self.edges[1].dot(x - self.corners[1]))
+            .max(self.edges[2].dot(x - self.corners[2]))
+            .max(0.0);
+        h * h + beyond * beyond
+    }
+}
+
+/// A triangle's planes in f32, one cache line, for a cheap conservative distance bound: its
+/// plane n · x = n · a and its three edge lines' in-plane outward normals e_k · x = e_k · p_k.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(align(64))]
+pub(crate) struct Planes([f32; 16]);
+
+impl Planes {
+    fn new(f: &Face) -> Self {
+        let mut p = [0f32; 16];
+        let planes = [
+            (f.normal, f.corners[0]),
+            (f.edges[0], f.corners[0]),
+            (f.edges[1], f.corners[1]),
+            (f.edges[2], f.corners[2]),
+        ];
+        for (k, (n, at)) in planes.into_iter().enumerate() {
+            p[4 * k..4 * k + 3].copy_from_slice(&n.as_vec3().to_array());
+            p[4 * k + 3] = n.dot(at) as f32;
+        }
+        Self(p)
+    }
+
+    /// A lower bound on the squared distance from `x` to the triangle, less `margin` (the
+    /// f32 rounding of these terms) on each part: as [`Face::distance_squared_bound`].
+    #[inline]
+    pub fn distance_squared_bound(&self, x: glam::Vec3, margin: f32) -> f32 {
+        let p = &self.0;
+        let d = |k: usize| p[k] * x.x + p[k + 1] * x.y + p[k + 2] * x.z - p[k + 3];
+        let h = (d(0).abs() - margin).max(0.0);
+        let beyond = (d(4).max(d(8)).max(d(12)) - margin).max(0.0);
+        h * h + beyond * beyond
     }
 }
 
@@ -67,6 +123,10 @@ pub(crate) struct MeshGeometry {
     pub end: Vec<DVec3>,
     /// Faces at the end of the substep, in storage order.
     pub faces: Vec<Face>,
+    /// Their planes in f32, for the contact loops' first test.
+    pub planes: Vec<Planes>,
+    /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
+    pub margin: f32,
     /// Adjacency and closedness.
     pub topology: Topology,
     /// Boxes of the triangles over the substep (start and end).
@@ -92,8 +152,13 @@ impl MeshGeometry {
         let (bvh, order) = Bvh::build(&boxes);
         let triangles: Vec<[u32; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
         let topology = Topology::new(vertices.len(), &triangles);
+        let extent = vertices
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         let mut geometry = Self {
             faces: Vec::new(),
+            planes: Vec::new(),
+            margin: 0.0,
             triangles,
             rest: vertices.to_vec(),
             start: vertices.to_vec(),
@@ -105,7 +170,15 @@ impl MeshGeometry {
             moving: false,
         };
         geometry.faces = geometry.compute_faces();
+        geometry.planes = geometry.faces.iter().map(Planes::new).collect();
+        geometry.set_margin(extent);
         geometry
+    }
+
+    /// The rounding margin for particles near a mesh within `extent` of the origin: a few
+    /// f32 ulps of the largest coordinate (with the lists' reach, 1 m).
+    fn set_margin(&mut self, extent: f64) {
+        self.margin = (1e-6 * (extent + 1.0)) as f32;
     }
 
     fn compute_faces(&self) -> Vec<Face> {
@@ -141,6 +214,17 @@ impl MeshGeometry {
             return;
         }
         self.faces = self.compute_faces();
+        self.planes = self
+            .faces
+            .par_iter()
+            .with_min_len(1024)
+            .map(Planes::new)
+            .collect();
+        let extent = self
+            .end
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+        self.set_margin(extent);
         let (start, end, triangles) = (&self.start, &self.end, &self.triangles);
         self.bvh.refit(|i| {
             let t = triangles[i];
@@ -211,19 +295,30 @@ impl MeshGeometry {
     }
 
     /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
-    /// a fixed order.
-    pub fn within(&self, x: DVec3, radius: f64, out: &mut Vec<u32>) {
+    /// a fixed order; returns the nearest of them.
+    pub fn within(&self, x: DVec3, radius: f64, out: &mut Vec<u32>) -> Option<MeshPoint> {
         let r2 = radius * radius;
         let faces = &self.faces;
+        let mut best: Option<(f64, usize, Closest)> = None;
         self.bvh.visit(
             |lo, hi| box_distance_squared(x, lo, hi) <= r2,
             |t| {
-                let [a, b, c] = faces[t].corners;
-                if (x - closest_on_triangle(x, a, b, c).point).length_squared() <= r2 {
+                let f = &faces[t];
+                if f.distance_squared_bound(x) > r2 {
+                    return;
+                }
+                let [a, b, c] = f.corners;
+                let q = closest_on_triangle(x, a, b, c);
+                let d2 = (x - q.point).length_squared();
+                if d2 <= r2 {
                     out.push(t as u32);
+                    if best.is_none_or(|b| d2 < b.0) {
+                        best = Some((d2, t, q));
+                    }
                 }
             },
         );
+        best.map(|(d2, t, q)| self.signed(x, t, q, d2))
     }
 
     /// The mesh's box at the end of the substep (of the swept boxes while it moves).
