@@ -304,7 +304,9 @@ impl MeshFrame<'_> {
             let mut second = f64::INFINITY;
             let x32 = xl.as_vec3();
             let hint = lists.hint[j];
-            if let Some(f) = g.faces.get(hint as usize) {
+            if let Some(f) = g.faces.get(hint as usize)
+                && f64::from(g.planes[hint as usize].distance_squared_bound(x32, g.margin)) < bound
+            {
                 let [a, b, c] = f.corners;
                 let q = closest_on_triangle(xl, a, b, c);
                 let d2 = (xl - q.point).length_squared();

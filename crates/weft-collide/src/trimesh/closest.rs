@@ -29,7 +29,7 @@ pub(crate) struct Closest {
 }
 
 /// The point of triangle (a, b, c) closest to `p` (Ericson §5.1.5).
-#[inline]
+#[inline(always)]
 pub(crate) fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Closest {
     let at = |point, bary, feature| Closest {
         point,
