@@ -1,5 +1,7 @@
 //! Colliders: a parry shape with a pose that follows a prescribed motion, and friction.
 
+use std::sync::Arc;
+
 use glam::{DVec3, Quat, Vec3};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
@@ -13,6 +15,8 @@ use crate::error::ShapeError;
 use crate::friction::Friction;
 use crate::shape::ShapeDesc;
 use crate::surface::SurfacePoint;
+use crate::trimesh::MeshGeometry;
+use crate::trimesh::deforming::MeshAnimation;
 
 /// How to build a collider: shape, placement at t = 0, motion and friction.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,7 +73,8 @@ impl ColliderDesc {
 /// A built collider: parry shape, rest pose, motion, friction and the current pose.
 ///
 /// Spheres, half-spaces, cuboids and capsules are queried in closed form in f64
-/// (`analytic.rs`) with the pose held in f64; other shapes go through parry in f32.
+/// (`analytic.rs`) with the pose held in f64, triangle meshes in f64 through their own BVH
+/// (`trimesh/`); convex hulls and compounds go through parry in f32.
 #[derive(Clone)]
 pub struct Collider {
     shape: SharedShape,
@@ -91,6 +96,12 @@ pub struct Collider {
     prev_pose64: WorldPose,
     /// Whether the f64 pose did not change over the substep.
     still: bool,
+    /// A triangle mesh's own geometry, in f64 (the collider's frame).
+    mesh: Option<Box<MeshGeometry>>,
+    /// What moves a deforming mesh's vertices.
+    animation: Option<Arc<dyn MeshAnimation>>,
+    /// The animation's output for the substep's end.
+    next_vertices: Vec<DVec3>,
 }
 
 impl std::fmt::Debug for Collider {
@@ -100,6 +111,7 @@ impl std::fmt::Debug for Collider {
             .field("pose", &self.pose)
             .field("motion", &self.motion)
             .field("friction", &self.friction)
+            .field("deforming", &self.animation.is_some())
             .finish()
     }
 }
@@ -124,6 +136,13 @@ impl Collider {
         let start = compose(desc.motion.transform(0.0), &rest);
         let rest64 = WorldPose::new(desc.position.as_dvec3(), desc.rotation.as_dquat());
         let start64 = carry(desc.motion, 0.0, &rest64);
+        let mesh = match &desc.shape {
+            ShapeDesc::TriMesh(m) => {
+                let vertices: Vec<DVec3> = m.vertices.iter().map(|v| v.as_dvec3()).collect();
+                Some(Box::new(MeshGeometry::new(&vertices, &m.triangles)))
+            }
+            _ => None,
+        };
         Ok(Self {
             shape,
             kind: desc.shape.kind(),
@@ -138,6 +157,71 @@ impl Collider {
             pose64: start64,
             prev_pose64: start64,
             still: true,
+            mesh,
+            animation: None,
+            next_vertices: Vec::new(),
+        })
+    }
+
+    /// A deforming triangle-mesh collider: `desc`'s mesh, whose vertices (in the collider's
+    /// frame, which still follows `desc`'s placement and motion) `animation` gives at every
+    /// substep's end. Its acceleration structure is refitted, not rebuilt, and contacts are
+    /// swept against the moving triangles.
+    pub fn deforming(
+        desc: &ColliderDesc,
+        animation: Arc<dyn MeshAnimation>,
+    ) -> Result<Self, ShapeError> {
+        let mut c = Self::new(desc)?;
+        let Some(mesh) = c.mesh.as_mut() else {
+            return Err(ShapeError::InvalidParameter {
+                name: "deforming collider shape",
+                value: f64::NAN,
+                expected: "a triangle mesh",
+            });
+        };
+        let mut now = mesh.rest.clone();
+        animation.vertices_at(0.0, &mesh.rest, &mut now);
+        if !now.iter().all(|v| v.is_finite()) {
+            return Err(ShapeError::InvalidParameter {
+                name: "deforming mesh vertices at t = 0",
+                value: f64::NAN,
+                expected: "finite positions",
+            });
+        }
+        mesh.advance(&now);
+        mesh.advance(&now);
+        c.next_vertices = now;
+        c.animation = Some(animation);
+        c.local_aabb = c.mesh_aabb();
+        Ok(c)
+    }
+
+    /// Whether the collider is a deforming mesh.
+    pub fn is_deforming(&self) -> bool {
+        self.animation.is_some()
+    }
+
+    /// A triangle mesh's vertices at the end of the current substep, in the collider's frame,
+    /// in the order of its `TriangleMesh` (for drawing a deforming mesh); `None` for others.
+    pub fn mesh_vertices(&self) -> Option<&[DVec3]> {
+        self.mesh.as_ref().map(|m| &m.end[..])
+    }
+
+    /// The triangle-mesh geometry, for the world's contacts.
+    pub(crate) fn mesh(&self) -> Option<&MeshGeometry> {
+        self.mesh.as_deref()
+    }
+
+    /// The f64 poses at the end and start of the substep, and whether they are equal.
+    pub(crate) fn poses64(&self) -> (&WorldPose, &WorldPose, bool) {
+        (&self.pose64, &self.prev_pose64, self.still)
+    }
+
+    /// The mesh's local box (swept over the substep while it deforms).
+    fn mesh_aabb(&self) -> Option<Aabb> {
+        self.mesh.as_ref().map(|m| {
+            let (lo, hi) = m.bounds();
+            Aabb::new(lo.as_vec3(), hi.as_vec3())
         })
     }
 
@@ -173,6 +257,15 @@ impl Collider {
         self.prev_pose64 = carry(self.motion, t0, &self.rest64);
         self.pose64 = carry(self.motion, t1, &self.rest64);
         self.still = self.pose64 == self.prev_pose64;
+        if let (Some(animation), Some(mesh)) = (&self.animation, self.mesh.as_mut()) {
+            let next = &mut self.next_vertices;
+            animation.vertices_at(t1, &mesh.rest, next);
+            if !next.iter().all(|v| v.is_finite()) {
+                next.copy_from_slice(&mesh.end); // a bad frame: hold the last good one
+            }
+            mesh.advance(next);
+            self.local_aabb = self.mesh_aabb();
+        }
     }
 
     /// Whether one push along [`Self::closest`]'s normal to a distance r always clears a
@@ -195,10 +288,19 @@ impl Collider {
     /// The closest surface point to `x` if it lies within `max_dist` of the surface or `x` is
     /// inside (for meshes: within `max_dist` on either side).
     ///
-    /// Spheres, half-spaces, cuboids and capsules are answered in closed form in f64. For the
-    /// other shapes parry works in f32, so the query point is rounded to f32 here and the
+    /// Spheres, half-spaces, cuboids and capsules are answered in closed form in f64, triangle
+    /// meshes in f64 through their BVH, signed by pseudo-normals (negative inside a closed
+    /// mesh). For hulls and compounds parry works in f32, so the query point is rounded to f32 here and the
     /// answer widened back (a ~1e-7 m error on the surface point, none on the state).
     pub fn closest(&self, x: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        if let Some(mesh) = &self.mesh {
+            let p = mesh.nearest(self.pose64.inverse_transform_point(x), max_dist)?;
+            return Some(SurfacePoint {
+                point: self.pose64.transform_point(p.closest.point),
+                normal: self.pose64.rotation * p.normal,
+                distance: p.distance,
+            });
+        }
         match &self.analytic {
             Some(a) => a.closest(&self.pose64, x, max_dist),
             None => self.parry_closest(x, max_dist),
@@ -216,9 +318,11 @@ impl Collider {
         })
     }
 
-    /// How far the material point of the collider now at `point` moved during this substep.
+    /// How far the material point of the collider now at `point` moved during this substep
+    /// (for a deforming mesh, by the collider's rigid motion only; its contacts follow the
+    /// triangles themselves).
     pub fn displacement_at(&self, point: DVec3) -> DVec3 {
-        if self.analytic.is_some() {
+        if self.analytic.is_some() || self.mesh.is_some() {
             if self.still {
                 return DVec3::ZERO; // exactly, as below
             }
@@ -237,6 +341,14 @@ impl Collider {
 
     /// First hit of the segment `from → to` with the surface: `(fraction, normal facing from)`.
     pub fn sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
+        if let Some(mesh) = &self.mesh {
+            let (a, b) = (
+                self.pose64.inverse_transform_point(from),
+                self.pose64.inverse_transform_point(to),
+            );
+            let (t, n) = mesh.sweep(a, b)?;
+            return Some((t, self.pose64.rotation * n));
+        }
         let Some(shape) = &self.analytic else {
             return self.parry_sweep(from, to);
         };

@@ -1,5 +1,5 @@
-//! Weft's collisions: parry3d colliders (static or kinematic), Coulomb friction and
-//! particle self-collision, plugged into the solver's substeps as a
+//! Weft's collisions: colliders (static, kinematic or deforming triangle meshes), Coulomb
+//! friction and particle self-collision, plugged into the solver's substeps as a
 //! [`weft_solver::SubstepHook`] ([`CollisionWorld`]).
 #![warn(missing_docs)]
 
@@ -20,6 +20,7 @@ mod surface;
 mod tessellate;
 #[cfg(test)]
 mod test_rand;
+mod trimesh;
 mod world;
 
 pub use collider::{Collider, ColliderDesc};
@@ -31,6 +32,7 @@ pub use self_collision::{SelfCollisionParams, SelfCollisionTimes};
 pub use shape::{CompoundPart, ShapeDesc};
 pub use surface::SurfacePoint;
 pub use tessellate::{HALF_SPACE_EXTENT, Tessellation, tessellate_shape};
+pub use trimesh::deforming::{Keyframes, MeshAnimation};
 pub use world::{CollisionWorld, ContactStats};
 
 /// Re-export of parry, so users name the same shape types.

@@ -35,6 +35,78 @@ impl TriangleMesh {
         )
     }
 
+    /// A sphere of `radius` about the origin as a closed mesh: the icosahedron with each
+    /// triangle split in four `subdivisions` times (20 · 4^k triangles), vertices projected
+    /// onto the sphere. Its largest distance from the sphere, between vertices, is below
+    /// `radius` · (1 − cos θ) with θ the largest edge's angle.
+    pub fn icosphere(radius: f32, subdivisions: u32) -> Self {
+        let t = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut vertices: Vec<glam::DVec3> = [
+            (-1.0, t, 0.0),
+            (1.0, t, 0.0),
+            (-1.0, -t, 0.0),
+            (1.0, -t, 0.0),
+            (0.0, -1.0, t),
+            (0.0, 1.0, t),
+            (0.0, -1.0, -t),
+            (0.0, 1.0, -t),
+            (t, 0.0, -1.0),
+            (t, 0.0, 1.0),
+            (-t, 0.0, -1.0),
+            (-t, 0.0, 1.0),
+        ]
+        .iter()
+        .map(|&(x, y, z)| glam::DVec3::new(x, y, z).normalize())
+        .collect();
+        let mut triangles: Vec<[u32; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..subdivisions {
+            let mut middle = rustc_hash::FxHashMap::default();
+            let mut split = |a: u32, b: u32, vertices: &mut Vec<glam::DVec3>| {
+                *middle.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    let m = (vertices[a as usize] + vertices[b as usize]).normalize();
+                    vertices.push(m);
+                    (vertices.len() - 1) as u32
+                })
+            };
+            let mut next = Vec::with_capacity(4 * triangles.len());
+            for [a, b, c] in triangles {
+                let ab = split(a, b, &mut vertices);
+                let bc = split(b, c, &mut vertices);
+                let ca = split(c, a, &mut vertices);
+                next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+            }
+            triangles = next;
+        }
+        Self {
+            vertices: vertices
+                .iter()
+                .map(|v| (*v * f64::from(radius)).as_vec3())
+                .collect(),
+            triangles,
+        }
+    }
+
     /// A copy scaled by `scale` about the origin, then moved by `offset`.
     pub fn transformed(&self, scale: f32, offset: Vec3) -> Self {
         Self {

@@ -222,3 +222,44 @@ pub fn mesh_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), C
     world.add_collider(&ground(0.0))?;
     Ok((solver, world))
 }
+
+/// Subdivisions of [`icosphere_drop`]'s mesh: 20 · 4⁵ = 20,480 triangles.
+pub const ICOSPHERE_SUBDIVISIONS: u32 = 5;
+
+/// [`sphere_drop`] with the sphere as a triangle mesh: an icosphere of radius
+/// [`SPHERE_RADIUS`] and 20,480 triangles ([`ICOSPHERE_SUBDIVISIONS`]) at the origin, on the
+/// ground; the same cloth falls onto it.
+pub fn icosphere_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
+    let solver = falling_sheet(method, n, 1.6, SPHERE_RADIUS + 0.2, 0.4)?;
+    let mut world = CollisionWorld::new(&solver);
+    world.add_collider(
+        &ColliderDesc::new(ShapeDesc::TriMesh(crate::mesh::TriangleMesh::icosphere(
+            SPHERE_RADIUS as f32,
+            ICOSPHERE_SUBDIVISIONS,
+        )))
+        .with_friction(Friction::new(0.8, 0.6)),
+    )?;
+    world.add_collider(&ground(-SPHERE_RADIUS as f32))?;
+    Ok((solver, world))
+}
+
+/// A breathing, rippling ball: each vertex of an icosphere (radius [`SPHERE_RADIUS`], 5,120
+/// triangles) moves along its direction by 4 % of the radius · sin(2π (1 Hz · t + 2 y)), a
+/// deforming mesh; the cloth of [`sphere_drop`] (`n`×`n`) falls onto it, and the ground.
+pub fn breathing_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
+    let solver = falling_sheet(method, n, 1.6, SPHERE_RADIUS + 0.25, 0.4)?;
+    let mut world = CollisionWorld::new(&solver);
+    let ball = crate::mesh::TriangleMesh::icosphere(SPHERE_RADIUS as f32, 4);
+    let breathe = |t: f64, rest: &[DVec3], out: &mut [DVec3]| {
+        for (o, v) in out.iter_mut().zip(rest) {
+            let phase = std::f64::consts::TAU * (t + 2.0 * v.y);
+            *o = *v * (1.0 + 0.04 * phase.sin());
+        }
+    };
+    world.add_deforming_mesh(
+        &ColliderDesc::new(ShapeDesc::TriMesh(ball)).with_friction(Friction::new(0.8, 0.6)),
+        std::sync::Arc::new(breathe),
+    )?;
+    world.add_collider(&ground(-1.1 * SPHERE_RADIUS as f32))?;
+    Ok((solver, world))
+}

@@ -9,13 +9,17 @@
 //! v = (x − x_prev) / h then removes the normal approach velocity, exactly as it does for XPBD
 //! and PBD.
 
-use glam::DVec3;
+use std::sync::Arc;
+
+use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
+use crate::trimesh::candidates::{ChunkLists, MeshFrame};
+use crate::trimesh::deforming::MeshAnimation;
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -45,6 +49,11 @@ pub struct CollisionWorld {
     max_thickness: f64,
     fresh: bool,
     stats: ContactStats,
+    /// Per chunk of [`CHUNK`] particles, the candidate lists of each triangle-mesh collider.
+    mesh_lists: Vec<Vec<ChunkLists>>,
+    /// Triangle meshes go through parry's f32 queries, as before the f64 mesh path (kept
+    /// for comparisons).
+    parry_meshes: bool,
 }
 
 /// Rounds of re-query per particle and collider (a push out of one face of a mesh may land in
@@ -74,6 +83,8 @@ impl CollisionWorld {
             max_thickness: 0.0,
             fresh: true,
             stats: ContactStats::default(),
+            mesh_lists: Vec::new(),
+            parry_meshes: false,
         };
         world.sync_thickness(solver);
         world
@@ -86,6 +97,7 @@ impl CollisionWorld {
             self.thickness[cloth.particles.clone()].fill(cloth.thickness);
         }
         self.max_thickness = self.thickness.iter().copied().fold(0.0, f64::max);
+        self.mesh_lists.clear();
         if let Some(sc) = &mut self.self_collision {
             sc.invalidate();
         }
@@ -93,9 +105,55 @@ impl CollisionWorld {
 
     /// Builds and adds a collider; returns its index.
     pub fn add_collider(&mut self, desc: &ColliderDesc) -> Result<usize, ShapeError> {
-        self.colliders.push(Collider::new(desc)?);
+        self.push(Collider::new(desc)?)
+    }
+
+    /// Builds and adds a deforming triangle-mesh collider: `desc`'s mesh (its vertices the
+    /// rest shape), whose vertices `animation` sets at every substep (see
+    /// [`MeshAnimation`]); returns its index.
+    pub fn add_deforming_mesh(
+        &mut self,
+        desc: &ColliderDesc,
+        animation: Arc<dyn MeshAnimation>,
+    ) -> Result<usize, ShapeError> {
+        self.push(Collider::deforming(desc, animation)?)
+    }
+
+    fn push(&mut self, c: Collider) -> Result<usize, ShapeError> {
+        self.colliders.push(c);
         self.bounds.push(None);
+        self.mesh_lists.clear();
         Ok(self.colliders.len() - 1)
+    }
+
+    /// Sends triangle meshes through parry's f32 projection and ray casts (`true`), as Weft
+    /// did before its own mesh contacts, or through those (`false`, the default). For
+    /// side-by-side comparisons; deforming meshes need the default.
+    pub fn set_parry_meshes(&mut self, on: bool) {
+        self.parry_meshes = on;
+        self.mesh_lists.clear();
+    }
+
+    /// Candidate lists built so far for triangle-mesh contacts (all mesh colliders).
+    pub fn mesh_list_builds(&self) -> u64 {
+        self.mesh_lists
+            .iter()
+            .flat_map(|chunk| chunk.iter().map(|l| l.builds))
+            .sum()
+    }
+
+    /// Triangles now listed for triangle-mesh contacts, over all particles and mesh
+    /// colliders.
+    pub fn mesh_list_entries(&self) -> usize {
+        self.mesh_lists
+            .iter()
+            .flat_map(|chunk| chunk.iter().map(ChunkLists::entries))
+            .sum()
+    }
+
+    /// Whether collider `c` goes through the world's own mesh contacts.
+    fn own_mesh(&self, c: &Collider) -> bool {
+        c.mesh().is_some() && (!self.parry_meshes || c.is_deforming())
     }
 
     /// The colliders.
@@ -166,41 +224,98 @@ impl CollisionWorld {
             self.stats.swept = 0;
             return;
         }
+        let own: Vec<bool> = self.colliders.iter().map(|c| self.own_mesh(c)).collect();
+        let parry = self.parry_meshes;
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
         self.stats.swept = over_free_particles(
             p,
             0,
-            |i, x, prev| sweep_one(colliders, bounds, prev, x, thickness[i]),
+            |i, x, prev| sweep_one(colliders, bounds, &own, parry, prev, x, thickness[i]),
             |a, b| a + b,
         );
     }
 
     /// Pushes particles out of colliders to surface + thickness, with Coulomb friction. In
-    /// parallel over particles; each particle meets the colliders in their order.
-    fn resolve_colliders(&mut self, p: &mut Particles) -> usize {
+    /// parallel over fixed chunks of particles; each particle meets the colliders in their
+    /// order. Triangle meshes go through each particle's candidate list (`trimesh/`), held
+    /// per chunk, so the results do not depend on the thread count.
+    fn resolve_colliders(&mut self, p: &mut Particles, fresh: bool) -> (usize, usize) {
         if self.colliders.is_empty() {
-            return 0;
+            return (0, 0);
         }
+        let own: Vec<bool> = self.colliders.iter().map(|c| self.own_mesh(c)).collect();
+        let meshes = own.iter().filter(|&&o| o).count();
+        let chunks = p.len().div_ceil(CHUNK);
+        if self.mesh_lists.len() != chunks
+            || self.mesh_lists.first().is_some_and(|c| c.len() != meshes)
+        {
+            self.mesh_lists = (0..chunks)
+                .map(|k| vec![ChunkLists::new(CHUNK.min(p.len() - k * CHUNK)); meshes])
+                .collect();
+        }
+        let frames: Vec<Option<MeshFrame<'_>>> = self
+            .colliders
+            .iter()
+            .zip(&own)
+            .map(|(c, &own)| {
+                let geometry = c.mesh().filter(|_| own)?;
+                let (pose, prev_pose, still) = c.poses64();
+                let identity = |q: &crate::analytic::WorldPose| {
+                    q.translation == DVec3::ZERO && q.rotation == DQuat::IDENTITY
+                };
+                Some(MeshFrame {
+                    geometry,
+                    pose,
+                    prev_pose,
+                    identity: identity(pose) && identity(prev_pose),
+                    still,
+                    fresh,
+                    friction: c.friction(),
+                })
+            })
+            .collect();
+        let parry = self.parry_meshes;
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
-        let (contacts, deepest) = over_free_particles(
-            p,
-            (0, 0.0f64),
-            |i, x, prev| {
-                let (mut contacts, mut deepest) = (0, 0.0f64);
-                for (c, b) in colliders.iter().zip(bounds) {
-                    // Cheap reject: farther than the margin from the collider's box.
-                    if within(b, *x) {
-                        let (n, depth) = resolve_one(c, prev, x, thickness[i]);
-                        contacts += n;
-                        deepest = deepest.max(depth);
+        let Particles {
+            positions,
+            prev_positions,
+            inv_masses,
+            ..
+        } = p;
+        let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
+        let (contacts, deepest, swept) = positions
+            .par_chunks_mut(CHUNK)
+            .zip(self.mesh_lists.par_iter_mut())
+            .enumerate()
+            .map(|(k, (xs, lists))| {
+                lists.iter_mut().for_each(ChunkLists::compact);
+                let (mut contacts, mut deepest, mut swept) = (0, 0.0f64, 0);
+                for (j, x) in xs.iter_mut().enumerate() {
+                    let i = k * CHUNK + j;
+                    if inv[i] == 0.0 {
+                        continue;
+                    }
+                    let mut slot = 0;
+                    for ((c, b), frame) in colliders.iter().zip(bounds).zip(&frames) {
+                        if let Some(frame) = frame {
+                            let o = frame.resolve(&mut lists[slot], j, prev[i], x, thickness[i]);
+                            slot += 1;
+                            contacts += o.contacts;
+                            deepest = deepest.max(o.depth);
+                            swept += o.swept;
+                        } else if within(b, *x) {
+                            // Cheap reject: farther than the margin from the collider's box.
+                            let (n, depth) = resolve_one(c, parry, prev[i], x, thickness[i]);
+                            contacts += n;
+                            deepest = deepest.max(depth);
+                        }
                     }
                 }
-                (contacts, deepest)
-            },
-            |a, b| (a.0 + b.0, a.1.max(b.1)),
-        );
+                (contacts, deepest, swept)
+            })
+            .reduce(|| (0, 0.0, 0), |a, b| (a.0 + b.0, a.1.max(b.1), a.2 + b.2));
         self.stats.max_depth = self.stats.max_depth.max(deepest);
-        contacts
+        (contacts, swept)
     }
 }
 
@@ -242,6 +357,8 @@ fn over_free_particles<T: Copy + Send + Sync>(
 fn sweep_one(
     colliders: &[Collider],
     bounds: &[Option<Bounds>],
+    own: &[bool],
+    parry: bool,
     from: DVec3,
     x: &mut DVec3,
     r: f64,
@@ -252,7 +369,10 @@ fn sweep_one(
     }
     let step = (*x - from).length();
     let mut swept = 0;
-    for (c, b) in colliders.iter().zip(bounds) {
+    for ((c, b), &own) in colliders.iter().zip(bounds).zip(own) {
+        if own {
+            continue; // swept in its own contacts
+        }
         // Cheap reject: a path whose box misses the collider's (grown) box cannot cross it.
         if let Some((lo, hi)) = b
             && (from.min(*x).cmpgt(*hi).any() || from.max(*x).cmplt(*lo).any())
@@ -260,11 +380,16 @@ fn sweep_one(
             continue;
         }
         // Only a path that starts outside the surface can tunnel through it.
-        let outside = c.closest(from, step + r).is_none_or(|s| s.distance >= 0.0);
+        let outside = query(c, parry, from, step + r).is_none_or(|s| s.distance >= 0.0);
         if !outside {
             continue;
         }
-        if let Some((toi, n)) = c.sweep(from, *x) {
+        let hit = if parry && c.mesh().is_some() {
+            c.parry_sweep(from, *x)
+        } else {
+            c.sweep(from, *x)
+        };
+        if let Some((toi, n)) = hit {
             let hit = from + (*x - from) * toi;
             *x = hit + n * r;
             swept += 1;
@@ -275,7 +400,7 @@ fn sweep_one(
 
 /// Pushes one particle out of one collider to surface + `r`, with friction against the
 /// surface's motion; returns the contacts resolved and the deepest overlap.
-fn resolve_one(c: &Collider, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64) {
+fn resolve_one(c: &Collider, parry: bool, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64) {
     let friction = c.friction();
     let (mut contacts, mut deepest) = (0, 0.0f64);
     // A closed-form shape reports any point inside it, so only a surface nearer than r can
@@ -287,7 +412,7 @@ fn resolve_one(c: &Collider, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64)
         (ROUNDS, 2.0 * r)
     };
     for _ in 0..rounds {
-        let Some(s) = c.closest(*x, reach) else {
+        let Some(s) = query(c, parry, *x, reach) else {
             break;
         };
         let depth = r - s.distance;
@@ -304,6 +429,15 @@ fn resolve_one(c: &Collider, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64)
         deepest = deepest.max(depth);
     }
     (contacts, deepest)
+}
+
+/// [`Collider::closest`], or parry's for a mesh when `parry` is set.
+fn query(c: &Collider, parry: bool, x: DVec3, max_dist: f64) -> Option<crate::SurfacePoint> {
+    if parry && c.mesh().is_some() {
+        c.parry_closest(x, max_dist)
+    } else {
+        c.closest(x, max_dist)
+    }
 }
 
 impl SubstepHook for CollisionWorld {
@@ -347,7 +481,8 @@ impl SubstepHook for CollisionWorld {
             }
             None => (0, 0.0),
         };
-        let collider_contacts = self.resolve_colliders(particles);
+        let (collider_contacts, swept) = self.resolve_colliders(particles, fresh);
+        self.stats.swept += swept;
         self.stats.collider_contacts = collider_contacts;
         self.stats.self_contacts = self_contacts;
         self.stats.max_self_depth = self.stats.max_self_depth.max(self_depth);

@@ -63,3 +63,39 @@ fn sphere_drop_is_bitwise_repeatable_across_thread_counts() {
         "1 vs 4 threads differ"
     );
 }
+
+/// A cloth on the 20,480-triangle icosphere and one on the deforming ball (several chunks of
+/// particles, candidate lists rebuilt in parallel): the same positions bit for bit with 1 and
+/// 2 worker threads.
+fn meshes_in_pool(threads: usize) -> (Vec<DVec3>, usize) {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+        .install(|| {
+            let mut out = Vec::new();
+            let mut contacts = 0;
+            for build in [
+                weft_collide::scenarios::icosphere_drop,
+                weft_collide::scenarios::breathing_drop,
+            ] {
+                let (mut solver, mut world) = build(Method::Xpbd, 40).expect("scenario");
+                for _ in 0..40 {
+                    contacts += solver.step_with(&mut world).expect("step").contacts;
+                }
+                out.extend_from_slice(&solver.particles().positions);
+            }
+            (out, contacts)
+        })
+}
+
+#[test]
+fn mesh_contacts_are_bitwise_repeatable_across_thread_counts() {
+    let (a, contacts) = meshes_in_pool(1);
+    let (b, _) = meshes_in_pool(2);
+    assert!(contacts > 1000, "only {contacts} contacts");
+    assert!(
+        a.iter().zip(&b).all(|(x, y)| x.to_array() == y.to_array()),
+        "1 vs 2 threads differ"
+    );
+}

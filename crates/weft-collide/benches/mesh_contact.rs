@@ -1,0 +1,97 @@
+//! Triangle-mesh contact against the cloth's own solve, side by side in one run (XPBD,
+//! `method_setup`, 10 substeps, one iteration):
+//!
+//! - `static_mesh/16384`: a 128² cloth draped (after 30 frames) on `icosphere_drop`'s
+//!   sphere-shaped mesh of 20,480 triangles, and the ground. `constraint_solve` steps the
+//!   same state without any collision; `mesh` with the mesh (f64 path); `mesh_parry` with
+//!   the same mesh through parry's f32 projection (the path before); `sphere` the same cloth
+//!   after 30 frames on `sphere_drop`'s analytic sphere of the same size.
+//! - `deforming_mesh/8100`: a 90² cloth on `breathing_drop`'s deforming ball of 5,120
+//!   triangles (vertices set, faces and BVH refitted and contacts swept every substep),
+//!   against its own constraint solve.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{
+    BatchSize, Bencher, BenchmarkGroup, Criterion, SamplingMode, Throughput, criterion_group,
+    criterion_main, measurement::WallTime,
+};
+use weft_collide::CollisionWorld;
+use weft_collide::scenarios::{breathing_drop, icosphere_drop, sphere_drop};
+use weft_solver::{Method, Solver};
+
+/// Frames stepped before timing: the cloth has fallen onto the collider.
+const PREROLL: usize = 30;
+
+fn quick(g: &mut BenchmarkGroup<'_, WallTime>) {
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2));
+}
+
+fn in_contact(mut scene: (Solver, CollisionWorld)) -> (Solver, CollisionWorld) {
+    for _ in 0..PREROLL {
+        scene.0.step_with(&mut scene.1).expect("stable");
+    }
+    scene
+}
+
+/// A fresh copy of `solver` stepped without collisions per iteration (the copy untimed).
+fn step_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver) {
+    b.iter_batched(
+        || solver.clone(),
+        |mut s| {
+            black_box(s.step().expect("stable"));
+            s
+        },
+        BatchSize::LargeInput,
+    );
+}
+
+/// Steps copies of `solver` with copies of `world` (both untimed to make), so every sample
+/// starts from the same draped state.
+fn step_with_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver, world: &CollisionWorld) {
+    b.iter_batched(
+        || (solver.clone(), world.clone()),
+        |(mut s, mut w)| {
+            black_box(s.step_with(&mut w).expect("stable"));
+            (s, w)
+        },
+        BatchSize::LargeInput,
+    );
+}
+
+fn static_mesh(c: &mut Criterion) {
+    let n = 128;
+    let (solver, world) = in_contact(icosphere_drop(Method::Xpbd, n).expect("scene"));
+    let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, n).expect("scene"));
+    let mut parry = world.clone();
+    parry.set_parry_meshes(true);
+    let mut g = c.benchmark_group(format!("static_mesh/{}", n * n));
+    quick(&mut g);
+    g.throughput(Throughput::Elements((n * n) as u64));
+    g.bench_function("constraint_solve", |b| step_copies(b, &solver));
+    g.bench_function("mesh", |b| step_with_copies(b, &solver, &world));
+    g.bench_function("mesh_parry", |b| step_with_copies(b, &solver, &parry));
+    g.bench_function("sphere_solve", |b| step_copies(b, &sphere_solver));
+    g.bench_function("sphere", |b| {
+        step_with_copies(b, &sphere_solver, &sphere_world)
+    });
+    g.finish();
+}
+
+fn deforming_mesh(c: &mut Criterion) {
+    let n = 90;
+    let (solver, world) = in_contact(breathing_drop(Method::Xpbd, n).expect("scene"));
+    let mut g = c.benchmark_group(format!("deforming_mesh/{}", n * n));
+    quick(&mut g);
+    g.throughput(Throughput::Elements((n * n) as u64));
+    g.bench_function("constraint_solve", |b| step_copies(b, &solver));
+    g.bench_function("deforming", |b| step_with_copies(b, &solver, &world));
+    g.finish();
+}
+
+criterion_group!(benches, static_mesh, deforming_mesh);
+criterion_main!(benches);

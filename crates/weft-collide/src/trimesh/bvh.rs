@@ -1,0 +1,198 @@
+//! A flat bounding-volume hierarchy of axis-aligned boxes in f64, over a mesh's triangles:
+//! built once by median splits, refitted (not rebuilt) when the vertices move.
+
+use glam::DVec3;
+
+/// Triangles per leaf at most.
+const LEAF: usize = 4;
+
+/// A node: its box and either two children (`count == 0`: nodes `first` and `first + 1`) or
+/// a leaf's primitives `first .. first + count`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Node {
+    /// Minimum corner.
+    pub lo: DVec3,
+    /// Maximum corner.
+    pub hi: DVec3,
+    /// First child, or first primitive of a leaf.
+    pub first: u32,
+    /// Primitives of a leaf; 0 for an inner node.
+    pub count: u32,
+}
+
+/// The hierarchy, root first; every child comes after its parent.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Bvh {
+    /// Nodes in depth-first creation order.
+    pub nodes: Vec<Node>,
+}
+
+/// Squared distance from `x` to the box [lo, hi] (0 inside).
+#[inline]
+pub(crate) fn box_distance_squared(x: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    let d = (lo - x).max(x - hi).max(DVec3::ZERO);
+    d.length_squared()
+}
+
+impl Bvh {
+    /// Builds a hierarchy over primitives with boxes `boxes`; returns it and the order the
+    /// primitives must be stored in (`order[i]` is the original index of the i-th), so that
+    /// each leaf holds a contiguous range.
+    pub fn build(boxes: &[(DVec3, DVec3)]) -> (Self, Vec<u32>) {
+        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+        let centre = |i: u32| 0.5 * (boxes[i as usize].0 + boxes[i as usize].1);
+        let mut nodes = vec![Node {
+            lo: DVec3::ZERO,
+            hi: DVec3::ZERO,
+            first: 0,
+            count: 0,
+        }];
+        // (node, range start, range end)
+        let mut work = vec![(0usize, 0usize, boxes.len())];
+        while let Some((node, s, e)) = work.pop() {
+            if e - s <= LEAF {
+                nodes[node].first = s as u32;
+                nodes[node].count = (e - s) as u32;
+                continue;
+            }
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            for &i in &order[s..e] {
+                lo = lo.min(centre(i));
+                hi = hi.max(centre(i));
+            }
+            let extent = hi - lo;
+            let axis = if extent.x >= extent.y && extent.x >= extent.z {
+                0
+            } else if extent.y >= extent.z {
+                1
+            } else {
+                2
+            };
+            let mid = (s + e) / 2;
+            // Median split; ties broken by index, so the build is a function of the input.
+            order[s..e].select_nth_unstable_by(mid - s, |&i, &j| {
+                centre(i)[axis].total_cmp(&centre(j)[axis]).then(i.cmp(&j))
+            });
+            let child = nodes.len();
+            nodes[node].first = child as u32;
+            nodes[node].count = 0;
+            for _ in 0..2 {
+                nodes.push(Node {
+                    lo: DVec3::ZERO,
+                    hi: DVec3::ZERO,
+                    first: 0,
+                    count: 0,
+                });
+            }
+            work.push((child + 1, mid, e));
+            work.push((child, s, mid));
+        }
+        let mut bvh = Self { nodes };
+        let stored: Vec<(DVec3, DVec3)> = order.iter().map(|&i| boxes[i as usize]).collect();
+        bvh.refit(|i| stored[i]);
+        (bvh, order)
+    }
+
+    /// Recomputes every box from the primitives' boxes `leaf_box(i)` (i in storage order),
+    /// children before parents; the tree's shape is kept.
+    pub fn refit(&mut self, leaf_box: impl Fn(usize) -> (DVec3, DVec3)) {
+        for n in (0..self.nodes.len()).rev() {
+            let node = self.nodes[n];
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            if node.count > 0 {
+                for i in node.first..node.first + node.count {
+                    let (l, h) = leaf_box(i as usize);
+                    lo = lo.min(l);
+                    hi = hi.max(h);
+                }
+            } else {
+                for c in [node.first, node.first + 1] {
+                    let child = self.nodes[c as usize];
+                    lo = lo.min(child.lo);
+                    hi = hi.max(child.hi);
+                }
+            }
+            self.nodes[n].lo = lo;
+            self.nodes[n].hi = hi;
+        }
+    }
+
+    /// The root's box.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.nodes
+            .first()
+            .map_or((DVec3::ZERO, DVec3::ZERO), |n| (n.lo, n.hi))
+    }
+
+    /// Calls `leaf(i)` for every primitive in a leaf whose box, and every ancestor's box,
+    /// `keep` accepts; in a fixed order.
+    pub fn visit(&self, keep: impl Fn(DVec3, DVec3) -> bool, mut leaf: impl FnMut(usize)) {
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top] as usize];
+            if !keep(node.lo, node.hi) {
+                continue;
+            }
+            if node.count > 0 {
+                for i in node.first..node.first + node.count {
+                    leaf(i as usize);
+                }
+            } else {
+                stack[top] = node.first + 1;
+                stack[top + 1] = node.first;
+                top += 2;
+            }
+        }
+    }
+
+    /// Branch and bound: the primitive minimising `distance_squared(i)` (a value no less
+    /// than the squared distance from `x` to its box) among those below `limit_squared`,
+    /// nearer children first; ties keep the first found, so the answer is a function of the
+    /// input.
+    pub fn nearest<T>(
+        &self,
+        x: DVec3,
+        limit_squared: f64,
+        mut distance_squared: impl FnMut(usize) -> Option<(f64, T)>,
+    ) -> Option<(usize, f64, T)> {
+        let mut best: Option<(usize, f64, T)> = None;
+        let mut bound = limit_squared;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top] as usize];
+            if box_distance_squared(x, node.lo, node.hi) > bound {
+                continue;
+            }
+            if node.count > 0 {
+                for i in node.first..node.first + node.count {
+                    if let Some((d2, info)) = distance_squared(i as usize)
+                        && d2 < bound
+                    {
+                        bound = d2;
+                        best = Some((i as usize, d2, info));
+                    }
+                }
+            } else {
+                let (a, b) = (node.first, node.first + 1);
+                let da = {
+                    let n = self.nodes[a as usize];
+                    box_distance_squared(x, n.lo, n.hi)
+                };
+                let db = {
+                    let n = self.nodes[b as usize];
+                    box_distance_squared(x, n.lo, n.hi)
+                };
+                // The nearer child on top, popped first.
+                let (first, second) = if db < da { (b, a) } else { (a, b) };
+                stack[top] = second;
+                stack[top + 1] = first;
+                top += 2;
+            }
+        }
+        best
+    }
+}

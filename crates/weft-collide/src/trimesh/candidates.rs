@@ -1,0 +1,389 @@
+//! Per-particle candidate lists of a mesh collider, and one particle's contacts through them.
+//!
+//! Each particle keeps the triangles that were within a radius R of an anchor (its position
+//! when the list was built), at their positions then. Every triangle the particle can touch
+//! from x (a contact, distance < r) or on its path `from → x` (a crossing) is listed while
+//!
+//! max(|x − anchor|, |from − anchor|) + (travel of the surface since the build) + r ≤ R,
+//!
+//! since distances move by at most the particle's and the surface's displacements (a Verlet
+//! or skin list; Verlet 1967). The check is a few flops per particle; a particle that fails it
+//! gets a new list from the BVH with R = r (1 + skin) + |from − x| + the surface's motion this
+//! substep. An empty list records how far the nearest triangle is (or the mesh's box), so far
+//! particles are checked as rarely. The lists live in arenas of a fixed chunk of particles,
+//! each updated by one task: results do not depend on the thread count.
+
+use glam::DVec3;
+
+use super::MeshGeometry;
+use super::bvh::box_distance_squared;
+use super::ccd::{Crossing, moving_crossing, segment_crossing};
+use super::closest::closest_on_triangle;
+use crate::analytic::WorldPose;
+use crate::friction::Friction;
+
+/// Skin of a list, as a fraction of the particle's thickness r: lists are built with radius
+/// r (1 + SKIN) beyond the particle's own substep path.
+pub(crate) const SKIN: f64 = 0.5;
+
+/// Pushes per particle and projection (a push out of one face may land in another, in a
+/// concave corner).
+const ROUNDS: usize = 3;
+
+/// The candidate lists of one mesh collider for one chunk of particles.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ChunkLists {
+    /// Where each particle was when its list was built (collider frame).
+    anchor: Vec<DVec3>,
+    /// The list holds every triangle within this distance of the anchor; NaN: no list.
+    radius: Vec<f64>,
+    /// The surface's travel bound before the substep of the build.
+    travel: Vec<f64>,
+    /// Whether the anchor was inside the closed mesh.
+    inside: Vec<bool>,
+    /// The particle's position after the last projection (collider frame, end pose).
+    last: Vec<DVec3>,
+    /// The triangle each particle touched last (tested first: it tightens the search), or
+    /// `u32::MAX`.
+    hint: Vec<u32>,
+    /// Each particle's list: `tris[start .. start + len]`.
+    range: Vec<(u32, u32)>,
+    /// The lists, end to end; rebuilt lists are appended and the arena compacted when half
+    /// of it is stale.
+    tris: Vec<u32>,
+    /// Entries in use.
+    live: usize,
+    /// Lists built so far.
+    pub builds: u64,
+}
+
+impl ChunkLists {
+    /// Lists for `n` particles, all to be built.
+    pub fn new(n: usize) -> Self {
+        Self {
+            anchor: vec![DVec3::ZERO; n],
+            radius: vec![f64::NAN; n],
+            travel: vec![0.0; n],
+            inside: vec![false; n],
+            last: vec![DVec3::ZERO; n],
+            hint: vec![u32::MAX; n],
+            range: vec![(0, 0); n],
+            tris: Vec::new(),
+            live: 0,
+            builds: 0,
+        }
+    }
+
+    /// Triangles listed, over all particles of the chunk.
+    pub fn entries(&self) -> usize {
+        self.live
+    }
+
+    /// Drops stale entries once they are more than half the arena.
+    pub fn compact(&mut self) {
+        if self.tris.len() <= 2 * self.live + 4096 {
+            return;
+        }
+        let mut fresh = Vec::with_capacity(2 * self.live + 64);
+        for r in &mut self.range {
+            let s = fresh.len() as u32;
+            fresh.extend_from_slice(&self.tris[r.0 as usize..(r.0 + r.1) as usize]);
+            *r = (s, r.1);
+        }
+        self.tris = fresh;
+    }
+}
+
+/// One mesh collider as seen by every particle in one projection.
+pub(crate) struct MeshFrame<'a> {
+    /// The surface.
+    pub geometry: &'a MeshGeometry,
+    /// Collider pose at the end of the substep.
+    pub pose: &'a WorldPose,
+    /// Collider pose at its start.
+    pub prev_pose: &'a WorldPose,
+    /// Both poses are the identity: positions are used as they are.
+    pub identity: bool,
+    /// The pose did not change over the substep.
+    pub still: bool,
+    /// First projection of the substep: the path starts at the previous position, and the
+    /// surface moves along it.
+    pub fresh: bool,
+    /// Coulomb friction of the collider.
+    pub friction: Friction,
+}
+
+/// What one particle's contacts with one mesh did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Outcome {
+    /// Pushes resolved.
+    pub contacts: usize,
+    /// Deepest overlap with the thickness shell (m).
+    pub depth: f64,
+    /// Crossings stopped.
+    pub swept: usize,
+}
+
+impl MeshFrame<'_> {
+    fn to_local(&self, pose: &WorldPose, x: DVec3) -> DVec3 {
+        if self.identity {
+            x
+        } else {
+            pose.inverse_transform_point(x)
+        }
+    }
+
+    fn to_world_vector(&self, v: DVec3) -> DVec3 {
+        if self.identity {
+            v
+        } else {
+            self.pose.rotation * v
+        }
+    }
+
+    /// How far the material point with barycentric weights `bary` on triangle `t` moved over
+    /// the substep, in world space; exactly zero for a still surface.
+    fn surface_displacement(&self, t: usize, bary: [f64; 3]) -> DVec3 {
+        let g = self.geometry;
+        if self.still && !g.moving {
+            return DVec3::ZERO;
+        }
+        let tri = g.triangles[t];
+        let at = |v: &[DVec3]| (0..3).fold(DVec3::ZERO, |s, k| s + v[tri[k] as usize] * bary[k]);
+        let (end, start) = (at(&g.end), at(&g.start));
+        if self.identity {
+            end - start
+        } else {
+            self.pose.transform_point(end) - self.prev_pose.transform_point(start)
+        }
+    }
+
+    /// Makes particle `j`'s list valid for position `x` and path start `from` (local).
+    fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+        let g = self.geometry;
+        let anchor = lists.anchor[j];
+        // max(|x − anchor|, |from − anchor|) ≤ slack, compared squared.
+        let slack = lists.radius[j] - (g.travel - lists.travel[j]) - r;
+        if slack >= 0.0
+            && (x - anchor)
+                .length_squared()
+                .max((from - anchor).length_squared())
+                <= slack * slack
+        {
+            return;
+        }
+        lists.builds += 1;
+        let radius = r * (1.0 + SKIN) + (from - x).length() + (g.travel - g.travel_before);
+        let old = lists.range[j];
+        lists.live -= old.1 as usize;
+        let start = lists.tris.len();
+        let nearest = g.within(x, radius, &mut lists.tris);
+        let len = lists.tris.len() - start;
+        lists.live += len;
+        lists.range[j] = (start as u32, len as u32);
+        lists.anchor[j] = x;
+        lists.travel[j] = g.travel_before;
+        let closed = g.closed();
+        let (lo, hi) = g.bounds();
+        let outside_box = box_distance_squared(x, lo, hi).sqrt();
+        let (clearance, inside) = if let Some(p) = nearest {
+            // The nearest listed triangle is the nearest of all (it is within R).
+            (radius, p.distance < 0.0)
+        } else if !closed || outside_box > 0.0 {
+            (radius.max(outside_box), false)
+        } else {
+            match g.nearest(x, f64::INFINITY) {
+                Some(p) => (
+                    radius.max(p.distance.abs() * (1.0 - 1e-12)),
+                    p.distance < 0.0,
+                ),
+                None => (radius, false),
+            }
+        };
+        lists.radius[j] = clearance;
+        lists.inside[j] = inside;
+    }
+
+    /// The earliest crossing of the path `from → x` with a listed triangle: (crossing,
+    /// triangle).
+    fn first_crossing(
+        &self,
+        list: &[u32],
+        from: DVec3,
+        x: DVec3,
+        r: f64,
+    ) -> Option<(Crossing, usize)> {
+        let g = self.geometry;
+        let closed = g.closed();
+        let moving = self.fresh && g.moving;
+        // A path shorter than r/2 (relative to the surface) cannot cross it from r away,
+        // where the last projection left the particle (as the closed-form shapes' sweep).
+        let surface = if moving {
+            g.travel - g.travel_before
+        } else {
+            0.0
+        };
+        if (x - from).length() + surface <= 0.5 * r {
+            return None;
+        }
+        let mut best: Option<(Crossing, usize)> = None;
+        for &t in list {
+            let t = t as usize;
+            let f = &g.faces[t];
+            let hit = if moving {
+                let start = g.start_corners(t);
+                // Cheap reject: the path's box misses the triangle's swept box.
+                let (lo, hi) = (from.min(x), from.max(x));
+                let tlo = f.corners[0].min(f.corners[1]).min(f.corners[2]);
+                let thi = f.corners[0].max(f.corners[1]).max(f.corners[2]);
+                let slo = start[0].min(start[1]).min(start[2]).min(tlo);
+                let shi = start[0].max(start[1]).max(start[2]).max(thi);
+                if lo.cmpgt(shi).any() || hi.cmplt(slo).any() {
+                    continue;
+                }
+                moving_crossing(from, x, start, f.corners, closed)
+            } else {
+                segment_crossing(from, x, f.corners, f.normal, closed)
+            };
+            if let Some(c) = hit
+                && best.is_none_or(|b| c.t < b.0.t)
+            {
+                best = Some((c, t));
+            }
+        }
+        best
+    }
+
+    /// Particle `j` (thickness `r`, previous position `prev`, current `x`, world space):
+    /// stops a crossing of the surface on the side it came from, then pushes it to distance r
+    /// from the surface with Coulomb friction against the surface's motion.
+    pub fn resolve(
+        &self,
+        lists: &mut ChunkLists,
+        j: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        r: f64,
+    ) -> Outcome {
+        let g = self.geometry;
+        let mut out = Outcome::default();
+        let mut xl = self.to_local(self.pose, *x);
+        let from = if self.fresh {
+            self.to_local(self.prev_pose, prev)
+        } else {
+            lists.last[j]
+        };
+        let moved = |xl: &mut DVec3, x: &mut DVec3, to: DVec3| {
+            *x += self.to_world_vector(to - *xl);
+            *xl = to;
+        };
+        // Continuous: a crossing on the path is undone, the particle left r off the surface
+        // (where the surface is at the end of the substep) on the side it came from.
+        self.ensure(lists, j, xl, from, r);
+        let (s, len) = lists.range[j];
+        if let Some((c, t)) =
+            self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl, r)
+        {
+            let f = &g.faces[t];
+            let [a, b, cc] = f.corners;
+            let hit = a * c.bary[0] + b * c.bary[1] + cc * c.bary[2];
+            moved(&mut xl, x, hit + f.normal * (c.side * r));
+            out.swept += 1;
+        }
+        // After a push by δ every distance drops by at most δ: a round is needed again only
+        // if the runner-up of the last one (a lower bound on its distance) was within r + δ.
+        let mut again = true;
+        for _ in 0..ROUNDS {
+            if !again {
+                break;
+            }
+            self.ensure(lists, j, xl, from, r);
+            let (s, len) = lists.range[j];
+            let mut best: Option<(f64, usize, super::closest::Closest)> = None;
+            let mut bound = r * r;
+            let mut second = f64::INFINITY;
+            let x32 = xl.as_vec3();
+            let hint = lists.hint[j];
+            if let Some(f) = g.faces.get(hint as usize)
+                && f64::from(g.planes[hint as usize].distance_squared_bound(x32, g.margin)) < bound
+            {
+                let [a, b, c] = f.corners;
+                let q = closest_on_triangle(xl, a, b, c);
+                let d2 = (xl - q.point).length_squared();
+                if d2 < bound {
+                    bound = d2;
+                    best = Some((d2, hint as usize, q));
+                }
+            }
+            for &t in &lists.tris[s as usize..(s + len) as usize] {
+                if t == hint {
+                    continue;
+                }
+                // Cheap reject: the plane and edge lines are no farther than the triangle.
+                let lower = f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin));
+                if lower >= bound {
+                    second = second.min(lower);
+                    continue;
+                }
+                let [a, b, c] = g.faces[t as usize].corners;
+                let q = closest_on_triangle(xl, a, b, c);
+                let d2 = (xl - q.point).length_squared();
+                if d2 < bound {
+                    if best.is_some() {
+                        second = second.min(bound);
+                    }
+                    bound = d2;
+                    best = Some((d2, t as usize, q));
+                } else {
+                    second = second.min(d2);
+                }
+            }
+            let hit = match best {
+                Some((d2, t, q)) => {
+                    let mut p = g.signed(xl, t, q, d2);
+                    if !g.closed() && d2 <= 1e-24 {
+                        // On an open surface: back to the side the path came from.
+                        let n = g.faces[t].normal;
+                        p.normal = if n.dot(from - q.point) < 0.0 { -n } else { n };
+                    }
+                    p
+                }
+                None if lists.inside[j] => {
+                    // Deep inside a closed mesh: out through the nearest surface.
+                    match g.nearest(xl, f64::INFINITY) {
+                        Some(p) if p.distance < r => {
+                            lists.radius[j] = f64::NAN;
+                            p
+                        }
+                        _ => break,
+                    }
+                }
+                None => break,
+            };
+            lists.hint[j] = hit.triangle as u32;
+            let depth = r - hit.distance;
+            if depth <= 1e-6 * r.max(1e-3) {
+                break;
+            }
+            again = second.sqrt() - depth < r;
+            let to = xl + hit.normal * depth;
+            moved(&mut xl, x, to);
+            // Relative tangential displacement over the substep against the surface's own
+            // motion there (Macklin et al. 2014, eq. 24).
+            let n = self.to_world_vector(hit.normal);
+            let rel = (*x - prev) - self.surface_displacement(hit.triangle, hit.closest.bary);
+            let tangential = rel - n * n.dot(rel);
+            let correction = self.friction.correction(tangential, depth);
+            if correction != DVec3::ZERO {
+                // A tangential move of |correction| ≤ the slip: distances drop by at most it.
+                again |= second.sqrt() - depth - correction.length() < r;
+                *x -= correction;
+                xl = self.to_local(self.pose, *x);
+            }
+            out.contacts += 1;
+            out.depth = out.depth.max(depth);
+        }
+        lists.last[j] = xl;
+        out
+    }
+}

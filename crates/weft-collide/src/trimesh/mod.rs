@@ -1,0 +1,348 @@
+//! Particle–triangle-mesh contact in closed form and in f64: the closest point on a triangle
+//! (`closest`), pseudo-normals that tell inside from outside (`normals`), a flat BVH that is
+//! refitted when the mesh deforms (`bvh`), continuous collision against still and moving
+//! triangles (`ccd`), per-particle candidate lists kept with a skin (`candidates`) and the
+//! vertex animations that drive deforming meshes (`deforming`).
+
+pub(crate) mod bvh;
+pub(crate) mod candidates;
+pub(crate) mod ccd;
+pub(crate) mod closest;
+pub(crate) mod deforming;
+pub(crate) mod normals;
+#[cfg(test)]
+mod vs_parry;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use bvh::{Bvh, box_distance_squared};
+use closest::{Closest, closest_on_triangle};
+use normals::{Topology, face_normal, pseudo_normal};
+
+/// One triangle at the end of the substep: its corners, unit normal and in-plane outward
+/// edge normals (what the contact loops read, kept together for the cache).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Face {
+    /// Corners a, b, c (m, the collider's frame).
+    pub corners: [DVec3; 3],
+    /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
+    pub normal: DVec3,
+    /// Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
+    pub edges: [DVec3; 3],
+}
+
+impl Face {
+    fn new(corners: [DVec3; 3]) -> Self {
+        let normal = face_normal(corners[0], corners[1], corners[2]);
+        let edge = |k: usize| {
+            (corners[(k + 1) % 3] - corners[k])
+                .cross(normal)
+                .normalize_or_zero()
+        };
+        Self {
+            corners,
+            normal,
+            edges: [edge(0), edge(1), edge(2)],
+        }
+    }
+
+    /// A lower bound on the squared distance from `x` to the triangle: the squared distance
+    /// to its plane plus the square of the farthest in-plane distance beyond an edge's line.
+    #[inline]
+    pub fn distance_squared_bound(&self, x: DVec3) -> f64 {
+        let h = self.normal.dot(x - self.corners[0]);
+        let beyond = self.edges[0]
+            .dot(x - self.corners[0])
+            .max(self.edges[1].dot(x - self.corners[1]))
+            .max(self.edges[2].dot(x - self.corners[2]))
+            .max(0.0);
+        h * h + beyond * beyond
+    }
+}
+
+/// A triangle's planes in f32, one cache line, for a cheap conservative distance bound: its
+/// plane n · x = n · a and its three edge lines' in-plane outward normals e_k · x = e_k · p_k.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(align(64))]
+pub(crate) struct Planes([f32; 16]);
+
+impl Planes {
+    fn new(f: &Face) -> Self {
+        let mut p = [0f32; 16];
+        let planes = [
+            (f.normal, f.corners[0]),
+            (f.edges[0], f.corners[0]),
+            (f.edges[1], f.corners[1]),
+            (f.edges[2], f.corners[2]),
+        ];
+        for (k, (n, at)) in planes.into_iter().enumerate() {
+            p[4 * k..4 * k + 3].copy_from_slice(&n.as_vec3().to_array());
+            p[4 * k + 3] = n.dot(at) as f32;
+        }
+        Self(p)
+    }
+
+    /// A lower bound on the squared distance from `x` to the triangle, less `margin` (the
+    /// f32 rounding of these terms) on each part: as [`Face::distance_squared_bound`].
+    #[inline]
+    pub fn distance_squared_bound(&self, x: glam::Vec3, margin: f32) -> f32 {
+        let p = &self.0;
+        let d = |k: usize| p[k] * x.x + p[k + 1] * x.y + p[k + 2] * x.z - p[k + 3];
+        let h = (d(0).abs() - margin).max(0.0);
+        let beyond = (d(4).max(d(8)).max(d(12)) - margin).max(0.0);
+        h * h + beyond * beyond
+    }
+}
+
+/// A closest point on the mesh: triangle, point, signed distance (negative inside a closed
+/// mesh) and outward unit normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct MeshPoint {
+    /// Triangle index (storage order).
+    pub triangle: usize,
+    /// The closest point on that triangle.
+    pub closest: Closest,
+    /// Signed distance (m).
+    pub distance: f64,
+    /// Unit normal pointing from the surface to the particle's side (outward if inside).
+    pub normal: DVec3,
+}
+
+/// A triangle mesh in the collider's frame, with its vertices at the start and end of the
+/// substep (equal unless it deforms), per-triangle faces at the end, topology and BVH.
+#[derive(Clone, Debug)]
+pub(crate) struct MeshGeometry {
+    /// Triangles in BVH storage order.
+    pub triangles: Vec<[u32; 3]>,
+    /// Rest vertices (m), as given.
+    pub rest: Vec<DVec3>,
+    /// Vertices at the start of the substep.
+    pub start: Vec<DVec3>,
+    /// Vertices at the end of the substep: the current surface.
+    pub end: Vec<DVec3>,
+    /// Faces at the end of the substep, in storage order.
+    pub faces: Vec<Face>,
+    /// Their planes in f32, for the contact loops' first test.
+    pub planes: Vec<Planes>,
+    /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
+    pub margin: f32,
+    /// Adjacency and closedness.
+    pub topology: Topology,
+    /// Boxes of the triangles over the substep (start and end).
+    pub bvh: Bvh,
+    /// A bound on how far any vertex moved, summed over the substeps so far (m).
+    pub travel: f64,
+    /// The bound before the current substep.
+    pub travel_before: f64,
+    /// Whether the vertices moved in the current substep.
+    pub moving: bool,
+}
+
+impl MeshGeometry {
+    /// Builds the geometry of `vertices` and `triangles` (already validated).
+    pub fn new(vertices: &[DVec3], triangles: &[[u32; 3]]) -> Self {
+        let boxes: Vec<(DVec3, DVec3)> = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| vertices[i as usize]);
+                (a.min(b).min(c), a.max(b).max(c))
+            })
+            .collect();
+        let (bvh, order) = Bvh::build(&boxes);
+        let triangles: Vec<[u32; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
+        let topology = Topology::new(vertices.len(), &triangles);
+        let extent = vertices
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+        let mut geometry = Self {
+            faces: Vec::new(),
+            planes: Vec::new(),
+            margin: 0.0,
+            triangles,
+            rest: vertices.to_vec(),
+            start: vertices.to_vec(),
+            end: vertices.to_vec(),
+            topology,
+            bvh,
+            travel: 0.0,
+            travel_before: 0.0,
+            moving: false,
+        };
+        geometry.faces = geometry.compute_faces();
+        geometry.planes = geometry.faces.iter().map(Planes::new).collect();
+        geometry.set_margin(extent);
+        geometry
+    }
+
+    /// The rounding margin for particles near a mesh within `extent` of the origin: a few
+    /// f32 ulps of the largest coordinate (with the lists' reach, 1 m).
+    fn set_margin(&mut self, extent: f64) {
+        self.margin = (1e-6 * (extent + 1.0)) as f32;
+    }
+
+    fn compute_faces(&self) -> Vec<Face> {
+        let end = &self.end;
+        self.triangles
+            .par_iter()
+            .with_min_len(1024)
+            .map(|t| Face::new(t.map(|i| end[i as usize])))
+            .collect()
+    }
+
+    /// Whether the mesh is closed and consistently wound.
+    pub fn closed(&self) -> bool {
+        self.topology.closed
+    }
+
+    /// Starts a substep with the surface moving from the current vertices to `next`
+    /// (same length, finite; checked by the caller): refits the BVH to the swept boxes.
+    pub fn advance(&mut self, next: &[DVec3]) {
+        std::mem::swap(&mut self.start, &mut self.end);
+        self.end.copy_from_slice(next);
+        let moved = self
+            .start
+            .iter()
+            .zip(&self.end)
+            .map(|(a, b)| (*b - *a).length_squared())
+            .fold(0.0, f64::max)
+            .sqrt();
+        self.moving = moved > 0.0;
+        self.travel_before = self.travel;
+        self.travel += moved;
+        if !self.moving {
+            return;
+        }
+        self.faces = self.compute_faces();
+        self.planes = self
+            .faces
+            .par_iter()
+            .with_min_len(1024)
+            .map(Planes::new)
+            .collect();
+        let extent = self
+            .end
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+        self.set_margin(extent);
+        let (start, end, triangles) = (&self.start, &self.end, &self.triangles);
+        self.bvh.refit(|i| {
+            let t = triangles[i];
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            for v in t {
+                for p in [start[v as usize], end[v as usize]] {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            (lo, hi)
+        });
+    }
+
+    /// Triangle `t`'s corners at the start of the substep.
+    pub fn start_corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.start[i as usize])
+    }
+
+    /// The (not normalised) pseudo-normal of `feature` of triangle `t` at the end of the
+    /// substep.
+    pub fn pseudo_normal(&self, t: usize, feature: closest::Feature) -> DVec3 {
+        pseudo_normal(
+            &self.topology,
+            &self.triangles,
+            t,
+            feature,
+            |u| self.faces[u].normal,
+            |u, k| self.faces[u].corners[k],
+        )
+    }
+
+    /// Signed answer for the closest point `c` of triangle `t` to `x` at distance² `d2`:
+    /// for a closed mesh the sign of (x − q) · pseudo-normal (Bærentzen & Aanæs 2005,
+    /// Theorem 1), else positive.
+    pub fn signed(&self, x: DVec3, t: usize, c: Closest, d2: f64) -> MeshPoint {
+        let delta = x - c.point;
+        let len = d2.sqrt();
+        let pn = self.pseudo_normal(t, c.feature);
+        let inside = self.closed() && delta.dot(pn) < 0.0;
+        let normal = if len > 1e-12 {
+            if inside { -delta / len } else { delta / len }
+        } else {
+            pn.normalize_or(self.faces[t].normal)
+        };
+        MeshPoint {
+            triangle: t,
+            closest: c,
+            distance: if inside { -len } else { len },
+            normal,
+        }
+    }
+
+    /// The closest point of the whole mesh to `x` within `max_dist` (BVH branch and bound).
+    pub fn nearest(&self, x: DVec3, max_dist: f64) -> Option<MeshPoint> {
+        let faces = &self.faces;
+        let limit = if max_dist.is_finite() {
+            max_dist * max_dist
+        } else {
+            f64::INFINITY
+        };
+        let (t, d2, c) = self.bvh.nearest(x, limit, |t| {
+            let [a, b, cc] = faces[t].corners;
+            let c = closest_on_triangle(x, a, b, cc);
+            Some(((x - c.point).length_squared(), c))
+        })?;
+        Some(self.signed(x, t, c, d2))
+    }
+
+    /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
+    /// a fixed order; returns the nearest of them.
+    pub fn within(&self, x: DVec3, radius: f64, out: &mut Vec<u32>) -> Option<MeshPoint> {
+        let r2 = radius * radius;
+        let faces = &self.faces;
+        let mut best: Option<(f64, usize, Closest)> = None;
+        self.bvh.visit(
+            |lo, hi| box_distance_squared(x, lo, hi) <= r2,
+            |t| {
+                let f = &faces[t];
+                if f.distance_squared_bound(x) > r2 {
+                    return;
+                }
+                let [a, b, c] = f.corners;
+                let q = closest_on_triangle(x, a, b, c);
+                let d2 = (x - q.point).length_squared();
+                if d2 <= r2 {
+                    out.push(t as u32);
+                    if best.is_none_or(|b| d2 < b.0) {
+                        best = Some((d2, t, q));
+                    }
+                }
+            },
+        );
+        best.map(|(d2, t, q)| self.signed(x, t, q, d2))
+    }
+
+    /// The mesh's box at the end of the substep (of the swept boxes while it moves).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.bvh.bounds()
+    }
+
+    /// The first crossing of the segment `from → to` with the current surface (the entry into
+    /// a closed mesh, any crossing of an open one): (fraction, unit normal facing `from`).
+    pub fn sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
+        let (lo, hi) = (from.min(to), from.max(to));
+        let closed = self.closed();
+        let mut best: Option<(f64, DVec3)> = None;
+        self.bvh.visit(
+            |l, h| l.cmple(hi).all() && h.cmpge(lo).all(),
+            |t| {
+                let f = &self.faces[t];
+                if let Some(c) = ccd::segment_crossing(from, to, f.corners, f.normal, closed)
+                    && best.is_none_or(|b| c.t < b.0)
+                {
+                    best = Some((c.t, f.normal * c.side));
+                }
+            },
+        );
+        best
+    }
+}
