@@ -1,0 +1,46 @@
+//! Reading character files from disk; every error names the file. Parsing is done by the
+//! modules that own each format ([`crate::bvh`]).
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use crate::bvh::{Bvh, BvhOptions, parse_bvh};
+use crate::error::BvhError;
+
+/// A character file that cannot be read or parsed.
+#[derive(Debug, Error)]
+pub enum LoadError {
+    /// The file cannot be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not valid BVH.
+    #[error("{path}: {source}")]
+    Bvh {
+        /// The file.
+        path: PathBuf,
+        /// Why, with the line.
+        source: BvhError,
+    },
+}
+
+fn read_text(path: &Path) -> Result<String, LoadError> {
+    std::fs::read_to_string(path).map_err(|source| LoadError::Io {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// Reads and parses a BVH file.
+pub fn read_bvh(path: &Path, options: &BvhOptions) -> Result<Bvh, LoadError> {
+    let text = read_text(path)?;
+    parse_bvh(&text, options).map_err(|source| LoadError::Bvh {
+        path: path.to_owned(),
+        source,
+    })
+}
