@@ -54,3 +54,67 @@ impl Clip {
         self.frames.len()
     }
 }
+
+/// What sampling does outside the clip's frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wrap {
+    /// Hold the first frame before 0 and the last after (n − 1) Δt.
+    #[default]
+    Clamp,
+    /// Repeat with period n Δt; between the last frame and the first the pose is
+    /// interpolated like between any two frames (for clips whose last frame leads into the
+    /// first, such as the built-in walk cycle).
+    Loop,
+}
+
+impl Clip {
+    /// Length of the clip (s): (n − 1) Δt when clamped, n Δt (one period) when looping.
+    pub fn duration(&self, wrap: Wrap) -> f64 {
+        let n = self.frames.len() as f64;
+        match wrap {
+            Wrap::Clamp => (n - 1.0) * self.frame_time,
+            Wrap::Loop => n * self.frame_time,
+        }
+    }
+
+    /// The two frames around time `t` (s) and the fraction between them.
+    pub fn bracket(&self, t: f64, wrap: Wrap) -> (usize, usize, f64) {
+        let n = self.frames.len();
+        let u = t / self.frame_time;
+        match wrap {
+            Wrap::Clamp => {
+                if n == 1 || u.is_nan() || u <= 0.0 {
+                    return (0, 0, 0.0);
+                }
+                let last = (n - 1) as f64;
+                if u >= last {
+                    return (n - 1, n - 1, 0.0);
+                }
+                let i = (u.floor() as usize).min(n - 2);
+                (i, i + 1, u - i as f64)
+            }
+            Wrap::Loop => {
+                let u = u.rem_euclid(n as f64);
+                if !u.is_finite() {
+                    return (0, 0, 0.0);
+                }
+                let i = (u.floor() as usize).min(n - 1);
+                (i, (i + 1) % n, (u - i as f64).clamp(0.0, 1.0))
+            }
+        }
+    }
+
+    /// The pose at time `t` (s): rotations slerped, translations lerped between the frames
+    /// around `t`.
+    pub fn sample(&self, t: f64, wrap: Wrap) -> Pose {
+        let mut out = Pose::identity(0);
+        self.sample_into(t, wrap, &mut out);
+        out
+    }
+
+    /// [`Clip::sample`] into a reused pose.
+    pub fn sample_into(&self, t: f64, wrap: Wrap, out: &mut Pose) {
+        let (i, j, f) = self.bracket(t, wrap);
+        Pose::interpolate_into(&self.frames[i], &self.frames[j], f, out);
+    }
+}

@@ -6,6 +6,7 @@
 //! confined to [`files`].
 #![warn(missing_docs)]
 
+mod animation;
 pub mod bvh;
 mod clip;
 mod error;
@@ -14,8 +15,9 @@ mod pose;
 mod skeleton;
 mod transform;
 
+pub use animation::{Animation, BoneState, VELOCITY_STEP};
 pub use bvh::{Bvh, BvhOptions, CMU_SCALE, parse_bvh};
-pub use clip::Clip;
+pub use clip::{Clip, Wrap};
 pub use error::{BvhError, ClipError, SkeletonError};
 pub use pose::Pose;
 pub use skeleton::{Joint, Skeleton};
