@@ -14,6 +14,7 @@ pub mod files;
 mod pose;
 mod skeleton;
 mod transform;
+pub mod walk;
 
 pub use animation::{Animation, BoneState, VELOCITY_STEP};
 pub use bvh::{Bvh, BvhOptions, CMU_SCALE, parse_bvh};
@@ -22,3 +23,4 @@ pub use error::{BvhError, ClipError, SkeletonError};
 pub use pose::Pose;
 pub use skeleton::{Joint, Skeleton};
 pub use transform::Transform;
+pub use walk::{WALK_FRAMES, WALK_PERIOD, walk_cycle, walker_skeleton};
