@@ -185,3 +185,61 @@ pub enum BvhError {
     #[error(transparent)]
     Clip(#[from] ClipError),
 }
+
+/// A body table that cannot be read or does not fit its skeleton.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum BodyError {
+    /// The text is not valid TOML or not a body table.
+    #[error("{}{message}", at(.line))]
+    Toml {
+        /// 1-based line, when known.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// A shape entry that cannot be built.
+    #[error("{}shape {index} (bone `{bone}`), key `{key}`: {message}", at(.line))]
+    Shape {
+        /// 1-based line of the key (or of the shape), when known.
+        line: Option<usize>,
+        /// 1-based index of the shape in the table.
+        index: usize,
+        /// The shape's bone.
+        bone: String,
+        /// The key at fault.
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn at(line: &Option<usize>) -> String {
+    line.map(|l| format!("line {l}: ")).unwrap_or_default()
+}
+
+/// Cloth vertices that cannot be attached to a bone.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum AttachError {
+    /// A vertex index past the end of the positions.
+    #[error("vertex {vertex} is out of range ({len} vertices)")]
+    VertexOutOfRange {
+        /// The vertex.
+        vertex: u32,
+        /// Number of positions.
+        len: usize,
+    },
+    /// A vertex with a non-finite position.
+    #[error("vertex {vertex} has a non-finite position")]
+    NonFinite {
+        /// The vertex.
+        vertex: u32,
+    },
+    /// A bone index past the end of the skeleton.
+    #[error("bone {bone} is out of range ({len} bones)")]
+    BoneOutOfRange {
+        /// The bone.
+        bone: usize,
+        /// Number of bones.
+        len: usize,
+    },
+}

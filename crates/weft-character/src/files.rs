@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
+use crate::body_table::BodyTable;
 use crate::bvh::{Bvh, BvhOptions, parse_bvh};
-use crate::error::BvhError;
+use crate::error::{BodyError, BvhError};
 
 /// A character file that cannot be read or parsed.
 #[derive(Debug, Error)]
@@ -27,6 +28,14 @@ pub enum LoadError {
         /// Why, with the line.
         source: BvhError,
     },
+    /// The file is not a valid body table.
+    #[error("{path}: {source}")]
+    Body {
+        /// The file.
+        path: PathBuf,
+        /// Why, with the line.
+        source: BodyError,
+    },
 }
 
 fn read_text(path: &Path) -> Result<String, LoadError> {
@@ -40,6 +49,15 @@ fn read_text(path: &Path) -> Result<String, LoadError> {
 pub fn read_bvh(path: &Path, options: &BvhOptions) -> Result<Bvh, LoadError> {
     let text = read_text(path)?;
     parse_bvh(&text, options).map_err(|source| LoadError::Bvh {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// Reads and parses a body table (TOML, see [`BodyTable`]).
+pub fn read_body_table(path: &Path) -> Result<BodyTable, LoadError> {
+    let text = read_text(path)?;
+    BodyTable::from_toml(&text).map_err(|source| LoadError::Body {
         path: path.to_owned(),
         source,
     })

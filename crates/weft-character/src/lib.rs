@@ -7,20 +7,33 @@
 #![warn(missing_docs)]
 
 mod animation;
+mod attach;
+mod body;
+mod body_table;
 pub mod bvh;
+mod character;
 mod clip;
 mod error;
 pub mod files;
 mod pose;
+mod round_cone;
+mod shape;
 mod skeleton;
+mod toml_lines;
 mod transform;
 pub mod walk;
 
 pub use animation::{Animation, BoneState, VELOCITY_STEP};
+pub use attach::Attachment;
+pub use body::{Body, BodyShape};
+pub use body_table::{BodyTable, ShapeKind, ShapeSpec};
 pub use bvh::{Bvh, BvhOptions, CMU_SCALE, parse_bvh};
+pub use character::{Character, CharacterState};
 pub use clip::{Clip, Wrap};
-pub use error::{BvhError, ClipError, SkeletonError};
+pub use error::{AttachError, BodyError, BvhError, ClipError, SkeletonError};
 pub use pose::Pose;
+pub use round_cone::{Contact, RoundCone};
+pub use shape::{Geometry, WorldShape};
 pub use skeleton::{Joint, Skeleton};
 pub use transform::Transform;
 pub use walk::{WALK_FRAMES, WALK_PERIOD, walk_cycle, walker_skeleton};
