@@ -76,6 +76,9 @@ pub struct BodyTable {
 /// The default table of the procedural walker ([`crate::walk`]).
 const WALKER: &str = include_str!("../bodies/walker.toml");
 
+/// The default table of the CMU motion-capture skeleton (joint names of 01_01.bvh).
+const CMU: &str = include_str!("../bodies/cmu.toml");
+
 impl BodyTable {
     /// A table from its shapes (no line information).
     pub fn new(shapes: Vec<ShapeSpec>) -> Self {
@@ -98,6 +101,12 @@ impl BodyTable {
     /// The built-in body of the procedural walker.
     pub fn walker() -> Self {
         Self::from_toml(WALKER).expect("the built-in walker body table parses")
+    }
+
+    /// The built-in body of the CMU motion-capture skeleton, for clips read with
+    /// [`crate::CMU_SCALE`] (e.g. `assets/characters/cmu_01_01_4s.bvh`).
+    pub fn cmu() -> Self {
+        Self::from_toml(CMU).expect("the built-in CMU body table parses")
     }
 
     /// 1-based line of `key` in shape `index` (or of the shape's header), when known.
