@@ -8,6 +8,7 @@ use thiserror::Error;
 use crate::body_table::BodyTable;
 use crate::bvh::{Bvh, BvhOptions, parse_bvh};
 use crate::error::{BodyError, BvhError};
+use crate::garment::{GarmentError, GarmentSpec};
 
 /// A character file that cannot be read or parsed.
 #[derive(Debug, Error)]
@@ -36,6 +37,14 @@ pub enum LoadError {
         /// Why, with the line.
         source: BodyError,
     },
+    /// The file is not a valid garment.
+    #[error("{path}: {source}")]
+    Garment {
+        /// The file.
+        path: PathBuf,
+        /// Why, with the line.
+        source: GarmentError,
+    },
 }
 
 fn read_text(path: &Path) -> Result<String, LoadError> {
@@ -58,6 +67,15 @@ pub fn read_bvh(path: &Path, options: &BvhOptions) -> Result<Bvh, LoadError> {
 pub fn read_body_table(path: &Path) -> Result<BodyTable, LoadError> {
     let text = read_text(path)?;
     BodyTable::from_toml(&text).map_err(|source| LoadError::Body {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// Reads and parses a garment file (TOML, see [`GarmentSpec`]).
+pub fn read_garment(path: &Path) -> Result<GarmentSpec, LoadError> {
+    let text = read_text(path)?;
+    GarmentSpec::from_toml(&text).map_err(|source| LoadError::Garment {
         path: path.to_owned(),
         source,
     })

@@ -1,9 +1,9 @@
 //! Weft's animated characters: motion capture (BVH), skeletons and clips sampled at any time,
 //! a procedural walk cycle, a mannequin body of analytic collision shapes that carry their
-//! velocities, and attachments of cloth vertices to bones.
+//! velocities, attachments of cloth vertices to bones, and garments sewn from flat panels.
 //!
-//! Everything is f64 and knows nothing of the solver, rendering or windows; reading files is
-//! confined to [`files`].
+//! Everything is f64 and knows nothing of rendering or windows; the solver appears only as
+//! the [`weft_solver::ClothMesh`] a garment becomes. Reading files is confined to [`files`].
 #![warn(missing_docs)]
 
 mod animation;
@@ -15,6 +15,7 @@ mod character;
 mod clip;
 mod error;
 pub mod files;
+pub mod garment;
 mod pose;
 mod round_cone;
 mod shape;
