@@ -10,6 +10,8 @@
 #                                                   STRIDE-th source frame kept
 #   assets/characters/LICENSE-assimp-testmodels.txt the package's copyright file, verbatim
 #   assets/characters/CMU-mocap-README.txt          the .source.txt beside the BVH files
+#   assets/characters/simple_skin.gltf              models/glTF2/simple_skin (2 joints, 10
+#                                                   vertices, a bending animation; BSD-3)
 #
 # Usage: scripts/import_character_assets.sh   (env: DEB=path/to/assimp-testmodels_*.deb to use
 #        a downloaded package; START=120 FRAMES=240 STRIDE=2, i.e. 1 s to 5 s at 60 fps)
@@ -32,6 +34,7 @@ models="$work/x/usr/share/assimp/models"
 mkdir -p "$out"
 cp "$work/x/usr/share/doc/assimp-testmodels/copyright" "$out/LICENSE-assimp-testmodels.txt"
 cp "$models/BVH/01_nn.bvh.source.txt" "$out/CMU-mocap-README.txt"
+cp "$models/glTF2/simple_skin/simple_skin.gltf" "$out/simple_skin.gltf"
 
 # Hierarchy verbatim; MOTION header rewritten for the kept frames; frames START,
 # START + STRIDE, … (0-based), FRAMES of them. Fails if the source has too few frames.

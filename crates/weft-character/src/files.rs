@@ -9,6 +9,7 @@ use crate::body_table::BodyTable;
 use crate::bvh::{Bvh, BvhOptions, parse_bvh};
 use crate::error::{BodyError, BvhError};
 use crate::garment::{GarmentError, GarmentSpec};
+use crate::skin::{BufferSource, SkinError, SkinnedMesh, parse_gltf_slice};
 
 /// A character file that cannot be read or parsed.
 #[derive(Debug, Error)]
@@ -45,6 +46,14 @@ pub enum LoadError {
         /// Why, with the line.
         source: GarmentError,
     },
+    /// The file is not a usable skinned glTF.
+    #[error("{path}: {source}")]
+    Skin {
+        /// The file (or the external buffer it names).
+        path: PathBuf,
+        /// Why.
+        source: SkinError,
+    },
 }
 
 fn read_text(path: &Path) -> Result<String, LoadError> {
@@ -79,4 +88,30 @@ pub fn read_garment(path: &Path) -> Result<GarmentSpec, LoadError> {
         path: path.to_owned(),
         source,
     })
+}
+
+/// Reads a skinned, animated mesh from a `.gltf` or `.glb` file; external buffers are read
+/// from paths relative to the file.
+pub fn read_skinned_gltf(path: &Path) -> Result<SkinnedMesh, LoadError> {
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let skin_error = |source| LoadError::Skin {
+        path: path.to_owned(),
+        source,
+    };
+    let (doc, sources) = parse_gltf_slice(&bytes).map_err(skin_error)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let buffers = sources
+        .into_iter()
+        .map(|s| match s {
+            BufferSource::Data(d) => Ok(d),
+            BufferSource::External(uri) => {
+                let file = dir.join(&uri);
+                std::fs::read(&file).map_err(|source| LoadError::Io { path: file, source })
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    SkinnedMesh::from_document(&doc, &buffers).map_err(skin_error)
 }

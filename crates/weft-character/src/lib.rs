@@ -20,6 +20,7 @@ mod pose;
 mod round_cone;
 mod shape;
 mod skeleton;
+pub mod skin;
 mod toml_lines;
 mod transform;
 pub mod walk;
