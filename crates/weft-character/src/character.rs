@@ -67,11 +67,24 @@ impl Character {
 impl CharacterState {
     /// The shape whose surface the point `p` is deepest inside (or nearest to), with its
     /// contact; `None` for a body without shapes.
+    ///
+    /// Shapes whose bounding sphere lies farther than the best distance so far are skipped:
+    /// the distance to a shape is never less than the distance to a sphere containing it, so
+    /// the answer is the same as testing every shape.
     pub fn nearest(&self, p: DVec3) -> Option<(&WorldShape, Contact)> {
-        self.shapes
-            .iter()
-            .map(|s| (s, s.contact(p)))
-            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
+        let mut best: Option<(&WorldShape, Contact)> = None;
+        for s in &self.shapes {
+            let (centre, radius) = s.geometry.bounding_sphere();
+            let bound = (p - centre).length() - radius;
+            if best.is_some_and(|(_, c)| bound >= c.distance) {
+                continue;
+            }
+            let c = s.contact(p);
+            if best.is_none_or(|(_, b)| c.distance < b.distance) {
+                best = Some((s, c));
+            }
+        }
+        best
     }
 
     /// Signed distance from `p` to the body, the union of its shapes (m); +∞ without shapes.

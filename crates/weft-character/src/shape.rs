@@ -34,6 +34,17 @@ impl Geometry {
         self.contact(p).distance
     }
 
+    /// A sphere (centre, radius) containing the geometry.
+    pub fn bounding_sphere(&self) -> (DVec3, f64) {
+        match *self {
+            Geometry::Sphere { center, radius } => (center, radius),
+            Geometry::RoundCone(c) => (
+                (c.a + c.b) * 0.5,
+                0.5 * (c.b - c.a).length() + c.ra.max(c.rb),
+            ),
+        }
+    }
+
     /// The geometry moved by a rigid transform.
     pub fn transformed(&self, t: &Transform) -> Geometry {
         match *self {

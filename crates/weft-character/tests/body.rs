@@ -172,3 +172,28 @@ fn body_table_files_name_the_file() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_culled_nearest_shape_is_the_exhaustive_one() {
+    let walker = Character::walker();
+    let state = walker.state(0.61);
+    let mut k = 0u64;
+    for i in 0..4000 {
+        k = k
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let r = |s: u32| ((k >> s) & 0xffff) as f64 / 65535.0;
+        let p = DVec3::new(r(0) - 0.5, 1.8 * r(16), r(32) - 0.5);
+        let exhaustive = state
+            .shapes
+            .iter()
+            .map(|s| s.contact(p).distance)
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(state.signed_distance(p), exhaustive, "point {i} at {p}");
+        // Each shape's bounding sphere holds it: its distance is never below the bound.
+        for s in &state.shapes {
+            let (c, r) = s.geometry.bounding_sphere();
+            assert!(s.contact(p).distance >= (p - c).length() - r - 1e-12);
+        }
+    }
+}
