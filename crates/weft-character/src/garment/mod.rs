@@ -1,0 +1,77 @@
+//! Garments sewn from flat panels: outlines triangulated to a chosen edge length, placed
+//! around the body, and seams given as matched vertex pairs, as a weft-solver [`ClothMesh`].
+
+mod outline;
+mod sew;
+mod spec;
+mod triangulate;
+
+use std::ops::Range;
+
+use glam::DVec2;
+use thiserror::Error;
+use weft_solver::{ClothMesh, MeshError};
+
+pub use sew::build_garment;
+pub use spec::{GarmentSpec, PanelSpec, SeamSide, SeamSpec};
+
+/// A garment ready for a solver: one mesh of all panels (unsewn) and the seams to close.
+#[derive(Clone, Debug)]
+pub struct Garment {
+    /// All panels' vertices and triangles, placed around the body; area-density masses.
+    pub mesh: ClothMesh,
+    /// Each panel's part of the mesh.
+    pub panels: Vec<PanelMesh>,
+    /// Vertex pairs to sew together (mesh indices), seam after seam, each seam in order
+    /// along its side a.
+    pub seam_pairs: Vec<[u32; 2]>,
+    /// For each seam of the file, its range in `seam_pairs`.
+    pub seams: Vec<Range<usize>>,
+}
+
+/// One panel's part of a garment mesh.
+#[derive(Clone, Debug)]
+pub struct PanelMesh {
+    /// The panel's name.
+    pub name: String,
+    /// Its vertices in the mesh; the outline's samples come first, in outline order.
+    pub vertices: Range<u32>,
+    /// How many of them lie on the outline.
+    pub boundary: usize,
+    /// Its triangles in the mesh.
+    pub triangles: Range<usize>,
+    /// Flat (2-D) rest coordinates of its vertices (m), in `vertices` order.
+    pub flat: Vec<DVec2>,
+}
+
+/// A garment that cannot be built; names the line and key where it can.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum GarmentError {
+    /// The text is not valid TOML or not a garment.
+    #[error("{}{message}", at(.line))]
+    Toml {
+        /// 1-based line, when known.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value that does not make a garment.
+    #[error("{}{place}, key `{key}`: {message}", at(.line))]
+    Key {
+        /// 1-based line, when known.
+        line: Option<usize>,
+        /// Which panel or seam (e.g. "panel 2 (`back`)").
+        place: String,
+        /// The key at fault.
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The panels do not make a valid cloth mesh.
+    #[error("the garment's mesh: {0}")]
+    Mesh(#[from] MeshError),
+}
+
+fn at(line: &Option<usize>) -> String {
+    line.map(|l| format!("line {l}: ")).unwrap_or_default()
+}

@@ -1,0 +1,97 @@
+//! The pieces together, as a solver will use them: a two-panel skirt sewn into a tube around
+//! the walker's hips, starting outside the body, its waistband attached to the hips.
+
+use weft_character::garment::{GarmentSpec, build_garment};
+use weft_character::{Attachment, Character};
+
+const SKIRT: &str = r#"edge_length = 0.03
+area_density = 0.2
+
+[[panel]]
+name = "front"
+outline = [[-0.15, 0.0], [0.15, 0.0], [0.15, 0.3], [-0.15, 0.3]]
+position = [0.0, 0.65, 0.18]
+
+[[panel]]
+name = "back"
+outline = [[-0.15, 0.0], [0.15, 0.0], [0.15, 0.3], [-0.15, 0.3]]
+position = [0.0, 0.65, -0.18]
+rotation = [0.0, 180.0, 0.0]
+
+[[seam]]
+a = { panel = "front", edges = [1, 1] }
+b = { panel = "back", edges = [3, 3] }
+flip = true
+
+[[seam]]
+a = { panel = "front", edges = [3, 3] }
+b = { panel = "back", edges = [1, 1] }
+flip = true
+"#;
+
+#[test]
+fn a_skirt_starts_outside_the_walker_and_its_waistband_follows_the_hips() {
+    let walker = Character::walker();
+    let skirt = build_garment(&GarmentSpec::from_toml(SKIRT).expect("spec")).expect("skirt");
+    // Dress the walker mid-stride, with the hips turned, so the binding needs the bone's full
+    // transform (its inverse rotation too).
+    let t0 = 0.3;
+    let start = walker.state(t0);
+    assert!(
+        start.bones[0]
+            .transform
+            .rotation
+            .angle_between(glam::DQuat::IDENTITY)
+            > 0.05
+    );
+    for (i, p) in skirt.mesh.positions.iter().enumerate() {
+        let d = start.signed_distance(*p);
+        assert!(d > 0.005, "skirt vertex {i} at {p} is {d} m from the body");
+    }
+    // The waistband: every vertex on the panels' top edges (flat y = 0.3).
+    let waist: Vec<u32> = skirt
+        .panels
+        .iter()
+        .flat_map(|panel| {
+            panel
+                .flat
+                .iter()
+                .enumerate()
+                .filter(|(_, q)| (q.y - 0.3).abs() < 1e-12)
+                .map(move |(k, _)| panel.vertices.start + k as u32)
+        })
+        .collect();
+    let per_panel = (0.3_f64 / 0.03).ceil() as usize + 1;
+    assert_eq!(waist.len(), 2 * per_panel);
+    let hips = walker.animation().skeleton().find("Hips").expect("hips");
+    let band = Attachment::bind(
+        hips,
+        waist,
+        &skirt.mesh.positions,
+        &start.bones[hips].transform,
+    )
+    .expect("bind");
+    let rest: Vec<glam::DVec3> = band
+        .vertices()
+        .iter()
+        .map(|&v| {
+            start.bones[hips]
+                .transform
+                .inverse()
+                .transform_point(skirt.mesh.positions[v as usize])
+        })
+        .collect();
+    for k in 1..50 {
+        let state = walker.state(t0 + k as f64 * 0.05);
+        let at = band.positions(&state.bones[hips].transform);
+        let back = state.bones[hips].transform.inverse();
+        for (p, r) in at.iter().zip(&rest) {
+            assert!((back.transform_point(*p) - *r).length() < 1e-9);
+        }
+        // The band stays off the body while the walker moves.
+        assert!(
+            at.iter().all(|p| state.signed_distance(*p) > 0.0),
+            "band touches at {k}"
+        );
+    }
+}
