@@ -15,8 +15,8 @@ mod recover;
 mod replay;
 mod run;
 mod sim;
-mod stop;
 mod stability;
+mod stop;
 mod video;
 mod view;
 

@@ -205,7 +205,10 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                 .zip(scenes)
                 .map(|(r, scene)| {
                     if stop.load(Ordering::SeqCst) {
-                        bar.done(&format!("  run {:>3} {} {}: {NOT_RUN}", r.index, r.series, r.label));
+                        bar.done(&format!(
+                            "  run {:>3} {} {}: {NOT_RUN}",
+                            r.index, r.series, r.label
+                        ));
                         return Ok(not_run(r));
                     }
                     let res = execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)
