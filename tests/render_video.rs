@@ -162,3 +162,60 @@ fn experiments_render_each_run_into_its_directory() {
         assert_eq!(frames.len(), 6);
     }
 }
+
+/// The poster's key result on video: an experiment run whose springs explode in the first frame
+/// is recorded as diverged, keeps a video (the initial state, then that frame held and marked)
+/// and says why beside it, instead of failing the run.
+#[test]
+fn an_experiment_run_that_diverges_at_once_keeps_its_marked_video() {
+    let dir = temp_dir("render-diverged");
+    write(&dir, "small.toml", SMALL);
+    let exp = write(
+        &dir,
+        "exp.toml",
+        r#"title = "explodes"
+scene = "small.toml"
+frames = 4
+metrics = ["frames"]
+set = { "sim.method" = "mass-spring", "sim.substeps" = 1, "cloth.flag.stretch_spring_stiffness" = 1e7 }
+
+[[series]]
+name = "springs"
+vary = { "sim.dt" = ["1/60"] }
+"#,
+    );
+    let out_dir = dir.join("out");
+    let out = run(&[
+        "experiments",
+        &exp,
+        "--render",
+        "--jobs",
+        "1",
+        "--out",
+        &out_dir.to_string_lossy(),
+    ]);
+    let (o, e) = texts(&out);
+    let result = std::fs::read_to_string(out_dir.join("results/run-0.json"))
+        .unwrap_or_else(|err| panic!("a result for the run ({err})\nstdout: {o}\nstderr: {e}"));
+    assert!(
+        result.contains("\"status\": \"diverged"),
+        "the run is recorded as diverged: {result}\nstderr: {e}"
+    );
+    let run_dir = std::fs::read_dir(out_dir.join("runs"))
+        .expect("runs/")
+        .map(|d| d.expect("entry").path())
+        .find(|p| p.is_dir())
+        .expect("the run's render folder");
+    let names = files(&run_dir);
+    assert!(names.contains(&"diverged.txt".to_owned()), "{names:?}");
+    assert!(
+        names.iter().any(|n| n.ends_with(".gif")),
+        "a finished GIF: {names:?}"
+    );
+    assert!(
+        names.iter().filter(|n| n.ends_with(".png")).count() >= 2,
+        "the initial frame and the held, marked one: {names:?}"
+    );
+    let why = std::fs::read_to_string(run_dir.join("diverged.txt")).expect("diverged.txt");
+    assert!(why.contains("stability limit"), "{why}");
+}

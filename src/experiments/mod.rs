@@ -361,6 +361,11 @@ fn execute(
             crate::video::VideoRecorder::new(gpu, &sim, &dir, size, every, options)
         })
         .transpose()?;
+    // The video starts with the initial state, so a run that diverges in its first frame still
+    // has a frame to hold and mark.
+    if let Some(v) = video.as_mut() {
+        v.frame(&sim)?;
+    }
     let mut meter = Meter::new(&sim);
     let mut status = Status::Complete;
     let mut first = sim.stats(0.0, 0);
