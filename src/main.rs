@@ -125,17 +125,20 @@ fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Res
         },
         progress: !args.quiet,
     };
-    if let Some(scene) = &args.scene {
+    if let Some(scene_file) = &args.scene {
+        // Neither --out itself nor any file the render writes into it may be an input.
+        let inputs = run::scene_inputs(scene_file, &scene);
         output::refuse_clashes(
-            &[output::Named {
-                role: "the scene",
-                path: scene,
-            }],
+            &inputs
+                .iter()
+                .map(|(role, path)| output::Named { role, path })
+                .collect::<Vec<_>>(),
             &[output::Named {
                 role: "--out",
                 path: &args.out,
             }],
         )?;
+        video::refuse_overwriting_inputs(&inputs, &args.out, &scene.name)?;
     }
     video::render(scene, &plan, stop)
 }

@@ -38,11 +38,6 @@ pub struct RunPlan<'a> {
     pub progress: bool,
 }
 
-/// Creates `path` for writing, with a message naming it (the viewer's `--record`).
-pub fn create_output(path: &Path) -> anyhow::Result<std::fs::File> {
-    std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))
-}
-
 /// Every file `scene` read, as paths: the scene file and its meshes (relative to its directory).
 pub fn scene_inputs(scene_file: &Path, scene: &Scene) -> Vec<(&'static str, PathBuf)> {
     let dir = Scene::dir_of(scene_file);

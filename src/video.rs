@@ -17,6 +17,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use weft_render::{Camera, FrameData, Gpu, OFFSCREEN_FORMAT, Offscreen, RenderOptions, Renderer};
 use weft_scene::Scene;
 
+use crate::output::Output;
 use crate::run::{EXIT_DIVERGED, EXIT_INTERRUPTED};
 use crate::sim::Simulation;
 use crate::view;
@@ -69,9 +70,10 @@ pub struct VideoRecorder<'g> {
     name: String,
     every: u64,
     images: u64,
-    gif: Option<GifEncoder<BufWriter<Arc<File>>>>,
-    gif_file: Arc<File>,
-    gif_partial: PathBuf,
+    gif: Option<GifEncoder<BufWriter<File>>>,
+    /// The GIF's output (its partial file, locked, renamed when finished): it also keeps a
+    /// second weft from rendering the same scene into the same directory.
+    gif_out: Option<Output>,
     gif_stride: u64,
     gif_delay_ms: u32,
     fps: f64,
@@ -95,14 +97,10 @@ impl<'g> VideoRecorder<'g> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
         let name = file_stem(&sim.scene.name);
-        let gif_partial = dir.join(format!(".{name}.gif.partial"));
-        let gif_file = Arc::new(
-            File::create(&gif_partial)
-                .with_context(|| format!("cannot write {}", gif_partial.display()))?,
-        );
-        let mut gif = GifEncoder::new_with_speed(BufWriter::new(Arc::clone(&gif_file)), GIF_SPEED);
+        let gif_out = Output::create(&dir.join(format!("{name}.gif")))?;
+        let mut gif = GifEncoder::new_with_speed(BufWriter::new(gif_out.handle()?), GIF_SPEED);
         gif.set_repeat(Repeat::Infinite)
-            .context("writing the GIF header")?;
+            .with_context(|| format!("cannot write {}", gif_out.target().display()))?;
         // Frame period of the images, and the GIF's: at least 20 ms, whole images apart.
         let period_ms = 1e3 * sim.scene.settings.dt * every as f64;
         let gif_stride = (GIF_MIN_DELAY_MS / period_ms).ceil().max(1.0) as u64;
@@ -120,8 +118,7 @@ impl<'g> VideoRecorder<'g> {
             every,
             images: 0,
             gif: Some(gif),
-            gif_file,
-            gif_partial,
+            gif_out: Some(gif_out),
             gif_stride,
             gif_delay_ms,
             fps: 1.0 / (sim.scene.settings.dt * every as f64),
@@ -152,7 +149,7 @@ impl<'g> VideoRecorder<'g> {
         {
             let delay = Delay::from_numer_denom_ms(self.gif_delay_ms, 1);
             gif.encode_frame(Frame::from_parts(image.clone(), 0, 0, delay))
-                .with_context(|| format!("cannot write {}", self.gif_partial.display()))?;
+                .with_context(|| format!("cannot write {}", self.gif_path().display()))?;
         }
         self.images += 1;
         self.last = Some(image);
@@ -170,8 +167,7 @@ impl<'g> VideoRecorder<'g> {
             }
         }
         let note = self.dir.join("diverged.txt");
-        std::fs::write(&note, format!("{message}\n"))
-            .with_context(|| format!("cannot write {}", note.display()))?;
+        crate::output::write_file(&note, format!("{message}\n").as_bytes())?;
         let mut files = self.finish()?;
         files.push(note);
         Ok(files)
@@ -213,22 +209,19 @@ impl<'g> VideoRecorder<'g> {
     /// Completes the GIF (renamed from its temporary name) and the MP4; returns the files.
     pub fn finish(mut self) -> anyhow::Result<Vec<PathBuf>> {
         let mut written = Vec::new();
-        let gif_path = self.dir.join(format!("{}.gif", self.name));
-        if let Some(gif) = self.gif.take() {
+        let gif_path = self.gif_path();
+        if let (Some(gif), Some(out)) = (self.gif.take(), self.gif_out.take()) {
             // Dropping the encoder writes the trailer and flushes, but cannot report a failed
-            // write: check the file ends with the GIF trailer byte (0x3B) instead.
+            // write: check the file ends with the GIF trailer byte (0x3B) instead. An
+            // unfinished output removes its partial file when dropped.
             drop(gif);
-            let complete = self.gif_file.sync_all().is_ok() && ends_with_trailer(&self.gif_partial);
-            if !complete {
-                let _ = std::fs::remove_file(&self.gif_partial);
-                bail!("cannot write {} (incomplete)", self.gif_partial.display());
+            if !ends_with_trailer(out.partial()) {
+                bail!("cannot write {} (incomplete)", gif_path.display());
             }
             if self.images == 0 {
-                let _ = std::fs::remove_file(&self.gif_partial);
                 bail!("no frames were rendered");
             }
-            std::fs::rename(&self.gif_partial, &gif_path)
-                .with_context(|| format!("cannot write {}", gif_path.display()))?;
+            out.commit()?;
             written.push(gif_path);
         }
         if let Some(mp4) = self.mp4()? {
@@ -237,18 +230,14 @@ impl<'g> VideoRecorder<'g> {
         Ok(written)
     }
 
+    /// Where the GIF goes.
+    fn gif_path(&self) -> PathBuf {
+        self.dir.join(format!("{}.gif", self.name))
+    }
+
     /// Encodes the PNGs as H.264 with ffmpeg when it is on PATH; logs and skips otherwise.
     fn mp4(&self) -> anyhow::Result<Option<PathBuf>> {
         encode_mp4(&self.dir, &self.name, self.fps)
-    }
-}
-
-impl Drop for VideoRecorder<'_> {
-    fn drop(&mut self) {
-        // Unfinished (error or early return): never leave a partial GIF behind.
-        if self.gif.take().is_some() {
-            let _ = std::fs::remove_file(&self.gif_partial);
-        }
     }
 }
 
@@ -256,7 +245,9 @@ impl Drop for VideoRecorder<'_> {
 /// logs and returns `None` otherwise.
 pub fn encode_mp4(dir: &Path, name: &str, fps: f64) -> anyhow::Result<Option<PathBuf>> {
     let path = dir.join(format!("{name}.mp4"));
-    let partial = dir.join(format!(".{name}.partial.mp4"));
+    // Claimed (partial file, locked) first; ffmpeg writes the partial, renamed when finished.
+    let out = Output::create(&path)?;
+    let partial = out.partial().to_path_buf();
     let status = Command::new("ffmpeg")
         .args(["-y", "-loglevel", "error", "-framerate"])
         .arg(format!("{fps:.6}"))
@@ -278,16 +269,57 @@ pub fn encode_mp4(dir: &Path, name: &str, fps: f64) -> anyhow::Result<Option<Pat
             Ok(None)
         }
         Err(e) => Err(e).context("cannot run ffmpeg"),
-        Ok(s) if !s.success() => {
-            let _ = std::fs::remove_file(&partial);
-            bail!("ffmpeg failed ({s}) encoding {}", path.display())
-        }
+        Ok(s) if !s.success() => bail!("ffmpeg failed ({s}) encoding {}", path.display()),
         Ok(_) => {
-            std::fs::rename(&partial, &path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            out.commit()?;
             Ok(Some(path))
         }
     }
+}
+
+/// Refuses an `--out` directory where the render would write over one of `inputs` (role,
+/// path): a frame `frame_NNNNN.png`, the GIF or MP4 named after `scene_name`, `diverged.txt`,
+/// or the partial file of any of them.
+pub fn refuse_overwriting_inputs(
+    inputs: &[(&str, PathBuf)],
+    out: &Path,
+    scene_name: &str,
+) -> anyhow::Result<()> {
+    let Ok(dir) = std::fs::canonicalize(out) else {
+        // No directory yet: no input is in it.
+        return Ok(());
+    };
+    let name = file_stem(scene_name);
+    for (role, input) in inputs {
+        let Ok(input) = std::fs::canonicalize(input) else {
+            continue;
+        };
+        let Some(file) = input.file_name().map(|f| f.to_string_lossy()) else {
+            continue;
+        };
+        if input.parent() == Some(dir.as_path()) && written_by_render(&file, &name) {
+            bail!(
+                "--out {} would write {}, which is {role}: refusing to overwrite an input; \
+                 choose another --out",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Whether `render` writes a file called `file` (or its partial) into its directory.
+fn written_by_render(file: &str, name: &str) -> bool {
+    let whole = file.replacen(".partial.", ".", 1);
+    let frame = whole
+        .strip_prefix("frame_")
+        .and_then(|f| f.strip_suffix(".png"))
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+    frame
+        || whole == format!("{name}.gif")
+        || whole == format!("{name}.mp4")
+        || whole == "diverged.txt"
 }
 
 /// Width of the red frame that marks a diverged run's last image (px).
@@ -312,20 +344,23 @@ pub fn mark_diverged(mut image: image::RgbaImage) -> image::RgbaImage {
     image
 }
 
-/// Writes `image` as a PNG with the strongest compression (about half the default's size).
+/// Writes `image` as a PNG with the strongest compression (about half the default's size),
+/// to its partial file, renamed into place when whole.
 fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
     use image::ImageEncoder;
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-    let mut out = BufWriter::new(File::create(path)?);
-    PngEncoder::new_with_quality(&mut out, CompressionType::Best, FilterType::Adaptive)
+    let out = Output::create(path)?;
+    let mut file = BufWriter::new(out.handle()?);
+    PngEncoder::new_with_quality(&mut file, CompressionType::Best, FilterType::Adaptive)
         .write_image(
             image.as_raw(),
             image.width(),
             image.height(),
             image::ExtendedColorType::Rgba8,
         )?;
-    std::io::Write::flush(&mut out)?;
-    Ok(())
+    std::io::Write::flush(&mut file)?;
+    drop(file);
+    out.commit()
 }
 
 /// Whether the file at `path` ends with the GIF trailer byte.

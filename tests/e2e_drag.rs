@@ -377,6 +377,10 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
     assert!(kill.success());
     let (status, out) = wait_exit(&mut viewer, "SIGINT");
     assert_eq!(status.code(), Some(130), "{out}");
+    assert!(
+        !log.with_file_name("session.partial.mcap").exists(),
+        "the finished log is renamed into place"
+    );
     let bytes = std::fs::read(&log).expect("log exists");
     let summary = mcap::Summary::read(&bytes)
         .expect("summary readable")
@@ -396,6 +400,43 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
         .count() as u64;
     assert!(frames > 0, "{out}");
     assert_eq!(logged, frames + 1, "frame 0 and every simulated frame");
+}
+
+#[test]
+fn a_record_write_that_fails_names_the_path() {
+    require("Xvfb", "xvfb");
+    require("xdotool", "xdotool");
+    let dir = temp_dir("e2e-full");
+    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (display, _xvfb) = start_xvfb(2);
+    let viewer = weft()
+        .args(["view", &scene_path, "--record", "/dev/full"])
+        .args(["--exit-after-frames", "20"])
+        .env("DISPLAY", &display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft view starts");
+    let mut viewer = Guard(viewer);
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = viewer.0.try_wait().expect("wait") {
+            break s;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the viewer did not exit after 20 frames"
+        );
+        sleep(Duration::from_millis(100));
+    };
+    let out = viewer.0.wait_with_output_now();
+    assert_eq!(status.code(), Some(1), "{out}");
+    assert!(
+        out.contains("/dev/full"),
+        "the message names the path: {out}"
+    );
+    assert!(!out.contains("panicked"), "{out}");
 }
 
 /// Output of a finished child, for messages.

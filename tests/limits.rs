@@ -193,3 +193,46 @@ fn a_huge_sweep_asks_for_yes_and_jobs_and_shards_are_checked_first() {
     assert!(out.status.success(), "{so}{e}");
     assert!(e.contains("--jobs 100000 cut to"), "{e}");
 }
+
+#[test]
+fn the_memory_limit_covers_the_runs_that_run_at_once() {
+    let dir = temp_dir("queue-memory");
+    // 128² = 16384 particles: about 19 MiB each once built, 38 MiB for two at once.
+    write(&dir, "mid.toml", &big(128));
+    let exp = write(
+        &dir,
+        "q.toml",
+        "scene = \"mid.toml\"\nframes = 1\nmetrics = [\"sag\"]\n\n[[series]]\nname = \"s\"\n\
+         vary = { \"sim.substeps\" = [1, 2] }\n",
+    );
+    let o = dir.join("out").to_string_lossy().into_owned();
+    let args = |jobs: &'static str| {
+        vec![
+            "experiments".to_owned(),
+            exp.clone(),
+            "--out".into(),
+            o.clone(),
+            "--no-mcap".into(),
+            "--max-memory".into(),
+            "30M".into(),
+            "--jobs".into(),
+            jobs.into(),
+        ]
+    };
+    let two: Vec<String> = args("2");
+    let out = run(&two.iter().map(String::as_str).collect::<Vec<_>>());
+    let (so, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{so}{e}");
+    assert!(
+        e.contains("2 runs at a time") && e.contains("--jobs") && e.contains("30 MiB"),
+        "{e}"
+    );
+    assert!(
+        !dir.join("out").join("results").join("run-0.json").exists(),
+        "no run started"
+    );
+    let one: Vec<String> = args("1");
+    let out = run(&one.iter().map(String::as_str).collect::<Vec<_>>());
+    let (so, e) = texts(&out);
+    assert!(out.status.success(), "one at a time fits: {so}{e}");
+}

@@ -149,17 +149,18 @@ fn experiments_render_each_run_into_its_directory() {
     run_dirs.sort();
     assert_eq!(run_dirs.len(), 2, "{run_dirs:?}");
     for d in &run_dirs {
-        // 12 frames at 1/60 s, rendered every 2nd for ~30 images/s: 6 PNGs and 6 GIF frames.
+        // The initial state and 12 frames at 1/60 s, rendered every 2nd for ~30 images/s:
+        // frames 0, 2, …, 12, 7 PNGs and 7 GIF frames.
         let names = files(d);
         let pngs = names.iter().filter(|n| n.ends_with(".png")).count();
-        assert_eq!(pngs, 6, "{}: {names:?}", d.display());
+        assert_eq!(pngs, 7, "{}: {names:?}", d.display());
         let file = std::fs::File::open(d.join("small.gif")).expect("GIF in the run directory");
         let frames = GifDecoder::new(std::io::BufReader::new(file))
             .expect("GIF decodes")
             .into_frames()
             .collect_frames()
             .expect("frames decode");
-        assert_eq!(frames.len(), 6);
+        assert_eq!(frames.len(), 7);
     }
 }
 
@@ -218,4 +219,72 @@ vary = { "sim.dt" = ["1/60"] }
     );
     let why = std::fs::read_to_string(run_dir.join("diverged.txt")).expect("diverged.txt");
     assert!(why.contains("stability limit"), "{why}");
+}
+
+#[test]
+fn render_never_writes_over_an_input() {
+    let dir = temp_dir("render-inputs");
+    // A scene whose name is one of the frames the render writes into its own directory.
+    let scene = write(&dir, "frame_00000.png", SMALL);
+    let d = dir.to_string_lossy().into_owned();
+    let args = [
+        "render", &scene, "--frames", "2", "--size", "32x24", "--out", &d, "-q",
+    ];
+    let out = run(&args);
+    let (o, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{o}{e}");
+    assert!(e.contains("refusing to overwrite an input"), "{e}");
+    assert!(e.contains("frame_00000.png"), "names the file: {e}");
+    assert_eq!(
+        std::fs::read_to_string(&scene).expect("the scene is kept"),
+        SMALL
+    );
+    // --out that is the scene, by another spelling.
+    let same = dir.join(".").join("frame_00000.png");
+    let out = run(&[
+        "render",
+        &scene,
+        "--frames",
+        "2",
+        "--out",
+        &same.to_string_lossy(),
+        "-q",
+    ]);
+    let (_, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("refusing to overwrite an input"), "{e}");
+}
+
+#[test]
+fn a_failing_frame_write_names_the_path_and_leaves_no_frame() {
+    let dir = temp_dir("render-full");
+    let scene = write(&dir, "s.toml", SMALL);
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(&out_dir).expect("out dir");
+    // A 1-block file-size limit (EFBIG, SIGXFSZ ignored) stands in for a full disk: the
+    // first PNG cannot be written whole.
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f 1; exec \"$0\" render '{scene}' --frames 2 --size 160x120 \
+             --out '{}' -q",
+            out_dir.display()
+        ))
+        .arg(env!("CARGO_BIN_EXE_weft"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("sh runs");
+    let (o, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{o}{e}");
+    let frame = out_dir.join("frame_00000.png");
+    assert!(
+        e.contains(&frame.display().to_string()),
+        "names the path: {e}"
+    );
+    assert!(!e.contains("panicked"), "{e}");
+    let names = files(&out_dir);
+    assert!(
+        names.is_empty(),
+        "no frame, GIF or partial passed off as whole: {names:?}"
+    );
 }

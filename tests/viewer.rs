@@ -1,10 +1,14 @@
 //! The viewer's command line without a display: `weft` with no command is the viewer, a
 //! missing display is a clear error pointing to the headless commands, and an unwritable
-//! `--record` fails before any window is tried.
+//! `--record` fails before any window is tried. `--record` never overwrites an input, an
+//! earlier log or another weft's log: it is claimed (partial file, lock) before the window.
 
 mod common;
 
-use common::{temp_dir, texts, weft};
+use std::process::Stdio;
+use std::time::Duration;
+
+use common::{big, exits_within, partial, signal, temp_dir, texts, wait_for, weft, write};
 
 fn without_display(args: &[&str]) -> std::process::Output {
     weft()
@@ -69,4 +73,67 @@ fn bad_scene_and_bad_size_are_reported_before_the_window() {
     let (_, err) = texts(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("WIDTHxHEIGHT"), "{err}");
+}
+
+#[test]
+fn record_may_not_overwrite_the_scene() {
+    let dir = temp_dir("viewer-record-scene");
+    let scene = write(&dir, "s.toml", common::SMALL);
+    // The same file by another spelling.
+    let same = dir.join(".").join("s.toml");
+    let out = without_display(&["view", &scene, "--record", &same.to_string_lossy()]);
+    let (_, err) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("refusing to overwrite an input"), "{err}");
+    assert!(!err.contains("cannot open a window"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&scene).expect("the scene is still there"),
+        common::SMALL
+    );
+}
+
+#[test]
+fn a_failed_session_keeps_the_earlier_log() {
+    let dir = temp_dir("viewer-record-keep");
+    let log = dir.join("session.mcap");
+    std::fs::write(&log, b"an earlier session").expect("write");
+    let out = without_display(&["view", "--record", &log.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(1), "{:?}", texts(&out));
+    assert_eq!(
+        std::fs::read(&log).expect("the earlier log is kept"),
+        b"an earlier session"
+    );
+    assert!(!partial(&log).exists(), "the unfinished partial goes");
+}
+
+#[test]
+fn record_refuses_a_log_another_weft_is_writing() {
+    let dir = temp_dir("viewer-record-locked");
+    let scene = write(&dir, "s.toml", &big(64));
+    let target = dir.join("a.mcap");
+    let first = weft()
+        .args(["run", &scene, "--frames", "100000000", "--out"])
+        .arg(&target)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starts");
+    let part = partial(&target);
+    let started = wait_for(Duration::from_secs(30), || {
+        std::fs::metadata(&part).is_ok_and(|m| m.len() > 0)
+    });
+    let out = without_display(&["view", "--record", &target.to_string_lossy()]);
+    signal(first.id(), "INT");
+    let (run, _) = exits_within(first, Duration::from_secs(20));
+    assert!(started, "the run never started writing {}", part.display());
+    let (_, err) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("another weft is writing"), "{err}");
+    assert_eq!(
+        run.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(target.exists(), "the run's log is whole and in place");
 }

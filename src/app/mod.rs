@@ -32,7 +32,8 @@ use anyhow::Context;
 use winit::event_loop::EventLoop;
 
 use crate::cli::ViewArgs;
-use crate::run::{EXIT_INTERRUPTED, create_output};
+use crate::output::{Named, Output, refuse_clashes};
+use crate::run::{EXIT_INTERRUPTED, scene_inputs};
 use crate::sim::Simulation;
 use recording::SessionLog;
 use session::{SceneSource, Session};
@@ -54,8 +55,25 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
             return Ok(ExitCode::FAILURE);
         }
     };
-    // An unwritable log fails before any window opens.
-    let file = args.record.as_deref().map(create_output).transpose()?;
+    // The log may not be an input (the scene, its meshes); an unwritable log, or one another
+    // weft is writing, fails before any window opens. It stays a partial file until finished.
+    if let Some(record) = &args.record {
+        let inputs = match &args.scene {
+            Some(file) => scene_inputs(file, &scene),
+            None => Vec::new(),
+        };
+        refuse_clashes(
+            &inputs
+                .iter()
+                .map(|(role, path)| Named { role, path })
+                .collect::<Vec<_>>(),
+            &[Named {
+                role: "--record",
+                path: record,
+            }],
+        )?;
+    }
+    let file = args.record.as_deref().map(Output::create).transpose()?;
     let sim = Simulation::new(scene)?;
     let log = file
         .map(|f| {
@@ -70,10 +88,8 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
     let event_loop = match EventLoop::new() {
         Ok(l) => l,
         Err(e) => {
+            // Unfinished: its partial file goes, and whatever was at the target stays.
             drop(log);
-            if let Some(p) = &args.record {
-                let _ = std::fs::remove_file(p);
-            }
             anyhow::bail!(
                 "cannot open a window: {}\n  \
                  The viewer needs a display (DISPLAY or WAYLAND_DISPLAY); none is usable here.\n  \

@@ -1,27 +1,29 @@
 //! `weft view --record`: the session logged in the layout of `weft run --out`, plus an
 //! `/interaction` channel with the grabbed particle and drag target of every frame.
 
-use std::fs::File;
+use anyhow::Context;
 
 use crate::app::grab::Grab;
+use crate::output::Output;
 use crate::record::{RecordOptions, Recorder, Status};
 use crate::sim::{FrameStats, Simulation};
 
 /// The JSON schema of `/interaction` messages.
 const INTERACTION_SCHEMA: &str = r#"{"title":"weft.Interaction","type":"object","properties":{"frame":{"type":"integer","description":"frame of the session (continues across resets)"},"time":{"type":"number","description":"simulated time of the session (s)"},"grabbed":{"type":"boolean"},"cloth":{"type":["string","null"],"description":"name of the grabbed cloth"},"cloth_index":{"type":["integer","null"]},"particle":{"type":["integer","null"],"description":"index within the cloth, as in /cloth/<name>/particles"},"target":{"type":["array","null"],"items":{"type":"number"},"description":"drag target (m)"}},"required":["frame","time","grabbed"]}"#;
 
-/// An open session log.
+/// An open session log, written to its partial file and renamed into place when finished.
 pub struct SessionLog {
     rec: Recorder,
+    out: Output,
     interaction: u16,
     frames: u64,
     time: f64,
 }
 
 impl SessionLog {
-    /// Starts the log in `file` (already created) with the scene of `sim` as frame 0.
+    /// Starts the log in `out` (already claimed) with the scene of `sim` as frame 0.
     pub fn new(
-        file: File,
+        out: Output,
         sim: &Simulation,
         mesh_every: u64,
         planned: u64,
@@ -30,11 +32,15 @@ impl SessionLog {
             mesh_every,
             timing: false,
         };
-        let mut rec = Recorder::new(file, sim, planned, options)?;
-        let interaction =
-            rec.add_json_channel("/interaction", "weft.Interaction", INTERACTION_SCHEMA)?;
+        let target = out.target().display().to_string();
+        let mut rec = Recorder::new(out.handle()?, sim, planned, options)
+            .with_context(|| format!("writing {target}"))?;
+        let interaction = rec
+            .add_json_channel("/interaction", "weft.Interaction", INTERACTION_SCHEMA)
+            .with_context(|| format!("writing {target}"))?;
         let mut log = Self {
             rec,
+            out,
             interaction,
             frames: 0,
             time: 0.0,
@@ -56,6 +62,7 @@ impl SessionLog {
         self.frames += 1;
         self.time += dt;
         self.write(sim, stats, grab)
+            .with_context(|| format!("writing {}", self.out.target().display()))
     }
 
     fn write(
@@ -90,8 +97,12 @@ impl SessionLog {
         self.rec.json(self.interaction, self.time, &json)
     }
 
-    /// Writes the status and the summary and closes the file.
+    /// Writes the status and the summary, closes the file and renames it into place.
     pub fn finish(self, status: &Status) -> anyhow::Result<()> {
-        self.rec.finish(status, self.frames)
+        let target = self.out.target().display().to_string();
+        self.rec
+            .finish(status, self.frames)
+            .with_context(|| format!("finishing {target}"))?;
+        self.out.commit()
     }
 }

@@ -286,13 +286,21 @@ mod tests {
         assert_eq!(s.source, file, "a failed switch keeps the scene");
         // Recording: the log holds one scene, so switching is refused.
         let path = std::env::temp_dir().join(format!("weft-session-{}.mcap", std::process::id()));
-        let f = std::fs::File::create(&path).expect("temp file");
-        s.log = Some(SessionLog::new(f, &s.sim, 0, 0).expect("log"));
+        let _ = std::fs::remove_file(&path);
+        let out = crate::output::Output::create(&path).expect("temp file");
+        s.log = Some(SessionLog::new(out, &s.sim, 0, 0).expect("log"));
         let e = s.switch_scene(SceneSource::Default).expect_err("refused");
         assert!(format!("{e}").contains("recorded"), "{e}");
         assert_eq!(s.source, file);
+        s.step_once().expect("steps");
+        assert!(
+            !path.exists(),
+            "nothing under the final name while recording"
+        );
         s.finish(false).expect("finishes");
         assert!(s.log.is_none());
+        assert!(path.exists(), "the finished log is renamed into place");
+        assert!(!crate::output::partial_path(&path).exists());
         let _ = std::fs::remove_file(path);
     }
 }

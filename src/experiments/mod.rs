@@ -66,6 +66,41 @@ fn slug(s: &str) -> String {
     out.trim_matches('-').chars().take(60).collect()
 }
 
+/// The memory `scene` needs once built (the estimate the scene loader checks).
+fn scene_bytes(scene: &weft_scene::Scene) -> u64 {
+    let particles: u64 = scene.cloths.iter().map(|c| c.mesh.len() as u64).sum();
+    weft_scene::estimate_bytes(particles, scene.self_collision.is_some())
+}
+
+/// Refuses a queue whose runs, `jobs` at a time, could need more memory together than the
+/// limit allows (each alone was checked when it was loaded): the `jobs` largest estimates
+/// are what may be built at once.
+fn refuse_concurrent_memory(
+    needs: &[u64],
+    jobs: usize,
+    limits: &weft_scene::Limits,
+) -> anyhow::Result<()> {
+    let Some((cap, origin)) = &limits.max_memory else {
+        return Ok(());
+    };
+    let mut sorted = needs.to_vec();
+    sorted.sort_unstable_by(|a, b| b.cmp(a));
+    let at_once = jobs.min(sorted.len());
+    let need: u64 = sorted
+        .iter()
+        .take(at_once)
+        .fold(0u64, |a, b| a.saturating_add(*b));
+    if need > *cap {
+        bail!(
+            "{at_once} runs at a time may need about {} together, more than the {} allowed \
+             ({origin}); lower --jobs, or raise the limit with --max-memory",
+            weft_scene::human(need),
+            weft_scene::human(*cap)
+        );
+    }
+    Ok(())
+}
+
 /// Queues longer than this are run only with `--yes`.
 pub const ASK_ABOVE_RUNS: u64 = 1000;
 /// Queues longer than this are refused outright (their plan alone would fill memory).
@@ -170,15 +205,17 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                 before - mine.len()
             );
         }
-        // Validate every run's scene before simulating any.
+        // Validate every run's scene before simulating any, keeping only its memory estimate:
+        // a loaded scene holds its cloths' meshes, so each run loads its own when it starts.
         let limits = args.limits.limits();
-        let mut scenes = Vec::new();
+        let mut needs = Vec::with_capacity(mine.len());
         for r in &mine {
             match weft_scene::load_with(&scene_path, &r.overrides, &limits) {
-                Ok(s) => scenes.push(s),
+                Ok(s) => needs.push(scene_bytes(&s)),
                 Err(e) => bail!("run {} ({} {}):\n{e}", r.index, r.series, r.label),
             }
         }
+        refuse_concurrent_memory(&needs, jobs, &limits)?;
         eprintln!(
             "weft: {}: {} of {} runs{}, {} at a time, into {}",
             args.file.display(),
@@ -202,8 +239,7 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         let bar = progress::QueueProgress::new(mine.len());
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
-                .zip(scenes)
-                .map(|(r, scene)| {
+                .map(|r| {
                     if stop.load(Ordering::SeqCst) {
                         bar.done(&format!(
                             "  run {:>3} {} {}: {NOT_RUN}",
@@ -211,7 +247,11 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                         ));
                         return Ok(not_run(r));
                     }
-                    let res = execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)
+                    let res = weft_scene::load_with(&scene_path, &r.overrides, &limits)
+                        .map_err(|e| anyhow::anyhow!("{e}"))
+                        .and_then(|scene| {
+                            execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)
+                        })
                         .and_then(|result| {
                             // Written as soon as the run ends, so a killed queue keeps what it did.
                             let path = result_path(&out, r.index);
