@@ -1,6 +1,8 @@
 //! Fixtures shared by the physics tests.
 #![allow(dead_code)]
 
+pub mod flag;
+
 use weft_solver::glam::DVec3;
 use weft_solver::{
     ClothMesh, ClothParams, Corner, Family, Forces, GridDesc, Mass, Method, Orientation, Pin,
