@@ -253,34 +253,19 @@ mod tests {
     fn segment_crossing_keeps_the_side() {
         let tri = [DVec3::ZERO, DVec3::X, DVec3::Z];
         let n = DVec3::NEG_Y; // (x) × (z) = −y
-        let down = segment_crossing(
-            DVec3::new(0.2, 1.0, 0.2),
-            DVec3::new(0.2, -1.0, 0.2),
-            tri,
-            n,
-            false,
-        )
-        .expect("crosses");
+        // A vertical segment through (x, ·, 0.2) from y = 1 down to y = −1.
+        let cross = |x: f64, entering_only: bool| {
+            segment_crossing(
+                DVec3::new(x, 1.0, 0.2),
+                DVec3::new(x, -1.0, 0.2),
+                tri,
+                n,
+                entering_only,
+            )
+        };
+        let down = cross(0.2, false).expect("crosses");
         assert_eq!((down.t, down.side), (0.5, -1.0));
-        assert!(
-            segment_crossing(
-                DVec3::new(0.2, 1.0, 0.2),
-                DVec3::new(0.2, -1.0, 0.2),
-                tri,
-                n,
-                true
-            )
-            .is_none()
-        );
-        assert!(
-            segment_crossing(
-                DVec3::new(2.0, 1.0, 0.2),
-                DVec3::new(2.0, -1.0, 0.2),
-                tri,
-                n,
-                false
-            )
-            .is_none()
-        );
+        assert!(cross(0.2, true).is_none());
+        assert!(cross(2.0, false).is_none());
     }
 }
