@@ -7,18 +7,11 @@ use common::flag::{flag_settings, in_pool, state_bits, step, windy_flag};
 use common::*;
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    Aero, ClothParams, Edge, Family, Forces, GridDesc, Method, Motion, Pin, Settings, Solver,
-    SolverBuilder, Wind,
+    Aero, ClothParams, Family, Forces, Method, Motion, Settings, Solver, SolverBuilder, Wind,
 };
 
 fn build(method: Method, domain_size: usize) -> Solver {
-    let mesh = GridDesc {
-        resolution: (48, 48),
-        pins: vec![Pin::Edge(Edge::Top)],
-        ..GridDesc::default()
-    }
-    .build()
-    .expect("valid grid");
+    let mesh = top_pinned_grid((48, 48));
     let mut params = ClothParams::default()
         .edit(Family::BendDistance, |p| p.enabled = true)
         .edit(Family::Tether, |p| p.enabled = true);

@@ -4,9 +4,8 @@
 mod common;
 
 use common::flag::{flag_settings, in_pool, state_bits, step, windy_flag};
-use weft_solver::{
-    ClothParams, Edge, Forces, GridDesc, Method, Pin, Settings, SimdPath, SolverBuilder,
-};
+use common::top_pinned_grid;
+use weft_solver::{ClothParams, Forces, Method, Settings, SimdPath, SolverBuilder};
 
 /// A flag in wind with compliant, damped stretch, bend-distance and mixed chunks (a 37-wide grid
 /// leaves ragged rows and gathered chunks), run 20 frames on `path`.
@@ -52,13 +51,7 @@ fn every_kernel_path_gives_the_baseline_bits() {
 #[test]
 fn switching_the_path_between_frames_keeps_the_bits() {
     let widest = SimdPath::widest();
-    let mesh = GridDesc {
-        resolution: (24, 24),
-        pins: vec![Pin::Edge(Edge::Top)],
-        ..GridDesc::default()
-    }
-    .build()
-    .expect("valid grid");
+    let mesh = top_pinned_grid((24, 24));
     let build = || {
         let settings = Settings {
             simd: Some(SimdPath::Scalar),

@@ -3,8 +3,8 @@
 
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    ClothMesh, ClothParams, Edge, Family, Forces, GridDesc, Method, Pin, Settings, Solver,
-    SolverBuilder, SubstepHook, Wind,
+    ClothMesh, ClothParams, Family, Forces, Method, Settings, Solver, SolverBuilder, SubstepHook,
+    Wind,
 };
 
 /// A hook that does nothing but says it is active, forcing the general loop.
@@ -36,13 +36,7 @@ pub fn flag_settings(method: Method, domain_size: usize) -> Settings {
 /// stretch, in 3 m/s linear wind (drag 0.2) with global damping 0.1: the builder holding it
 /// (add pins before building) and its mesh.
 pub fn windy_flag(resolution: (usize, usize), settings: Settings) -> (SolverBuilder, ClothMesh) {
-    let mesh = GridDesc {
-        resolution,
-        pins: vec![Pin::Edge(Edge::Top)],
-        ..GridDesc::default()
-    }
-    .build()
-    .expect("valid grid");
+    let mesh = super::top_pinned_grid(resolution);
     let params = ClothParams::default()
         .edit(Family::BendDistance, |p| p.enabled = true)
         .edit(Family::Stretch, |p| {
