@@ -1,37 +1,11 @@
 //! The BVH reader: a hand-computed three-joint pose, and malformed files with their lines.
 
+mod common;
+
+use common::TINY_BVH as TINY;
 use glam::DVec3;
 use weft_character::files::{LoadError, read_bvh};
 use weft_character::{BvhError, BvhOptions, parse_bvh};
-
-/// Root (6 channels, Z X Y rotation order), Mid (Y X Z), Tip (2 channels: X Z), End Site.
-/// Centimetres; frame 0 is the rest pose, frame 1 a pose worked out by hand below.
-const TINY: &str = "HIERARCHY
-ROOT Root
-{
-  OFFSET 0 0 0
-  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-  JOINT Mid
-  {
-    OFFSET 0 10 0
-    CHANNELS 3 Yrotation Xrotation Zrotation
-    JOINT Tip
-    {
-      OFFSET 5 0 0
-      CHANNELS 2 Xrotation Zrotation
-      End Site
-      {
-        OFFSET 0 0 3
-      }
-    }
-  }
-}
-MOTION
-Frames: 2
-Frame Time: 0.5
-0 0 0 0 0 0 0 0 0 0 0
-100 200 300 90 90 0 90 0 0 90 0
-";
 
 fn cm() -> BvhOptions {
     BvhOptions { scale: 0.01 }

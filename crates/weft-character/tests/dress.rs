@@ -1,38 +1,21 @@
 //! The pieces together, as a solver will use them: a two-panel skirt sewn into a tube around
 //! the walker's hips, starting outside the body, its waistband attached to the hips.
 
+mod common;
+
+use common::tube_garment;
 use weft_character::garment::{GarmentSpec, build_garment};
 use weft_character::{Attachment, Character};
 
-const SKIRT: &str = r#"edge_length = 0.03
-area_density = 0.2
-
-[[panel]]
-name = "front"
-outline = [[-0.15, 0.0], [0.15, 0.0], [0.15, 0.3], [-0.15, 0.3]]
-position = [0.0, 0.65, 0.18]
-
-[[panel]]
-name = "back"
-outline = [[-0.15, 0.0], [0.15, 0.0], [0.15, 0.3], [-0.15, 0.3]]
-position = [0.0, 0.65, -0.18]
-rotation = [0.0, 180.0, 0.0]
-
-[[seam]]
-a = { panel = "front", edges = [1, 1] }
-b = { panel = "back", edges = [3, 3] }
-flip = true
-
-[[seam]]
-a = { panel = "front", edges = [3, 3] }
-b = { panel = "back", edges = [1, 1] }
-flip = true
-"#;
+/// A skirt: two 0.3 m × 0.3 m panels at hip height, 0.36 m apart, sewn at both sides.
+fn skirt() -> String {
+    tube_garment(0.15, 0.3, 0.65, 0.18, 0.2)
+}
 
 #[test]
 fn a_skirt_starts_outside_the_walker_and_its_waistband_follows_the_hips() {
     let walker = Character::walker();
-    let skirt = build_garment(&GarmentSpec::from_toml(SKIRT).expect("spec")).expect("skirt");
+    let skirt = build_garment(&GarmentSpec::from_toml(&skirt()).expect("spec")).expect("skirt");
     // Dress the walker mid-stride, with the hips turned, so the binding needs the bone's full
     // transform (its inverse rotation too).
     let t0 = 0.3;

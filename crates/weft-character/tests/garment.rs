@@ -1,37 +1,18 @@
 //! Garments from flat panels: triangulation to a target edge length, preserved panel areas,
 //! seam vertex pairs matched in order and count, and errors that name their line.
 
+mod common;
+
+use common::tube_garment;
 use glam::DVec2;
 use weft_character::files::{LoadError, read_garment};
 use weft_character::garment::{Garment, GarmentError, GarmentSpec, build_garment};
 
 /// A tube: front and back rectangles (0.4 m × 0.5 m) facing each other 0.3 m apart, sewn
 /// at both sides.
-const TUBE: &str = r#"edge_length = 0.03
-area_density = 0.15
-
-[[panel]]
-name = "front"
-outline = [[-0.2, 0.0], [0.2, 0.0], [0.2, 0.5], [-0.2, 0.5]]
-position = [0.0, 0.5, 0.15]
-
-[[panel]]
-name = "back"
-outline = [[-0.2, 0.0], [0.2, 0.0], [0.2, 0.5], [-0.2, 0.5]]
-position = [0.0, 0.5, -0.15]
-rotation = [0.0, 180.0, 0.0]
-
-# Front's right side (going up) to the back's edge 3, which runs down on the same side.
-[[seam]]
-a = { panel = "front", edges = [1, 1] }
-b = { panel = "back", edges = [3, 3] }
-flip = true
-
-[[seam]]
-a = { panel = "front", edges = [3, 3] }
-b = { panel = "back", edges = [1, 1] }
-flip = true
-"#;
+fn tube() -> String {
+    tube_garment(0.2, 0.5, 0.5, 0.15, 0.15)
+}
 
 fn build(text: &str) -> Garment {
     build_garment(&GarmentSpec::from_toml(text).expect("valid garment")).expect("garment")
@@ -55,7 +36,7 @@ fn polygon_area(p: &[DVec2]) -> f64 {
 
 #[test]
 fn panels_are_triangulated_to_the_target_edge_length() {
-    let g = build(TUBE);
+    let g = build(&tube());
     let h = 0.03;
     let lengths = edge_lengths(&g);
     let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
@@ -77,7 +58,7 @@ fn panels_are_triangulated_to_the_target_edge_length() {
         }
     }
     // Finer target, more triangles, shorter edges: the length is a real control.
-    let fine = build(&TUBE.replace("edge_length = 0.03", "edge_length = 0.015"));
+    let fine = build(&tube().replace("edge_length = 0.03", "edge_length = 0.015"));
     let fine_mean = edge_lengths(&fine).iter().sum::<f64>() / fine.mesh.stretch.len() as f64;
     assert!(
         (fine_mean / mean - 0.5).abs() < 0.1,
@@ -88,7 +69,7 @@ fn panels_are_triangulated_to_the_target_edge_length() {
 
 #[test]
 fn panel_areas_and_masses_are_preserved() {
-    let g = build(TUBE);
+    let g = build(&tube());
     assert!(
         (g.mesh.area() - 2.0 * 0.4 * 0.5).abs() < 1e-12,
         "{}",
@@ -127,7 +108,7 @@ outline = [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.45], [0.45, 0.35], [0.52, 0.5],
 
 #[test]
 fn seam_pairs_match_in_order_and_count() {
-    let g = build(TUBE);
+    let g = build(&tube());
     let h = 0.03;
     let pieces = (0.5_f64 / h).ceil() as usize;
     assert_eq!(g.seams.len(), 2);
@@ -222,7 +203,7 @@ fn key_line(e: &GarmentError) -> (&'static str, Option<usize>) {
 
 #[test]
 fn bad_garments_name_their_key_and_line() {
-    let e = error_of(&TUBE.replace(
+    let e = error_of(&tube().replace(
         "b = { panel = \"back\", edges = [3, 3] }",
         "b = { panel = \"bak\", edges = [3, 3] }",
     ));
@@ -231,15 +212,15 @@ fn bad_garments_name_their_key_and_line() {
         e.to_string().contains("seam 1") && e.to_string().contains("bak"),
         "{e}"
     );
-    let e = error_of(&TUBE.replace("edges = [3, 3] }\nflip", "edges = [4, 4] }\nflip"));
+    let e = error_of(&tube().replace("edges = [3, 3] }\nflip", "edges = [4, 4] }\nflip"));
     assert_eq!(key_line(&e), ("b", Some(18)));
-    let e = error_of(&TUBE.replace(
+    let e = error_of(&tube().replace(
         "a = { panel = \"front\", edges = [3, 3] }",
         "a = { panel = \"front\", edges = [1, 1] }",
     ));
     assert_eq!(key_line(&e), ("a", Some(22)));
     assert!(e.to_string().contains("already in seam 1"), "{e}");
-    let bow_tie = TUBE.replacen(
+    let bow_tie = tube().replacen(
         "[[-0.2, 0.0], [0.2, 0.0], [0.2, 0.5], [-0.2, 0.5]]",
         "[[-0.2, 0.0], [0.2, 0.5], [0.2, 0.0], [-0.2, 0.5]]",
         1,
@@ -247,30 +228,30 @@ fn bad_garments_name_their_key_and_line() {
     let e = error_of(&bow_tie);
     assert_eq!(key_line(&e), ("outline", Some(6)));
     assert!(e.to_string().contains("crosses itself"), "{e}");
-    let repeated = TUBE.replacen("[[-0.2, 0.0], [0.2, 0.0],", "[[-0.2, 0.0], [-0.2, 0.0],", 1);
+    let repeated = tube().replacen("[[-0.2, 0.0], [0.2, 0.0],", "[[-0.2, 0.0], [-0.2, 0.0],", 1);
     assert_eq!(key_line(&error_of(&repeated)), ("outline", Some(6)));
-    let two = TUBE.replacen(
+    let two = tube().replacen(
         "[[-0.2, 0.0], [0.2, 0.0], [0.2, 0.5], [-0.2, 0.5]]",
         "[[-0.2, 0.0], [0.2, 0.0]]",
         1,
     );
     assert_eq!(key_line(&error_of(&two)), ("outline", Some(6)));
-    let e = error_of(&TUBE.replace("edge_length = 0.03", "edge_length = -0.03"));
+    let e = error_of(&tube().replace("edge_length = 0.03", "edge_length = -0.03"));
     assert_eq!(key_line(&e), ("edge_length", Some(1)));
-    let e = error_of(&TUBE.replace("edge_length = 0.03", "edge_length = 1e-5"));
+    let e = error_of(&tube().replace("edge_length = 0.03", "edge_length = 1e-5"));
     assert_eq!(key_line(&e).0, "outline");
-    let e = error_of(&TUBE.replace("name = \"back\"", "name = \"front\""));
+    let e = error_of(&tube().replace("name = \"back\"", "name = \"front\""));
     assert_eq!(key_line(&e), ("name", Some(10)));
     for (text, line) in [
         (
-            TUBE.replace("flip = true\n\n[[seam]]", "flip = 1\n\n[[seam]]"),
+            tube().replace("flip = true\n\n[[seam]]", "flip = 1\n\n[[seam]]"),
             19,
         ),
         (
-            TUBE.replace("position = [0.0, 0.5, 0.15]", "position = [0.0, 0.5]"),
+            tube().replace("position = [0.0, 0.5, 0.15]", "position = [0.0, 0.5]"),
             7,
         ),
-        (TUBE.replace("area_density = 0.15", "density = 0.15"), 2),
+        (tube().replace("area_density = 0.15", "density = 0.15"), 2),
     ] {
         match error_of(&text) {
             GarmentError::Toml { line: Some(l), .. } => assert_eq!(l, line, "{text}"),
@@ -286,7 +267,7 @@ fn garment_files_name_the_file() {
     let path = dir.join("tube.toml");
     std::fs::write(
         &path,
-        TUBE.replace("edge_length = 0.03", "edge_length = \"fine\""),
+        tube().replace("edge_length = 0.03", "edge_length = \"fine\""),
     )
     .expect("write");
     let e = read_garment(&path).expect_err("bad garment accepted");
@@ -295,7 +276,7 @@ fn garment_files_name_the_file() {
         e.to_string().contains("tube.toml") && e.to_string().contains("line 1"),
         "{e}"
     );
-    std::fs::write(&path, TUBE).expect("write");
+    std::fs::write(&path, tube()).expect("write");
     let spec = read_garment(&path).expect("good garment");
     assert_eq!(spec.panels.len(), 2);
     std::fs::remove_dir_all(&dir).ok();

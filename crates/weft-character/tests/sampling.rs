@@ -1,37 +1,12 @@
 //! Sampling a clip between frames, and bone velocities against finite differences.
 
+mod common;
+
+use common::TINY_BVH as TINY;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{DQuat, DVec3};
 use weft_character::{Animation, BvhOptions, Clip, Pose, VELOCITY_STEP, Wrap, parse_bvh};
-
-/// Root (6 channels), Mid (rotates 90° about y from frame 0 to 1), Tip; centimetres.
-const TINY: &str = "HIERARCHY
-ROOT Root
-{
-  OFFSET 0 0 0
-  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-  JOINT Mid
-  {
-    OFFSET 0 10 0
-    CHANNELS 3 Yrotation Xrotation Zrotation
-    JOINT Tip
-    {
-      OFFSET 5 0 0
-      CHANNELS 2 Xrotation Zrotation
-      End Site
-      {
-        OFFSET 0 0 3
-      }
-    }
-  }
-}
-MOTION
-Frames: 2
-Frame Time: 0.5
-0 0 0 0 0 0 0 0 0 0 0
-100 200 300 90 90 0 90 0 0 90 0
-";
 
 fn tiny(wrap: Wrap) -> Animation {
     let bvh = parse_bvh(TINY, &BvhOptions { scale: 0.01 }).expect("valid BVH");

@@ -276,13 +276,7 @@ impl CollisionWorld {
             .collect();
         let parry = self.parry_meshes;
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
-        let Particles {
-            positions,
-            prev_positions,
-            inv_masses,
-            ..
-        } = p;
-        let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
+        let (positions, prev, inv) = moving_views(p);
         let (contacts, deepest, swept) = positions
             .par_chunks_mut(CHUNK)
             .zip(self.mesh_lists.par_iter_mut())
@@ -319,6 +313,17 @@ impl CollisionWorld {
     }
 }
 
+/// The particles' positions to move, with their previous positions and inverse masses to read.
+fn moving_views(p: &mut Particles) -> (&mut [DVec3], &[DVec3], &[f64]) {
+    let Particles {
+        positions,
+        prev_positions,
+        inv_masses,
+        ..
+    } = p;
+    (positions, prev_positions, inv_masses)
+}
+
 /// Calls `f(i, position, previous position)` for every particle with a nonzero inverse mass,
 /// in parallel over fixed chunks of [`CHUNK`] particles, and folds the results with
 /// `combine`, which must not depend on order (sums of counts, maxima) so that the answer is
@@ -329,13 +334,7 @@ fn over_free_particles<T: Copy + Send + Sync>(
     f: impl Fn(usize, &mut DVec3, DVec3) -> T + Sync,
     combine: impl Fn(T, T) -> T + Sync + Send,
 ) -> T {
-    let Particles {
-        positions,
-        prev_positions,
-        inv_masses,
-        ..
-    } = p;
-    let (prev, inv) = (&prev_positions[..], &inv_masses[..]);
+    let (positions, prev, inv) = moving_views(p);
     positions
         .par_chunks_mut(CHUNK)
         .enumerate()

@@ -83,6 +83,25 @@ impl StabilityBound {
     }
 }
 
+/// Every enabled constraint of `block` with its particles, its parameters and ∇C from `grad`
+/// at `x`; constraints whose gradient is undefined (degenerate) are left out.
+fn enabled_gradients<'a, const N: usize, S: Shape<N>>(
+    block: &'a Block<N, S>,
+    x: &'a [DVec3],
+    params: &'a [FamilyParams],
+    grad: impl Fn(&S, &[DVec3; N]) -> Option<[DVec3; N]> + 'a,
+) -> impl Iterator<Item = ([u32; N], &'a FamilyParams, [DVec3; N])> + 'a {
+    let constraints = block.particles.iter().zip(&block.shapes).zip(&block.group);
+    constraints.filter_map(move |((idx, shape), &g)| {
+        let p = &params[g as usize];
+        if !p.enabled {
+            return None;
+        }
+        let gr = grad(shape, &idx.map(|i| x[i as usize]))?;
+        Some((*idx, p, gr))
+    })
+}
+
 /// Row sums of the scaled stiffness and damping matrices, per particle.
 struct Rows {
     k: Vec<f64>,
@@ -99,14 +118,7 @@ impl Rows {
         params: &[FamilyParams],
         grad: impl Fn(&S, &[DVec3; N]) -> Option<[DVec3; N]>,
     ) {
-        for ((idx, shape), &g) in block.particles.iter().zip(&block.shapes).zip(&block.group) {
-            let p = &params[g as usize];
-            if !p.enabled {
-                continue;
-            }
-            let Some(gr) = grad(shape, &idx.map(|i| x[i as usize])) else {
-                continue;
-            };
+        for (idx, p, gr) in enabled_gradients(block, x, params, grad) {
             let norms = gr.map(|v| v.length());
             let ws = idx.map(|i| w[i as usize].sqrt());
             let sum: f64 = (0..N).map(|j| norms[j] * ws[j]).sum();
@@ -132,14 +144,7 @@ fn product<const N: usize, S: Shape<N>>(
     out_k: &mut [DVec3],
     out_c: &mut [DVec3],
 ) {
-    for ((idx, shape), &g) in block.particles.iter().zip(&block.shapes).zip(&block.group) {
-        let p = &params[g as usize];
-        if !p.enabled {
-            continue;
-        }
-        let Some(gr) = grad(shape, &idx.map(|i| x[i as usize])) else {
-            continue;
-        };
+    for (idx, p, gr) in enabled_gradients(block, x, params, grad) {
         let s: f64 = (0..N)
             .map(|j| gr[j].dot(z[idx[j] as usize]) * sw[idx[j] as usize])
             .sum();

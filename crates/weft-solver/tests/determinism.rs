@@ -3,21 +3,15 @@
 
 mod common;
 
+use common::flag::{flag_settings, in_pool, state_bits, step, windy_flag};
 use common::*;
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    Aero, ClothParams, Edge, Family, Forces, GridDesc, Method, Motion, Pin, Settings, Solver,
-    SolverBuilder, SubstepHook, Wind,
+    Aero, ClothParams, Family, Forces, Method, Motion, Settings, Solver, SolverBuilder, Wind,
 };
 
 fn build(method: Method, domain_size: usize) -> Solver {
-    let mesh = GridDesc {
-        resolution: (48, 48),
-        pins: vec![Pin::Edge(Edge::Top)],
-        ..GridDesc::default()
-    }
-    .build()
-    .expect("valid grid");
+    let mesh = top_pinned_grid((48, 48));
     let mut params = ClothParams::default()
         .edit(Family::BendDistance, |p| p.enabled = true)
         .edit(Family::Tether, |p| p.enabled = true);
@@ -59,11 +53,7 @@ fn bits(s: &Solver) -> Vec<[u64; 3]> {
 }
 
 fn run_in_pool(threads: usize, method: Method, domain_size: usize) -> Vec<[u64; 3]> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
-    pool.install(|| {
+    in_pool(threads, || {
         let mut s = build(method, domain_size);
         run(&mut s, 40);
         bits(&s)
@@ -92,50 +82,11 @@ fn results_are_bit_identical_across_thread_counts() {
     }
 }
 
-/// A hook that does nothing but says it is active, forcing the general loop.
-struct Active;
-
-impl SubstepHook for Active {}
-
 /// A flag in linear wind with a moving pin, global and XPBD damping, and a dragged corner:
 /// everything the fused frame handles.
 fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
-    pool.install(|| {
-        let mesh = GridDesc {
-            resolution: (40, 40),
-            pins: vec![Pin::Edge(Edge::Top)],
-            ..GridDesc::default()
-        }
-        .build()
-        .expect("valid grid");
-        let params = ClothParams::default()
-            .edit(Family::BendDistance, |p| p.enabled = true)
-            .edit(Family::Stretch, |p| {
-                p.compliance = 1e-6;
-                p.damping = 0.5;
-            });
-        let forces = Forces {
-            wind: Wind {
-                velocity: DVec3::new(0.0, 0.0, 3.0),
-                drag: 0.2,
-                aero: None,
-            },
-            damping: 0.1,
-            ..Forces::default()
-        };
-        let settings = Settings {
-            method,
-            substeps: 4,
-            iterations: 2,
-            domain_size: 200,
-            ..Settings::default()
-        };
-        let mut b = SolverBuilder::new(settings, forces).expect("valid");
-        b.add_cloth("flag", &mesh, params, 0.01).expect("valid");
+    in_pool(threads, || {
+        let (mut b, mesh) = windy_flag((40, 40), flag_settings(method, 200));
         b.add_kinematic_pin(
             0,
             0,
@@ -154,19 +105,11 @@ fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
                 15 => s.release(),
                 _ => {}
             }
-            if active {
-                s.step_with(&mut Active).expect("stable");
-            } else {
-                s.step().expect("stable");
-            }
+            step(&mut s, active);
         }
         let p = s.particles();
         assert!((p.positions[corner] - mesh.positions[corner]).length() > 0.1);
-        p.positions
-            .iter()
-            .chain(&p.velocities)
-            .map(|v| v.to_array().map(f64::to_bits))
-            .collect()
+        state_bits(&s)
     })
 }
 

@@ -68,13 +68,7 @@ fn grabbed_particle_reaches_its_target_and_keeps_its_velocity_on_release() {
 fn tethers_limit_stretch_of_a_soft_cloth() {
     let droop = |tethers: bool| {
         let params = in_plane(0.05, 1.0, 0.0).edit(Family::Tether, |p| p.enabled = tethers);
-        let mesh = GridDesc {
-            resolution: (12, 12),
-            pins: vec![Pin::Edge(Edge::Top)],
-            ..GridDesc::default()
-        }
-        .build()
-        .expect("valid");
+        let mesh = top_pinned_grid((12, 12));
         let forces = Forces {
             damping: 2.0,
             ..Forces::default()

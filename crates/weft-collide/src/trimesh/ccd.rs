@@ -185,15 +185,15 @@ mod tests {
             let end = start.map(|v| v + rng.cube(0.8));
             let (p0, p1) = (rng.cube(1.0), rng.cube(1.0));
             let hit = moving_crossing(p0, p1, start, end, false);
+            // The triangle's corners and the point at time t.
+            let at = |t: f64| {
+                let l = |u: DVec3, v: DVec3| u + (v - u) * t;
+                let [a, b, c] = [0, 1, 2].map(|k| l(start[k], end[k]));
+                (a, b, c, l(p0, p1))
+            };
             // Reference: sample 4000 times; a change of side inside the triangle.
             let side = |t: f64| {
-                let l = |u: DVec3, v: DVec3| u + (v - u) * t;
-                let (a, b, c) = (
-                    l(start[0], end[0]),
-                    l(start[1], end[1]),
-                    l(start[2], end[2]),
-                );
-                let p = l(p0, p1);
+                let (a, b, c, p) = at(t);
                 (
                     (b - a).cross(c - a).dot(p - a),
                     inside(p, a, b, c).is_some(),
@@ -220,14 +220,8 @@ mod tests {
             if let Some(r) = reference {
                 let h = hit.unwrap_or_else(|| {
                     let near = |t: f64| {
-                        let l = |u: DVec3, v: DVec3| u + (v - u) * t;
-                        let (a, b, c) = (
-                            l(start[0], end[0]),
-                            l(start[1], end[1]),
-                            l(start[2], end[2]),
-                        );
+                        let (a, b, c, p) = at(t);
                         let n = (b - a).cross(c - a);
-                        let p = l(p0, p1);
                         let area = n.length_squared();
                         [
                             (c - b).cross(p - b).dot(n) / area,
@@ -253,34 +247,19 @@ mod tests {
     fn segment_crossing_keeps_the_side() {
         let tri = [DVec3::ZERO, DVec3::X, DVec3::Z];
         let n = DVec3::NEG_Y; // (x) × (z) = −y
-        let down = segment_crossing(
-            DVec3::new(0.2, 1.0, 0.2),
-            DVec3::new(0.2, -1.0, 0.2),
-            tri,
-            n,
-            false,
-        )
-        .expect("crosses");
+        // A vertical segment through (x, ·, 0.2) from y = 1 down to y = −1.
+        let cross = |x: f64, entering_only: bool| {
+            segment_crossing(
+                DVec3::new(x, 1.0, 0.2),
+                DVec3::new(x, -1.0, 0.2),
+                tri,
+                n,
+                entering_only,
+            )
+        };
+        let down = cross(0.2, false).expect("crosses");
         assert_eq!((down.t, down.side), (0.5, -1.0));
-        assert!(
-            segment_crossing(
-                DVec3::new(0.2, 1.0, 0.2),
-                DVec3::new(0.2, -1.0, 0.2),
-                tri,
-                n,
-                true
-            )
-            .is_none()
-        );
-        assert!(
-            segment_crossing(
-                DVec3::new(2.0, 1.0, 0.2),
-                DVec3::new(2.0, -1.0, 0.2),
-                tri,
-                n,
-                false
-            )
-            .is_none()
-        );
+        assert!(cross(0.2, true).is_none());
+        assert!(cross(2.0, false).is_none());
     }
 }

@@ -1,9 +1,11 @@
 //! Fixtures shared by the physics tests.
 #![allow(dead_code)]
 
+pub mod flag;
+
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    ClothMesh, ClothParams, Corner, Family, Forces, GridDesc, Mass, Method, Orientation, Pin,
+    ClothMesh, ClothParams, Corner, Edge, Family, Forces, GridDesc, Mass, Method, Orientation, Pin,
     Settings, Solver, SolverBuilder,
 };
 
@@ -70,6 +72,17 @@ pub fn hanging_grid(n: usize) -> ClothMesh {
         orientation: Orientation::Vertical,
         mass: Mass::Total(1.0),
         pins: vec![Pin::Corner(Corner::TopLeft), Pin::Corner(Corner::TopRight)],
+    }
+    .build()
+    .expect("valid grid")
+}
+
+/// A default grid of `resolution` particles pinned along its top edge.
+pub fn top_pinned_grid(resolution: (usize, usize)) -> ClothMesh {
+    GridDesc {
+        resolution,
+        pins: vec![Pin::Edge(Edge::Top)],
+        ..GridDesc::default()
     }
     .build()
     .expect("valid grid")

@@ -1,0 +1,70 @@
+//! Fixtures shared by the character tests.
+#![allow(dead_code)]
+
+/// Root (6 channels, Z X Y rotation order), Mid (Y X Z), Tip (2 channels: X Z), End Site.
+/// Centimetres; frame 0 is the rest pose, frame 1 turns Mid 90° about y (and more, worked out
+/// by hand in the BVH tests).
+pub const TINY_BVH: &str = "HIERARCHY
+ROOT Root
+{
+  OFFSET 0 0 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Mid
+  {
+    OFFSET 0 10 0
+    CHANNELS 3 Yrotation Xrotation Zrotation
+    JOINT Tip
+    {
+      OFFSET 5 0 0
+      CHANNELS 2 Xrotation Zrotation
+      End Site
+      {
+        OFFSET 0 0 3
+      }
+    }
+  }
+}
+MOTION
+Frames: 2
+Frame Time: 0.5
+0 0 0 0 0 0 0 0 0 0 0
+100 200 300 90 90 0 90 0 0 90 0
+";
+
+/// Garment TOML for a tube: front and back rectangles `2·half_width` wide and `height` tall,
+/// bottoms at `y`, facing each other at z = ±`z`, sewn at both sides; edge length 0.03 m.
+pub fn tube_garment(half_width: f64, height: f64, y: f64, z: f64, area_density: f64) -> String {
+    let (w, h) = (half_width, height);
+    let outline = format!(
+        "[[{:?}, 0.0], [{w:?}, 0.0], [{w:?}, {h:?}], [{:?}, {h:?}]]",
+        -w, -w
+    );
+    format!(
+        r#"edge_length = 0.03
+area_density = {area_density:?}
+
+[[panel]]
+name = "front"
+outline = {outline}
+position = [0.0, {y:?}, {z:?}]
+
+[[panel]]
+name = "back"
+outline = {outline}
+position = [0.0, {y:?}, {:?}]
+rotation = [0.0, 180.0, 0.0]
+
+# Front's right side (going up) to the back's edge 3, which runs down on the same side.
+[[seam]]
+a = {{ panel = "front", edges = [1, 1] }}
+b = {{ panel = "back", edges = [3, 3] }}
+flip = true
+
+[[seam]]
+a = {{ panel = "front", edges = [3, 3] }}
+b = {{ panel = "back", edges = [1, 1] }}
+flip = true
+"#,
+        -z
+    )
+}
