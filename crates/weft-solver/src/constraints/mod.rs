@@ -93,8 +93,9 @@ impl ConstraintSet {
         self.tethers.reset_multipliers();
     }
 
-    /// One Gauss–Seidel sweep over the dihedral and tether constraints, colour by colour (the
-    /// distance constraints are solved by [`crate::domains::Domains`]).
+    /// One Gauss–Seidel sweep over the dihedral and tether constraints, colour by colour, the
+    /// dihedrals' symmetric (forward, then backward); the distance constraints are solved by
+    /// [`crate::domains::Domains`].
     pub(crate) fn project_others(
         &mut self,
         x: &mut [DVec3],
@@ -103,7 +104,7 @@ impl ConstraintSet {
         params: &[FamilyParams],
         rule: Rule,
     ) {
-        self.dihedral.project(x, prev, w, params, rule);
+        self.dihedral.project_symmetric(x, prev, w, params, rule);
         self.tethers.project(x, prev, w, params, rule);
     }
 
