@@ -190,12 +190,14 @@ fn scenes_with_several_methods_log_every_cloth() {
         "cloth.pbd.resolution=[6, 6]",
         "--set",
         "cloth.springs.resolution=[6, 6]",
+        "--set",
+        "cloth.implicit.resolution=[6, 6]",
         "--out",
         &mcap.to_string_lossy(),
     ]);
     assert!(out.status.success(), "{:?}", texts(&out));
     let log = read_log(&mcap);
-    for name in ["xpbd", "pbd", "springs"] {
+    for name in ["xpbd", "pbd", "springs", "implicit"] {
         assert_eq!(log.counts[&format!("/cloth/{name}/particles")], 4);
         assert_eq!(log.last[&format!("/cloth/{name}/particles")].len(), 36);
     }
