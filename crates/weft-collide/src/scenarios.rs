@@ -1,5 +1,7 @@
-//! Ready-made scenes as code, for tests, benches and the app: each returns a solver and the
-//! collision world to step it with (`solver.step_with(&mut world)`).
+//! Scenes as code, sized by parameter, for this crate's benches, examples and the tests that
+//! need a size or setting no shipped scene has: each returns a solver and the collision world
+//! to step it with (`solver.step_with(&mut world)`). A test of a scene Weft ships reads its
+//! file in `assets/scenes` through weft-scene instead (`crates/weft-scene/tests/`).
 
 use std::path::PathBuf;
 
