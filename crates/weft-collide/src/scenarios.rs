@@ -1,5 +1,7 @@
-//! Ready-made scenes as code, for tests, benches and the app: each returns a solver and the
-//! collision world to step it with (`solver.step_with(&mut world)`).
+//! Scenes as code, sized by parameter, for this crate's benches, examples and the tests that
+//! need a size or setting no shipped scene has: each returns a solver and the collision world
+//! to step it with (`solver.step_with(&mut world)`). A test of a scene Weft ships reads its
+//! file in `assets/scenes` through weft-scene instead (`crates/weft-scene/tests/`).
 
 use std::path::PathBuf;
 
@@ -104,7 +106,7 @@ pub fn ground(height: f32) -> ColliderDesc {
 
 /// Sphere radius of [`sphere_drop`] (m); its centre is the origin.
 pub const SPHERE_RADIUS: f64 = 0.5;
-/// Cloth thickness of [`sphere_drop`] and [`table_drape`] (m).
+/// Cloth thickness of [`sphere_drop`] (m).
 pub const THICKNESS: f64 = 0.01;
 
 /// A horizontal 1.6 m cloth (`n`×`n` particles, 0.4 kg) falls from 0.2 m above a static
@@ -119,26 +121,6 @@ pub fn sphere_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld),
         .with_friction(Friction::new(0.8, 0.6)),
     )?;
     world.add_collider(&ground(-SPHERE_RADIUS as f32))?;
-    Ok((solver, world))
-}
-
-/// Half-size of [`table_drape`]'s box (m); its top is at y = 2 · half-height.
-pub const TABLE_HALF_EXTENTS: DVec3 = DVec3::new(0.4, 0.4, 0.4);
-
-/// A square 1.4 m cloth (`n`×`n`) falls onto a 0.8 m box standing on the ground and hangs
-/// over its edges.
-pub fn table_drape(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
-    let top = 2.0 * TABLE_HALF_EXTENTS.y;
-    let solver = falling_sheet(method, n, 1.4, top + 0.1, 0.3)?;
-    let mut world = CollisionWorld::new(&solver);
-    world.add_collider(
-        &ColliderDesc::new(ShapeDesc::Cuboid {
-            half_extents: TABLE_HALF_EXTENTS.as_vec3(),
-        })
-        .at(Vec3::Y * TABLE_HALF_EXTENTS.y as f32)
-        .with_friction(Friction::new(0.8, 0.6)),
-    )?;
-    world.add_collider(&ground(0.0))?;
     Ok((solver, world))
 }
 

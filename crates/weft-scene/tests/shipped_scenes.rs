@@ -1,33 +1,13 @@
 //! Every shipped scene runs 300 frames under every method at its own settings, and contact
 //! never adds energy: a cloth resting on a sphere loses kinetic energy under every method.
 
-use std::path::{Path, PathBuf};
+mod common;
 
-use weft_scene::{Override, Scene, SolverGroup};
+use std::path::PathBuf;
+
+use common::{scenes_dir, with_method};
+use weft_scene::SolverGroup;
 use weft_solver::Method;
-
-fn scenes_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes")
-}
-
-fn load(path: &Path, overrides: &[String]) -> Scene {
-    let ov: Vec<Override> = overrides
-        .iter()
-        .map(|s| s.parse().expect("valid override"))
-        .collect();
-    weft_scene::load(path, &ov).unwrap_or_else(|e| panic!("{}: {e:?}", path.display()))
-}
-
-/// The scene at `path` with every cloth switched to `method`.
-fn with_method(path: &Path, method: Method, extra: &[String]) -> Vec<SolverGroup> {
-    let probe = load(path, extra);
-    let mut ov: Vec<String> = extra.to_vec();
-    ov.push(format!("sim.method={}", method.name()));
-    for c in &probe.cloths {
-        ov.push(format!("cloth.{}.method={}", c.name, method.name()));
-    }
-    load(path, &ov).build().expect("scene builds")
-}
 
 fn kinetic_energy(groups: &[SolverGroup]) -> f64 {
     groups

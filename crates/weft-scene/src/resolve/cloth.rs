@@ -1,0 +1,222 @@
+//! A `[cloth.<name>]` table: a grid or an OBJ mesh, its pins, mass, material and per-family
+//! settings, checked and built into a [`ClothSpec`].
+
+use weft_solver::{
+    ClothMesh, ClothParams, Corner, Edge, GridDesc, Mass, MeshError, Method, Orientation, Pin,
+    Settings,
+};
+
+use super::{Checker, valid_name};
+use crate::family::{self, Field, Setting};
+use crate::ranges;
+use crate::scene::ClothSpec;
+use crate::schema::{ClothSection, OrientationName, PinSpec};
+
+fn named_pin(name: &str) -> Option<Pin> {
+    Some(match name {
+        "top-left" => Pin::Corner(Corner::TopLeft),
+        "top-right" => Pin::Corner(Corner::TopRight),
+        "bottom-left" => Pin::Corner(Corner::BottomLeft),
+        "bottom-right" => Pin::Corner(Corner::BottomRight),
+        "top" => Pin::Edge(Edge::Top),
+        "bottom" => Pin::Edge(Edge::Bottom),
+        "left" => Pin::Edge(Edge::Left),
+        "right" => Pin::Edge(Edge::Right),
+        _ => return None,
+    })
+}
+
+pub(super) fn cloth(
+    c: &mut Checker<'_>,
+    name: &str,
+    s: &ClothSection,
+    settings: &Settings,
+) -> Option<ClothSpec> {
+    let k = |field: &str| format!("cloth.{name}.{field}");
+    let before = c.errors.len();
+    if !valid_name(name) {
+        c.bad(
+            &format!("cloth.{name}"),
+            "a cloth name may hold only letters, digits, `_` and `-`",
+        );
+    }
+    let method = s.method.map(Method::from).unwrap_or(settings.method);
+    let material = s
+        .material
+        .as_ref()
+        .and_then(|m| match crate::material::resolve(m) {
+            Ok(m) => Some(m),
+            Err((field, message)) => {
+                c.bad(&k(&field), message);
+                None
+            }
+        });
+    let mass = match (s.mass, s.density) {
+        (Some(_), Some(_)) => {
+            c.bad(&k("density"), "give `mass` or `density`, not both");
+            Mass::Total(1.0)
+        }
+        (Some(m), None) => {
+            c.within(&k("mass"), m, &ranges::MASS);
+            Mass::Total(m)
+        }
+        (None, Some(d)) => {
+            c.within(&k("density"), d, &ranges::DENSITY);
+            Mass::Density(d)
+        }
+        (None, None) => material.map_or(Mass::Total(1.0), |m| Mass::Density(m.density)),
+    };
+    let center = c.vector(&k("center"), s.center.unwrap_or_default());
+    let pins = s.pins.clone().unwrap_or_default();
+    let mut params = ClothParams::default();
+    let entries = s.family_settings();
+    for &(fam, setting) in &entries {
+        if let Some(v) = setting.number() {
+            c.rule(
+                &k(&family::key(fam, setting.field())),
+                v,
+                setting.field().rule(),
+            );
+        }
+    }
+    for &(fam, setting) in &entries {
+        let field = setting.field();
+        let range = match field {
+            Field::Compliance => &ranges::COMPLIANCE,
+            Field::Damping | Field::SpringDamping => &ranges::DAMPING,
+            Field::SpringStiffness => &ranges::SPRING_STIFFNESS,
+            Field::Enabled | Field::PbdStiffness => continue,
+        };
+        if let Some(v) = setting.number()
+            && (field.rule())(v).is_ok()
+        {
+            c.within(&k(&family::key(fam, field)), v, range);
+        }
+    }
+    let thickness = s.thickness.unwrap_or(0.005);
+    c.within(&k("thickness"), thickness, &ranges::THICKNESS);
+    let motion = c.motion(&k("motion"), &s.motion);
+    let mesh = if let Some(path) = &s.mesh {
+        c.unused(&k("resolution"), &s.resolution, "by a mesh cloth");
+        c.unused(&k("size"), &s.size, "by a mesh cloth");
+        c.unused(&k("orientation"), &s.orientation, "by a mesh cloth");
+        let scale = s.scale.unwrap_or(1.0);
+        c.within(&k("scale"), scale, &ranges::SCALE);
+        let mut indices = Vec::new();
+        for (i, p) in pins.iter().enumerate() {
+            match p {
+                PinSpec::Index(v) if *v >= 0 && *v <= u32::MAX as i64 => indices.push(*v as u32),
+                PinSpec::Index(v) => {
+                    c.bad(&format!("{}[{i}]", k("pins")), format!("bad index {v}"))
+                }
+                PinSpec::Named(n) => c.bad(
+                    &format!("{}[{i}]", k("pins")),
+                    format!("`{n}`: a mesh cloth is pinned by vertex index only"),
+                ),
+            }
+        }
+        let (positions, triangles) = c.read_mesh(&k("mesh"), path, scale)?;
+        let positions = positions.into_iter().map(|p| p + center).collect();
+        if c.errors.len() > before {
+            return None;
+        }
+        ClothMesh::from_triangles(positions, triangles, mass, indices)
+            .map_err(|e| mesh_error(c, name, &e, true))
+            .ok()?
+    } else {
+        c.unused(&k("scale"), &s.scale, "by a grid cloth");
+        let [nx, ny] = s.resolution.unwrap_or([20, 20]);
+        if !(2..=4096).contains(&nx) || !(2..=4096).contains(&ny) {
+            c.bad(
+                &k("resolution"),
+                format!("each count must be in 2..=4096, got [{nx}, {ny}]"),
+            );
+        }
+        let [w, h] = s.size.unwrap_or([1.0, 1.0]);
+        c.within(&k("size"), w, &ranges::SIZE);
+        c.within(&k("size"), h, &ranges::SIZE);
+        let mut grid_pins = Vec::new();
+        for (i, p) in pins.iter().enumerate() {
+            let key = format!("{}[{i}]", k("pins"));
+            match p {
+                PinSpec::Named(n) => match named_pin(n) {
+                    Some(pin) => grid_pins.push(pin),
+                    None => c.bad(
+                        &key,
+                        format!(
+                            "unknown pin `{n}`: expected top-left, top-right, bottom-left, \
+                             bottom-right, top, bottom, left, right or a vertex index"
+                        ),
+                    ),
+                },
+                PinSpec::Index(v) if *v >= 0 && *v < nx.saturating_mul(ny) => {
+                    grid_pins.push(Pin::Index(*v as u32))
+                }
+                PinSpec::Index(v) => c.bad(
+                    &key,
+                    format!(
+                        "vertex {v} does not exist (the grid has {})",
+                        nx.max(0).saturating_mul(ny.max(0))
+                    ),
+                ),
+            }
+        }
+        if c.errors.len() > before {
+            return None;
+        }
+        GridDesc {
+            resolution: (nx as usize, ny as usize),
+            size: (w, h),
+            center,
+            orientation: match s.orientation.unwrap_or_default() {
+                OrientationName::Vertical => Orientation::Vertical,
+                OrientationName::Horizontal => Orientation::Horizontal,
+            },
+            mass,
+            pins: grid_pins,
+        }
+        .build()
+        .map_err(|e| mesh_error(c, name, &e, false))
+        .ok()?
+    };
+    if let Some(m) = material {
+        params = m.params(&mesh, settings, &params);
+    }
+    family::apply(&entries, &mut params);
+    // Spring constants not given in the file scale with the cloth's particle masses, so the
+    // explicit mass-spring method is stable at the default substeps (weft_solver::spring_defaults).
+    let unset: Vec<weft_solver::Family> = weft_solver::Family::ALL
+        .into_iter()
+        .filter(|&f| {
+            !entries
+                .iter()
+                .any(|&(g, setting)| g == f && matches!(setting, Setting::SpringStiffness(_)))
+        })
+        .collect();
+    if c.errors.len() == before && material.is_none() {
+        match weft_solver::stable_spring_defaults(&mesh, &params, &unset) {
+            Ok(p) => params = p,
+            Err(e) => c.bad(&format!("cloth.{name}"), e.to_string()),
+        }
+    }
+    (c.errors.len() == before).then(|| ClothSpec {
+        name: name.to_owned(),
+        method,
+        mesh,
+        params,
+        thickness,
+        motion,
+    })
+}
+
+fn mesh_error(c: &mut Checker<'_>, name: &str, e: &MeshError, is_mesh: bool) {
+    let field = match e {
+        MeshError::GridTooSmall { .. } => "resolution",
+        MeshError::InvalidSize { .. } => "size",
+        MeshError::InvalidMass { .. } => "mass",
+        MeshError::PinOutOfRange { .. } => "pins",
+        MeshError::NonFiniteVertex { .. } if !is_mesh => "center",
+        _ => "mesh",
+    };
+    c.bad(&format!("cloth.{name}.{field}"), e.to_string());
+}
