@@ -202,7 +202,10 @@ fn scenes_with_several_methods_log_every_cloth() {
         assert_eq!(log.last[&format!("/cloth/{name}/particles")].len(), 36);
     }
     assert!(!log.counts.contains_key("/cloth/xpbd/mesh"));
-    assert_eq!(log.metadata["weft.run"]["methods"], "pbd,mass-spring,xpbd");
+    assert_eq!(
+        log.metadata["weft.run"]["methods"],
+        "implicit-mass-spring,pbd,mass-spring,xpbd"
+    );
 }
 
 #[test]
