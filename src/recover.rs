@@ -39,6 +39,30 @@ enum Kept<'a> {
     Metadata(Metadata),
 }
 
+/// Keeps a schema, channel or message record, inside a chunk or outside one (noting the `/stats`
+/// channel, whose messages count the frames); ignores every other record.
+fn keep<'a>(record: Record<'_>, kept: &mut Vec<Kept<'a>>, frames_channel: &mut Option<u16>) {
+    match record {
+        Record::Schema { header, data } => kept.push(Kept::Schema(
+            header.id,
+            header.name,
+            header.encoding,
+            data.into_owned(),
+        )),
+        Record::Channel(c) => {
+            if c.topic == "/stats" {
+                *frames_channel = Some(c.id);
+            }
+            kept.push(Kept::Channel(c));
+        }
+        Record::Message { header, data } => kept.push(Kept::Message(
+            header,
+            std::borrow::Cow::Owned(data.into_owned()),
+        )),
+        _ => {}
+    }
+}
+
 /// Reads every complete record of `bytes` (tolerating a cut tail) and writes a valid log to
 /// `out`.
 pub fn rebuild<W: std::io::Write + std::io::Seek>(
@@ -65,19 +89,6 @@ pub fn rebuild<W: std::io::Write + std::io::Seek>(
             }
         };
         match record {
-            Record::Schema { header, data } => kept.push(Kept::Schema(
-                header.id,
-                header.name,
-                header.encoding,
-                data.into_owned(),
-            )),
-            Record::Channel(c) => {
-                if c.topic == "/stats" {
-                    frames_channel = Some(c.id);
-                }
-                kept.push(Kept::Channel(c));
-            }
-            Record::Message { header, data } => kept.push(Kept::Message(header, data)),
             Record::Chunk { header, data } => {
                 // A chunk is kept whole or not at all: its CRC covers every record in it.
                 let inner: Result<Vec<_>, _> =
@@ -86,25 +97,7 @@ pub fn rebuild<W: std::io::Write + std::io::Seek>(
                     Ok(records) => {
                         report.chunks += 1;
                         for r in records {
-                            match r {
-                                Record::Schema { header, data } => kept.push(Kept::Schema(
-                                    header.id,
-                                    header.name,
-                                    header.encoding,
-                                    data.into_owned(),
-                                )),
-                                Record::Channel(c) => {
-                                    if c.topic == "/stats" {
-                                        frames_channel = Some(c.id);
-                                    }
-                                    kept.push(Kept::Channel(c));
-                                }
-                                Record::Message { header, data } => kept.push(Kept::Message(
-                                    header,
-                                    std::borrow::Cow::Owned(data.into_owned()),
-                                )),
-                                _ => {}
-                            }
+                            keep(r, &mut kept, &mut frames_channel);
                         }
                     }
                     Err(_) => report.dropped_chunks += 1,
@@ -118,7 +111,7 @@ pub fn rebuild<W: std::io::Write + std::io::Seek>(
                 data,
             })),
             Record::Metadata(m) if m.name != "weft.status" => kept.push(Kept::Metadata(m)),
-            _ => {}
+            other => keep(other, &mut kept, &mut frames_channel),
         }
     }
     let mut w = WriteOptions::new()
