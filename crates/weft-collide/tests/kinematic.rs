@@ -2,9 +2,9 @@
 
 use weft_collide::{ColliderDesc, CollisionWorld, Friction, ShapeDesc};
 use weft_solver::glam::{DQuat, DVec3, Quat, Vec3};
-use weft_solver::{
-    ClothParams, Edge, Forces, GridDesc, Mass, Motion, Orientation, Pin, Settings, SolverBuilder,
-};
+mod common;
+
+use weft_solver::{ClothParams, Forces, Motion, Settings, SolverBuilder};
 
 const THICKNESS: f64 = 0.01;
 const RADIUS: f64 = 0.15;
@@ -12,16 +12,7 @@ const RADIUS: f64 = 0.15;
 #[test]
 fn moving_sphere_follows_its_motion_and_pushes_a_curtain() {
     // A 0.8 m curtain hangs in the x–y plane from its pinned top edge at y = 1.
-    let mesh = GridDesc {
-        resolution: (16, 16),
-        size: (0.8, 0.8),
-        center: DVec3::new(0.0, 0.6, 0.0),
-        orientation: Orientation::Vertical,
-        mass: Mass::Total(0.2),
-        pins: vec![Pin::Edge(Edge::Top)],
-    }
-    .build()
-    .expect("grid");
+    let mesh = common::hanging_curtain(16);
     let forces = Forces {
         damping: 1.0,
         ..Forces::default()

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use weft_collide::{ColliderDesc, CollisionWorld, Friction, Keyframes, ShapeDesc, TriangleMesh};
 use weft_solver::glam::{DVec3, Vec3};
 use weft_solver::{
-    ClothParams, Edge, Forces, GridDesc, Mass, Orientation, Pin, Settings, Solver, SolverBuilder,
+    ClothParams, Forces, GridDesc, Mass, Orientation, Settings, Solver, SolverBuilder,
 };
 
 const THICKNESS: f64 = 0.01;
@@ -160,16 +160,7 @@ fn blade_at(z: f64) -> Vec<DVec3> {
 /// blade's footprint gets behind it: all stay on the side they started on, a thickness off.
 #[test]
 fn fast_blade_does_not_tunnel_through_a_hanging_cloth() {
-    let cloth = GridDesc {
-        resolution: (32, 32),
-        size: (0.8, 0.8),
-        center: DVec3::new(0.0, 0.6, 0.0),
-        orientation: Orientation::Vertical,
-        mass: Mass::Total(0.2),
-        pins: vec![Pin::Edge(Edge::Top)],
-    }
-    .build()
-    .expect("grid");
+    let cloth = common::hanging_curtain(32);
     let mut solver = solver_with(&cloth, Forces::default());
     let mut world = CollisionWorld::new(&solver);
     let (z0, z1, t0, t1) = (-0.2, 0.16, 0.05, 0.065);

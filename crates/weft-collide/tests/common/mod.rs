@@ -5,7 +5,26 @@
 pub mod split;
 
 use weft_collide::CollisionWorld;
-use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
+use weft_solver::glam::DVec3;
+use weft_solver::{
+    ClothMesh, Edge, GridDesc, Mass, Orientation, Particles, Pin, Solver, SubstepContext,
+    SubstepHook,
+};
+
+/// A 0.8 m, 0.2 kg curtain of `n` × `n` particles hanging in the x–y plane (z = 0) from its
+/// pinned top edge at y = 1.
+pub fn hanging_curtain(n: usize) -> ClothMesh {
+    GridDesc {
+        resolution: (n, n),
+        size: (0.8, 0.8),
+        center: DVec3::new(0.0, 0.6, 0.0),
+        orientation: Orientation::Vertical,
+        mass: Mass::Total(0.2),
+        pins: vec![Pin::Edge(Edge::Top)],
+    }
+    .build()
+    .expect("grid")
+}
 
 /// Runs the world, then calls `check` after every substep with the final positions.
 pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles) + Send> {
