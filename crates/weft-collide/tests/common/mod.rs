@@ -3,12 +3,14 @@
 #![allow(dead_code)]
 
 pub mod split;
+mod watch;
+
+pub use watch::Watch;
 
 use weft_collide::CollisionWorld;
 use weft_solver::glam::DVec3;
 use weft_solver::{
     ClothMesh, Edge, GridDesc, Mass, Orientation, Particles, Pin, Solver, SubstepContext,
-    SubstepHook,
 };
 
 /// A 0.8 m, 0.2 kg curtain of `n` × `n` particles hanging in the x–y plane (z = 0) from its
@@ -24,29 +26,6 @@ pub fn hanging_curtain(n: usize) -> ClothMesh {
     }
     .build()
     .expect("grid")
-}
-
-/// Runs the world, then calls `check` after every substep with the final positions.
-pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles) + Send> {
-    /// The wrapped world.
-    pub world: &'a mut CollisionWorld,
-    /// Called at the end of every substep.
-    pub check: F,
-}
-
-impl<F: FnMut(&SubstepContext, &Particles) + Send> SubstepHook for Watch<'_, F> {
-    fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
-        self.world.begin_substep(ctx, particles);
-    }
-
-    fn project(&mut self, ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        self.world.project(ctx, particles)
-    }
-
-    fn end_substep(&mut self, ctx: &SubstepContext, particles: &mut Particles) {
-        self.world.end_substep(ctx, particles);
-        (self.check)(ctx, particles);
-    }
 }
 
 /// Steps `frames` frames, checking every substep.

@@ -2,11 +2,14 @@
 //! and a hook that checks the particles after every substep.
 #![allow(dead_code)]
 
+#[path = "../../../weft-collide/tests/common/watch.rs"]
+mod watch;
+
 use std::path::{Path, PathBuf};
 
-use weft_collide::CollisionWorld;
+use watch::Watch;
 use weft_scene::{Override, Scene, SolverGroup};
-use weft_solver::{Method, Particles, SubstepContext, SubstepHook};
+use weft_solver::{Method, Particles, SubstepContext};
 
 /// `assets/scenes`, the scenes Weft ships.
 pub fn scenes_dir() -> PathBuf {
@@ -31,27 +34,6 @@ pub fn with_method(path: &Path, method: Method, extra: &[String]) -> Vec<SolverG
         ov.push(format!("cloth.{}.method={}", c.name, method.name()));
     }
     load(path, &ov).build().expect("scene builds")
-}
-
-/// Runs the world, then calls `check` after every substep with the final positions.
-struct Watch<'a, F: FnMut(&SubstepContext, &Particles) + Send> {
-    world: &'a mut CollisionWorld,
-    check: F,
-}
-
-impl<F: FnMut(&SubstepContext, &Particles) + Send> SubstepHook for Watch<'_, F> {
-    fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
-        self.world.begin_substep(ctx, particles);
-    }
-
-    fn project(&mut self, ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        self.world.project(ctx, particles)
-    }
-
-    fn end_substep(&mut self, ctx: &SubstepContext, particles: &mut Particles) {
-        self.world.end_substep(ctx, particles);
-        (self.check)(ctx, particles);
-    }
 }
 
 /// Steps `group` (which must have a collision world) `frames` frames, calling `check` after
