@@ -56,6 +56,25 @@ pub enum ExportFormat {
     Glb,
 }
 
+/// How a GLB's animation goes from one exported frame to the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Interpolation {
+    /// Blend linearly (positions and translations; rotations by slerp).
+    Linear,
+    /// Hold each frame until the next.
+    Step,
+}
+
+impl Interpolation {
+    /// The name glTF gives it.
+    pub fn gltf(self) -> &'static str {
+        match self {
+            Interpolation::Linear => "LINEAR",
+            Interpolation::Step => "STEP",
+        }
+    }
+}
+
 /// `weft export`.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
@@ -74,6 +93,9 @@ pub struct ExportArgs {
     #[arg(long, default_value_t = 1, value_name = "N",
           value_parser = clap::value_parser!(u64).range(1..))]
     pub every: u64,
+    /// GLB: how the animation goes between exported frames.
+    #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
+    pub interpolation: Interpolation,
     /// No progress messages.
     #[arg(long, short)]
     pub quiet: bool,

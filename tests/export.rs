@@ -176,6 +176,7 @@ struct GlbRead {
     ball: Vec<[f32; 3]>,
     target_names: Vec<String>,
     triangles: usize,
+    interpolations: Vec<gltf::animation::Interpolation>,
 }
 
 fn read_glb(path: &Path) -> GlbRead {
@@ -210,7 +211,9 @@ fn read_glb(path: &Path) -> GlbRead {
     let mut weights = Vec::new();
     let mut ball = Vec::new();
     let mut animated = Vec::new();
+    let mut interpolations = Vec::new();
     for ch in anims[0].channels() {
+        interpolations.push(ch.sampler().interpolation());
         let r = ch.reader(get);
         let input: Vec<f32> = r.read_inputs().expect("inputs").collect();
         let node = ch.target().node().index();
@@ -275,6 +278,7 @@ fn read_glb(path: &Path) -> GlbRead {
         ball,
         target_names,
         triangles,
+        interpolations,
     }
 }
 
@@ -294,6 +298,10 @@ fn glb_animates_the_logged_cloth_and_the_moving_colliders() {
     );
     assert_eq!(g.target_names[29], "frame_00030");
     assert_eq!(g.triangles, 98);
+    assert_eq!(
+        g.interpolations,
+        [gltf::animation::Interpolation::Linear; 3]
+    );
     for (k, t) in g.times.iter().enumerate() {
         assert!((*t as f64 - k as f64 / 60.0).abs() < 1e-6, "key {k} at {t}");
         let b = g.ball[k].map(f64::from);
@@ -317,10 +325,20 @@ fn frames_and_every_choose_the_keys() {
     let o = export(
         &log,
         &out,
-        &["--format", "glb", "--frames", "10..=20", "--every", "5"],
+        &[
+            "--format",
+            "glb",
+            "--frames",
+            "10..=20",
+            "--every",
+            "5",
+            "--interpolation",
+            "step",
+        ],
     );
     assert!(o.status.success(), "{:?}", texts(&o));
     let g = read_glb(&out.join("m.glb"));
+    assert_eq!(g.interpolations, [gltf::animation::Interpolation::Step; 3]);
     assert_eq!(g.target_names, ["frame_00015", "frame_00020"]);
     let want = [0.0, 5.0 / 60.0, 10.0 / 60.0];
     for (k, t) in g.times.iter().enumerate() {

@@ -4,7 +4,8 @@
 //! * each cloth is a mesh whose base positions are the first exported frame and which has one
 //!   morph target per later frame (its displacement from the first); an animation channel on the
 //!   node's `weights` holds, at frame k's time, weight 1 on target k and 0 elsewhere, with
-//!   LINEAR interpolation, so positions blend linearly between consecutive frames;
+//!   LINEAR interpolation (positions blend linearly between consecutive frames) or STEP
+//!   (each frame held until the next);
 //! * each collider is a node holding its shape's mesh in its own frame, with `translation` and
 //!   `rotation` channels (rotations kept on one hemisphere so slerp takes the short way) when it
 //!   moves;
@@ -102,10 +103,12 @@ fn material(name: String, color: [f32; 4]) -> Value {
 
 const COLLIDER_GREY: [f32; 4] = [0.6, 0.6, 0.62, 1.0];
 
-/// The glTF JSON and binary buffer of `tracks`; `poll` is called once per frame written and
-/// stops the build when it returns an error.
+/// The glTF JSON and binary buffer of `tracks`, every channel interpolated as
+/// `interpolation` ("LINEAR" or "STEP"); `poll` is called once per frame written and stops the
+/// build when it returns an error.
 pub fn build(
     tracks: &Tracks,
+    interpolation: &str,
     mut poll: impl FnMut() -> anyhow::Result<()>,
 ) -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
     let mut b = Buffers::default();
@@ -116,7 +119,7 @@ pub fn build(
     let input = b.floats(&times, "SCALAR", 1, None);
     let frames = times.len();
     let mut animate = |path: &str, node: usize, output: usize| {
-        samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+        samplers.push(json!({"input": input, "output": output, "interpolation": interpolation}));
         channels.push(json!({"sampler": samplers.len() - 1,
                              "target": {"node": node, "path": path}}));
     };

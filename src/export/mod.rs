@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, bail};
 
-use crate::cli::{ExportArgs, ExportFormat};
+use crate::cli::{ExportArgs, ExportFormat, Interpolation};
 use crate::output::{Named, Output, refuse_clashes};
 use crate::stop::EXIT_INTERRUPTED;
 use estimate::Needs;
@@ -200,7 +200,7 @@ fn run(args: &ExportArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
     drop(bytes);
     match args.format {
         ExportFormat::Obj => write_obj(&tracks, &files, first, path, stop)?,
-        ExportFormat::Glb => write_glb(&tracks, first, stop)?,
+        ExportFormat::Glb => write_glb(&tracks, args.interpolation, first, stop)?,
     }
     if !args.quiet {
         say!(
@@ -242,8 +242,13 @@ fn write_obj(
     Ok(())
 }
 
-fn write_glb(tracks: &Tracks, out: Output, stop: &AtomicBool) -> anyhow::Result<()> {
-    let (json, bin) = glb::build(tracks, || poll(stop))?;
+fn write_glb(
+    tracks: &Tracks,
+    interpolation: Interpolation,
+    out: Output,
+    stop: &AtomicBool,
+) -> anyhow::Result<()> {
+    let (json, bin) = glb::build(tracks, interpolation.gltf(), || poll(stop))?;
     // The document is checked as a glTF reader checks it before it is written.
     let root = gltf::json::deserialize::from_slice(&json)
         .context("internal error: the glTF written does not parse")?;
