@@ -96,7 +96,7 @@ pub struct ExportArgs {
     /// GLB: how the animation goes between exported frames.
     #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
     pub interpolation: Interpolation,
-    /// No progress messages.
+    /// No summary line.
     #[arg(long, short)]
     pub quiet: bool,
     /// Memory and file-size limits (the memory the export needs is estimated first).

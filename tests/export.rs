@@ -315,6 +315,13 @@ fn glb_animates_the_logged_cloth_and_the_moving_colliders() {
         .fold(0.0f32, f32::max);
     assert!(worst < 1e-6, "GLB differs from the log by {worst} m");
     assert!(g.cloth[0] != g.cloth[30], "the cloth moves");
+    // The same log gives the same bytes.
+    let again = dir.join("again");
+    let o = export(&log, &again, &["--format", "glb", "-q"]);
+    assert!(o.status.success(), "{:?}", texts(&o));
+    assert!(o.stdout.is_empty(), "--quiet says nothing");
+    let bytes = |d: &Path| std::fs::read(d.join("m.glb")).expect("the GLB");
+    assert!(bytes(&out) == bytes(&again), "two exports differ");
 }
 
 #[test]
