@@ -18,7 +18,11 @@ Usage: read_collider_state.py LOG.mcap
 import json
 import math
 import sys
-import tomllib
+
+try:
+    import tomllib
+except ImportError:  # Python < 3.11
+    import tomli as tomllib
 
 import jsonschema
 from mcap.reader import make_reader
