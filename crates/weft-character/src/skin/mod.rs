@@ -9,12 +9,14 @@
 //! files (and external buffers) is [`crate::files`]'s job.
 
 mod animation;
+mod collider;
 mod load;
 
 use glam::{DMat4, DQuat, DVec3};
 use thiserror::Error;
 
 pub use animation::{Channel, ChannelValues, Interpolation};
+pub use collider::SkinCollider;
 pub use load::{BufferSource, decode_data_uri, parse_gltf_slice};
 
 /// A glTF that cannot be turned into a skinned mesh.
@@ -129,16 +131,21 @@ impl SkinnedMesh {
 
     /// Vertex positions at time `t` (s) by linear blend skinning.
     pub fn skin(&self, t: f64) -> Vec<DVec3> {
+        let mut out = vec![DVec3::ZERO; self.positions.len()];
+        self.skin_into(t, &mut out);
+        out
+    }
+
+    /// [`Self::skin`] written into `out` (one per vertex; extra entries are left alone),
+    /// without allocating the positions.
+    pub fn skin_into(&self, t: f64, out: &mut [DVec3]) {
         let m = self.joint_matrices(t);
-        self.positions
-            .iter()
-            .zip(&self.influences)
-            .map(|(&v, inf)| {
-                inf.iter()
-                    .filter(|(_, w)| *w != 0.0)
-                    .map(|&(j, w)| m[j as usize].transform_point3(v) * w)
-                    .sum()
-            })
-            .collect()
+        for ((o, &v), inf) in out.iter_mut().zip(&self.positions).zip(&self.influences) {
+            *o = inf
+                .iter()
+                .filter(|(_, w)| *w != 0.0)
+                .map(|&(j, w)| m[j as usize].transform_point3(v) * w)
+                .sum();
+        }
     }
 }

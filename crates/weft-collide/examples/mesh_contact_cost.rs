@@ -1,0 +1,131 @@
+//! What triangle-mesh contact costs per frame, in CPU time as well as wall-clock time (on a
+//! shared machine the wall clock mostly measures the other processes), side by side in one
+//! run: the scenes of the `mesh_contact` bench (XPBD, 10 substeps × 1 iteration), each
+//! stepped after 30 frames from the same state, median over `REPS` frames.
+//!
+//! - static: a 128² cloth on `icosphere_drop`'s 20,480-triangle sphere mesh and the ground,
+//!   against the bare solve of the same state (fused, no hook), the ground alone, and the
+//!   cloth on `sphere_drop`'s analytic sphere of the same size and the ground;
+//! - deforming: a 90² cloth on `breathing_drop`'s 5,120-triangle deforming ball, against its
+//!   bare solve.
+//!
+//! CPU time is the sum over the process's threads of the time on a CPU
+//! (`/proc/self/task/*/schedstat`, Linux; "n/a" elsewhere).
+//!
+//! `cargo run --release -p weft-collide --example mesh_contact_cost -- [REPS]`; set
+//! `RAYON_NUM_THREADS` to choose the thread count.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::time::Instant;
+
+use weft_collide::CollisionWorld;
+use weft_collide::scenarios::{breathing_drop, ground, icosphere_drop, sphere_drop};
+use weft_solver::{Method, Solver};
+
+/// Nanoseconds on a CPU, summed over the process's threads, if the system tells.
+fn cpu_ns() -> Option<u64> {
+    let mut sum = 0;
+    for entry in std::fs::read_dir("/proc/self/task").ok()? {
+        let text = std::fs::read_to_string(entry.ok()?.path().join("schedstat")).ok()?;
+        sum += text.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(sum)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Median CPU and wall-clock milliseconds of `f` on fresh copies made by `setup` (untimed).
+fn time<T>(reps: usize, setup: impl Fn() -> T, f: impl Fn(&mut T)) -> (Option<f64>, f64) {
+    let (mut cpu, mut wall) = (Vec::new(), Vec::new());
+    for _ in 0..reps {
+        let mut x = setup();
+        let (c0, w0) = (cpu_ns(), Instant::now());
+        f(&mut x);
+        wall.push(w0.elapsed().as_secs_f64() * 1e3);
+        if let (Some(a), Some(b)) = (c0, cpu_ns()) {
+            cpu.push((b - a) as f64 * 1e-6);
+        }
+    }
+    let cpu = (cpu.len() == reps).then(|| median(cpu));
+    (cpu, median(wall))
+}
+
+fn in_contact(mut scene: (Solver, CollisionWorld)) -> (Solver, CollisionWorld) {
+    for _ in 0..30 {
+        scene.0.step_with(&mut scene.1).expect("stable");
+    }
+    scene
+}
+
+fn bare(reps: usize, s: &Solver) -> (Option<f64>, f64) {
+    time(
+        reps,
+        || s.clone(),
+        |s| {
+            std::hint::black_box(s.step().expect("stable"));
+        },
+    )
+}
+
+fn with(reps: usize, s: &Solver, w: &CollisionWorld) -> (Option<f64>, f64) {
+    time(
+        reps,
+        || (s.clone(), w.clone()),
+        |(s, w)| {
+            std::hint::black_box(s.step_with(w).expect("stable"));
+        },
+    )
+}
+
+fn show(name: &str, (cpu, wall): (Option<f64>, f64)) {
+    match cpu {
+        Some(c) => println!("  {name:<34} CPU {c:7.2} ms   wall {wall:7.2} ms"),
+        None => println!("  {name:<34} CPU     n/a      wall {wall:7.2} ms"),
+    }
+}
+
+fn ratio(a: (Option<f64>, f64), b: (Option<f64>, f64)) -> String {
+    match (a.0, b.0) {
+        (Some(x), Some(y)) => format!("{:.2} (CPU), {:.2} (wall)", x / y, a.1 / b.1),
+        _ => format!("{:.2} (wall)", a.1 / b.1),
+    }
+}
+
+fn main() {
+    let reps: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(15);
+    let (solver, mesh_world) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
+    let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
+    let mut ground_world = CollisionWorld::new(&solver);
+    ground_world
+        .add_collider(&ground(-weft_collide::scenarios::SPHERE_RADIUS as f32))
+        .expect("ground");
+    println!("static, 128² cloth, per frame (median of {reps}):");
+    let solve = bare(reps, &solver);
+    let ground_only = with(reps, &solver, &ground_world);
+    let mesh = with(reps, &solver, &mesh_world);
+    let sphere_solve = bare(reps, &sphere_solver);
+    let sphere = with(reps, &sphere_solver, &sphere_world);
+    show("bare solve (mesh scene's state)", solve);
+    show("ground only", ground_only);
+    show("20,480-triangle mesh + ground", mesh);
+    show("bare solve (sphere scene's state)", sphere_solve);
+    show("analytic sphere + ground", sphere);
+    println!("  frame with mesh / bare solve: {}", ratio(mesh, solve));
+    println!("  mesh frame / sphere frame:    {}", ratio(mesh, sphere));
+    let (solver, world) = in_contact(breathing_drop(Method::Xpbd, 90).expect("scene"));
+    println!("deforming, 90² cloth on a 5,120-triangle ball, per frame (median of {reps}):");
+    let solve = bare(reps, &solver);
+    let deforming = with(reps, &solver, &world);
+    show("bare solve", solve);
+    show("deforming mesh + ground", deforming);
+    println!(
+        "  frame with mesh / bare solve: {}",
+        ratio(deforming, solve)
+    );
+}
