@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
-use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
+use weft_solver::{Contacts, ParticleContacts, Particles, Solver, SubstepContext, SubstepHook};
 
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
@@ -230,7 +230,7 @@ impl CollisionWorld {
         self.stats.swept = over_free_particles(
             p,
             0,
-            |i, x, prev| sweep_one(colliders, bounds, &own, parry, prev, x, thickness[i]),
+            |i, x, prev| sweep_one(colliders, bounds, |k| own[k], parry, prev, x, thickness[i]),
             |a, b| a + b,
         );
     }
@@ -356,7 +356,7 @@ fn over_free_particles<T: Copy + Send + Sync>(
 fn sweep_one(
     colliders: &[Collider],
     bounds: &[Option<Bounds>],
-    own: &[bool],
+    own: impl Fn(usize) -> bool,
     parry: bool,
     from: DVec3,
     x: &mut DVec3,
@@ -368,8 +368,8 @@ fn sweep_one(
     }
     let step = (*x - from).length();
     let mut swept = 0;
-    for ((c, b), &own) in colliders.iter().zip(bounds).zip(own) {
-        if own {
+    for (k, (c, b)) in colliders.iter().zip(bounds).enumerate() {
+        if own(k) {
             continue; // swept in its own contacts
         }
         // Cheap reject: a path whose box misses the collider's (grown) box cannot cross it.
@@ -459,6 +459,27 @@ impl SubstepHook for CollisionWorld {
         self.stats = ContactStats::default();
     }
 
+    /// Closed-form colliders only (no mesh, no self-collision): each particle's sweep and
+    /// push-out read that particle alone, so the solver may run them inside its domains.
+    fn particle_contacts(&self) -> Option<&dyn ParticleContacts> {
+        let per_particle = self.self_collision.is_none()
+            && !self.colliders.is_empty()
+            && self.colliders.iter().all(|c| c.mesh().is_none());
+        per_particle.then_some(self as &dyn ParticleContacts)
+    }
+
+    /// The statistics [`SubstepHook::project`] keeps, from a fused pass's totals.
+    fn fused_pass(&mut self, fresh: bool, totals: Contacts) -> usize {
+        if fresh {
+            self.fresh = false;
+            self.stats.swept = totals.swept;
+        }
+        self.stats.collider_contacts = totals.contacts;
+        self.stats.self_contacts = 0;
+        self.stats.max_depth = self.stats.max_depth.max(totals.depth);
+        totals.contacts
+    }
+
     fn project(&mut self, _ctx: &SubstepContext, particles: &mut Particles) -> usize {
         // Once per substep, before the first projection: the colliders' sweep, then the
         // self-collision's clamp (a move back along a swept path stays clear of colliders).
@@ -486,5 +507,26 @@ impl SubstepHook for CollisionWorld {
         self.stats.self_contacts = self_contacts;
         self.stats.max_self_depth = self.stats.max_self_depth.max(self_depth);
         collider_contacts + self_contacts
+    }
+}
+
+/// One particle's part of [`SubstepHook::project`] with closed-form colliders only: on the
+/// substep's first pass the sweep, then the push-out from each collider in order — the same
+/// calls as `sweep` and `resolve_colliders` make for that particle.
+impl ParticleContacts for CollisionWorld {
+    fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
+        let (parry, r) = (self.parry_meshes, self.thickness[i]);
+        let mut out = Contacts::default();
+        if fresh {
+            out.swept = sweep_one(&self.colliders, &self.bounds, |_| false, parry, prev, x, r);
+        }
+        for (c, b) in self.colliders.iter().zip(&self.bounds) {
+            if within(b, *x) {
+                let (n, depth) = resolve_one(c, parry, prev, x, r);
+                out.contacts += n;
+                out.depth = out.depth.max(depth);
+            }
+        }
+        out
     }
 }

@@ -1,5 +1,7 @@
 //! The seam through which collisions (or anything else) act inside each substep.
 
+use glam::DVec3;
+
 use crate::method::Method;
 use crate::particles::Particles;
 
@@ -39,6 +41,54 @@ pub trait SubstepHook: Send {
     /// Whether the hook does anything; an inactive hook lets the solver fuse a substep's phases.
     fn is_active(&self) -> bool {
         true
+    }
+
+    /// The hook's [`SubstepHook::project`] as per-particle contacts, when that is all it does
+    /// (analytic colliders: each particle moved on its own, by its own position and previous
+    /// position), so the solver may keep a frame fused: per substep it calls
+    /// [`SubstepHook::begin_substep`] (with the particle store as it was at the frame's start:
+    /// the hook must not read it), then after every projection pass
+    /// [`ParticleContacts::resolve`] on each free particle inside the domains, then
+    /// [`SubstepHook::fused_pass`] with the pass's totals; it never calls `project` or
+    /// `end_substep` (which must do nothing). Same arithmetic, same order per particle, so the
+    /// same bits as the general loop. `None` (the default): the general loop.
+    fn particle_contacts(&self) -> Option<&dyn ParticleContacts> {
+        None
+    }
+
+    /// After a fused pass of [`SubstepHook::particle_contacts`] (`fresh`: the substep's
+    /// first): the pass's totals; returns the contact count, as [`SubstepHook::project`] does.
+    fn fused_pass(&mut self, _fresh: bool, totals: Contacts) -> usize {
+        totals.contacts
+    }
+}
+
+/// Contacts that each particle resolves on its own (see [`SubstepHook::particle_contacts`]).
+pub trait ParticleContacts: Sync {
+    /// Moves free particle `i` (global index) at `x` out of obstacles; `prev` is its position
+    /// at the substep's start, `fresh` marks the substep's first pass.
+    fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts;
+}
+
+/// What per-particle contacts did: summed (counts) and maximised (depth) over particles.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Contacts {
+    /// Contacts resolved.
+    pub contacts: usize,
+    /// Particles stopped by continuous (swept) collision.
+    pub swept: usize,
+    /// Deepest overlap (m).
+    pub depth: f64,
+}
+
+impl Contacts {
+    /// Both totals together (sums and maximum: independent of the order, so of the threads).
+    pub fn merge(self, other: Self) -> Self {
+        Self {
+            contacts: self.contacts + other.contacts,
+            swept: self.swept + other.swept,
+            depth: self.depth.max(other.depth),
+        }
     }
 }
 

@@ -343,11 +343,12 @@ impl Solver {
 
     /// Advances one frame of Δt: `substeps` substeps of the shared loop, calling `hook` inside.
     ///
-    /// When nothing needs the particle store between the phases of a substep (no active hook, no
+    /// When nothing needs the particle store between the phases of a substep (no active hook, or
+    /// one whose contacts are per particle ([`SubstepHook::particle_contacts`]), no
     /// aerodynamics, only distance constraints, a position-based method), the frame runs fused:
     /// each domain integrates, pins and projects its own particles in one parallel region per
-    /// substep and iteration. That path does the same arithmetic in the same order as the
-    /// general loop, so both give the same bits.
+    /// substep and iteration, and resolves its particles' contacts in one more. That path does
+    /// the same arithmetic in the same order as the general loop, so both give the same bits.
     ///
     /// The frame runs on one of rayon's threads (`rayon::scope`, inline when called from one):
     /// its parallel loops then start from inside the pool, and the calling thread is handed
@@ -356,8 +357,10 @@ impl Solver {
         let s = self.settings;
         let rule = s.method.strategy().rule(s.h());
         let (stats, whole) = rayon::scope(|_| match rule {
-            Some(rule) if !hook.is_active() && self.fusable() => {
-                (StepStats::default(), self.frame_fused(rule))
+            Some(rule)
+                if self.fusable() && (!hook.is_active() || hook.particle_contacts().is_some()) =>
+            {
+                self.frame_fused(rule, hook)
             }
             _ => self.frame_general(hook),
         });
@@ -398,13 +401,15 @@ impl Solver {
         time
     }
 
-    /// One frame with every substep phase inside the domains' parallel regions; false when the
-    /// stop flag cut it short.
-    fn frame_fused(&mut self, rule: Rule) -> bool {
+    /// One frame with every substep phase inside the domains' parallel regions, with the hook's
+    /// per-particle contacts when it is active; false when the stop flag cut it short.
+    fn frame_fused(&mut self, rule: Rule, hook: &mut dyn SubstepHook) -> (StepStats, bool) {
         let s = self.settings;
         let h = s.h();
         let inv_h = 1.0 / h;
         let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
+        let active = hook.is_active();
+        let mut stats = StepStats::default();
         self.domains.prepare(&self.params, rule);
         let lambda = self.domains.mode().lambda;
         let mut whole = true;
@@ -412,12 +417,21 @@ impl Solver {
             if self.stopping() {
                 if k == 0 {
                     // Nothing loaded into the domains yet: the store is as it was.
-                    return false;
+                    return (stats, false);
                 }
                 whole = false;
                 break;
             }
-            self.substep_targets(k);
+            let time = self.substep_targets(k);
+            if active {
+                let ctx = SubstepContext {
+                    method: s.method,
+                    time,
+                    h,
+                    substep: k,
+                };
+                hook.begin_substep(&ctx, &self.particles);
+            }
             let step = Integration {
                 h,
                 forces: &self.forces,
@@ -435,8 +449,14 @@ impl Solver {
                     };
                     d.integrate(&step, finish, lambda);
                 });
-            for _ in 1..s.iterations {
-                self.domains.project();
+            for it in 0..s.iterations {
+                if it > 0 {
+                    self.domains.project();
+                }
+                if active && let Some(contacts) = hook.particle_contacts() {
+                    let totals = self.domains.collide(contacts, it == 0);
+                    stats.contacts = hook.fused_pass(it == 0, totals);
+                }
             }
         }
         let p = &mut self.particles;
@@ -447,7 +467,7 @@ impl Solver {
             &mut p.prev_positions,
             &mut p.velocities,
         );
-        whole
+        (stats, whole)
     }
 
     /// One frame of the general loop: every phase on the particle store, the hook in between;

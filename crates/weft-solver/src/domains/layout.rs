@@ -48,68 +48,72 @@ pub(super) struct Chunk {
     pub rest: f64,
 }
 
-/// Loads one end of a chunk: `idx` gives each lane's particle when gathered.
+/// Loads one end of lanes `off..off + W` of a chunk: `idx` gives each lane's particle.
 #[inline(always)]
-fn gather(src: &[f64], idx: &[u32]) -> [f64; LANES] {
-    std::array::from_fn(|l| src[idx[l] as usize])
+fn gather<const W: usize>(src: &[f64], idx: &[u32], off: usize) -> [f64; W] {
+    std::array::from_fn(|l| src[idx[off + l] as usize])
 }
 
 #[inline(always)]
-fn scatter(dst: &mut [f64], idx: &[u32], val: &[f64; LANES]) {
-    for l in 0..LANES {
-        dst[idx[l] as usize] = val[l];
+fn scatter<const W: usize>(dst: &mut [f64], idx: &[u32], off: usize, val: &[f64; W]) {
+    for l in 0..W {
+        dst[idx[off + l] as usize] = val[l];
     }
 }
 
-/// Both ends of a chunk from one array (positions, previous positions or inverse masses).
+/// Both ends of lanes `off..off + W` of a chunk from one array (positions, previous positions
+/// or inverse masses). `W` divides [`LANES`] and `off` is a multiple of `W`: a kernel path
+/// projects a chunk in parts as wide as its vector registers, read straight from the layout.
 #[inline(always)]
-pub(super) fn load_ends<const LAYOUT: u8>(
+pub(super) fn load_ends<const LAYOUT: u8, const W: usize>(
     src: &[f64],
     p: &[u32],
     q: &[u32],
-) -> ([f64; LANES], [f64; LANES]) {
+    off: usize,
+) -> ([f64; W], [f64; W]) {
     match layout_of(LAYOUT) {
         Layout::Contiguous => {
-            let (p0, q0) = (p[0] as usize, q[0] as usize);
-            let mut a = [0.0; LANES];
-            let mut b = [0.0; LANES];
-            a.copy_from_slice(&src[p0..p0 + LANES]);
-            b.copy_from_slice(&src[q0..q0 + LANES]);
+            let (p0, q0) = (p[0] as usize + off, q[0] as usize + off);
+            let mut a = [0.0; W];
+            let mut b = [0.0; W];
+            a.copy_from_slice(&src[p0..p0 + W]);
+            b.copy_from_slice(&src[q0..q0 + W]);
             (a, b)
         }
         Layout::Paired => {
-            let p0 = p[0] as usize;
-            let s = &src[p0..p0 + 2 * LANES];
+            let p0 = p[0] as usize + 2 * off;
+            let s = &src[p0..p0 + 2 * W];
             (
                 std::array::from_fn(|l| s[2 * l]),
                 std::array::from_fn(|l| s[2 * l + 1]),
             )
         }
         Layout::Quad => {
-            let p0 = p[0] as usize;
-            let s = &src[p0..p0 + 2 * LANES];
+            // QUAD[off + l] = 2 off + QUAD[l] for the offsets used (multiples of 2).
+            let p0 = p[0] as usize + 2 * off;
+            let s = &src[p0..p0 + 2 * W];
             (
                 std::array::from_fn(|l| s[QUAD[l]]),
                 std::array::from_fn(|l| s[QUAD[l] + 2]),
             )
         }
         Layout::Spaced => {
-            let p0 = p[0] as usize;
-            let s = &src[p0..p0 + SPACED];
+            let p0 = p[0] as usize + 4 * off;
+            let s = &src[p0..p0 + 4 * W - 1];
             (
                 std::array::from_fn(|l| s[4 * l]),
                 std::array::from_fn(|l| s[4 * l + 2]),
             )
         }
         Layout::Strided => {
-            let (p0, q0) = (p[0] as usize, q[0] as usize);
-            let (sp, sq) = (&src[p0..p0 + STRIDED], &src[q0..q0 + STRIDED]);
+            let (p0, q0) = (p[0] as usize + 2 * off, q[0] as usize + 2 * off);
+            let (sp, sq) = (&src[p0..p0 + 2 * W - 1], &src[q0..q0 + 2 * W - 1]);
             (
                 std::array::from_fn(|l| sp[2 * l]),
                 std::array::from_fn(|l| sq[2 * l]),
             )
         }
-        Layout::Gathered => (gather(src, p), gather(src, q)),
+        Layout::Gathered => (gather(src, p, off), gather(src, q, off)),
     }
 }
 
@@ -122,64 +126,68 @@ pub(super) const SPACED: usize = 4 * LANES - 1;
 /// Window of a [`Layout::Strided`] end: lanes at even offsets 0..=14.
 pub(super) const STRIDED: usize = 2 * LANES - 1;
 
+/// Stores both ends of lanes `off..off + W` of a chunk (see [`load_ends`]).
 #[inline(always)]
-pub(super) fn store_ends<const LAYOUT: u8>(
+pub(super) fn store_ends<const LAYOUT: u8, const W: usize>(
     dst: &mut [f64],
     p: &[u32],
     q: &[u32],
-    a: &[f64; LANES],
-    b: &[f64; LANES],
+    off: usize,
+    a: &[f64; W],
+    b: &[f64; W],
 ) {
     match layout_of(LAYOUT) {
         Layout::Contiguous => {
-            let (p0, q0) = (p[0] as usize, q[0] as usize);
-            dst[p0..p0 + LANES].copy_from_slice(a);
-            dst[q0..q0 + LANES].copy_from_slice(b);
+            let (p0, q0) = (p[0] as usize + off, q[0] as usize + off);
+            dst[p0..p0 + W].copy_from_slice(a);
+            dst[q0..q0 + W].copy_from_slice(b);
         }
         Layout::Paired => {
-            let p0 = p[0] as usize;
-            let s = &mut dst[p0..p0 + 2 * LANES];
-            for l in 0..LANES {
+            let p0 = p[0] as usize + 2 * off;
+            let s = &mut dst[p0..p0 + 2 * W];
+            for l in 0..W {
                 s[2 * l] = a[l];
                 s[2 * l + 1] = b[l];
             }
         }
         Layout::Quad => {
-            let p0 = p[0] as usize;
-            let s = &mut dst[p0..p0 + 2 * LANES];
-            for l in 0..LANES {
+            let p0 = p[0] as usize + 2 * off;
+            let s = &mut dst[p0..p0 + 2 * W];
+            for l in 0..W {
                 s[QUAD[l]] = a[l];
                 s[QUAD[l] + 2] = b[l];
             }
         }
         Layout::Spaced => {
-            // Read, replace the chunk's slots, write back: the other slots (odd offsets) are
+            // Read, replace the part's slots, write back: the other slots (odd offsets) are
             // particles no lane of this chunk touches, so they keep their values.
-            let p0 = p[0] as usize;
+            let p0 = p[0] as usize + 4 * off;
             let mut win = [0.0; SPACED];
-            win.copy_from_slice(&dst[p0..p0 + SPACED]);
-            for l in 0..LANES {
+            let win = &mut win[..4 * W - 1];
+            win.copy_from_slice(&dst[p0..p0 + 4 * W - 1]);
+            for l in 0..W {
                 win[4 * l] = a[l];
                 win[4 * l + 2] = b[l];
             }
-            dst[p0..p0 + SPACED].copy_from_slice(&win);
+            dst[p0..p0 + 4 * W - 1].copy_from_slice(win);
         }
         Layout::Strided => {
-            let (p0, q0) = (p[0] as usize, q[0] as usize);
+            let (p0, q0) = (p[0] as usize + 2 * off, q[0] as usize + 2 * off);
             for (start, v) in [(p0, a), (q0, b)] {
                 // Read, replace the even slots, write the window back: the odd slots are
                 // particles no other lane of this chunk touches, so they keep their values.
                 let mut win = [0.0; STRIDED];
-                win.copy_from_slice(&dst[start..start + STRIDED]);
-                for l in 0..LANES {
+                let win = &mut win[..2 * W - 1];
+                win.copy_from_slice(&dst[start..start + 2 * W - 1]);
+                for l in 0..W {
                     win[2 * l] = v[l];
                 }
-                dst[start..start + STRIDED].copy_from_slice(&win);
+                dst[start..start + 2 * W - 1].copy_from_slice(win);
             }
         }
         Layout::Gathered => {
-            scatter(dst, p, a);
-            scatter(dst, q, b);
+            scatter(dst, p, off, a);
+            scatter(dst, q, off, b);
         }
     }
 }

@@ -36,6 +36,7 @@ use rayon::prelude::*;
 
 use crate::constraints::lanes::{Coef, LANES};
 use crate::constraints::{Block, Distance, Rule};
+use crate::hook::{Contacts, ParticleContacts};
 use crate::params::FamilyParams;
 
 pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode};
@@ -279,6 +280,15 @@ impl Domains {
             .par_iter_mut()
             .zip(x.par_chunks_mut(size))
             .for_each(|(d, x)| d.store_positions(x));
+    }
+
+    /// Resolves every free particle's contacts with `contacts` (see
+    /// [`crate::ParticleContacts`]), domain by domain in parallel; returns the totals.
+    pub fn collide(&mut self, contacts: &dyn ParticleContacts, fresh: bool) -> Contacts {
+        self.list
+            .par_iter_mut()
+            .map(|d| d.collide(contacts, fresh))
+            .reduce(Contacts::default, Contacts::merge)
     }
 
     /// Ends a fused frame: velocity update and damping, then copies the state back out.

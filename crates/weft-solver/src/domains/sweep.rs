@@ -26,40 +26,43 @@ pub(super) fn sweep(dom: &mut Domain, coef: &[Coef], mode: Mode) {
 /// [`sweep`] compiled for AVX-512 (the baseline build where the CPU lacks it).
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
 fn sweep_avx512(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes(dom, coef, mode);
+    sweep_modes::<LANES>(dom, coef, mode);
 }
 
 /// [`sweep`] compiled for AVX2 and FMA.
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn sweep_avx2(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes(dom, coef, mode);
+    sweep_modes::<4>(dom, coef, mode);
 }
 
 /// [`sweep`] compiled for NEON.
 #[multiversion(targets("aarch64+neon"))]
 fn sweep_neon(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes(dom, coef, mode);
+    sweep_modes::<2>(dom, coef, mode);
 }
 
 /// [`sweep`] compiled for the baseline target.
 #[inline(never)]
 fn sweep_scalar(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes(dom, coef, mode);
+    sweep_modes::<2>(dom, coef, mode);
 }
 
 /// The sweep with its optional terms chosen at compile time.
 #[inline(always)]
-fn sweep_modes(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+fn sweep_modes<const W: usize>(dom: &mut Domain, coef: &[Coef], mode: Mode) {
     match (mode.damped, mode.lambda) {
-        (false, false) => sweep_with::<false, false>(dom, coef),
-        (false, true) => sweep_with::<false, true>(dom, coef),
-        (true, false) => sweep_with::<true, false>(dom, coef),
-        (true, true) => sweep_with::<true, true>(dom, coef),
+        (false, false) => sweep_with::<false, false, W>(dom, coef),
+        (false, true) => sweep_with::<false, true, W>(dom, coef),
+        (true, false) => sweep_with::<true, false, W>(dom, coef),
+        (true, true) => sweep_with::<true, true, W>(dom, coef),
     }
 }
 
 #[inline(always)]
-fn sweep_with<const DAMPED: bool, const LAMBDA: bool>(dom: &mut Domain, coef: &[Coef]) {
+fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
+    dom: &mut Domain,
+    coef: &[Coef],
+) {
     let Domain {
         x,
         prev,
@@ -72,7 +75,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool>(dom: &mut Domain, coef: &[
     } = dom;
     for (c, (chunk_range, tail)) in plan.iter().enumerate() {
         for chunk in &chunks[chunk_range.clone()] {
-            project_chunk::<DAMPED, LAMBDA>(chunk, pairs, x, prev, w, coef);
+            project_chunk::<DAMPED, LAMBDA, W>(chunk, pairs, x, prev, w, coef);
         }
         for k in *tail..colours[c].end {
             let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
@@ -96,7 +99,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool>(dom: &mut Domain, coef: &[
 }
 
 #[inline(always)]
-fn project_chunk<const DAMPED: bool, const LAMBDA: bool>(
+fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
     chunk: &Chunk,
     pairs: &mut Pairs,
     x: &mut [Vec<f64>; 3],
@@ -108,17 +111,24 @@ fn project_chunk<const DAMPED: bool, const LAMBDA: bool>(
     // switch inside the per-axis loops made the compiler spill them and reload with
     // masked loads, which cannot forward from the stores).
     match chunk.layout {
-        Layout::Contiguous => project_laid_out::<DAMPED, LAMBDA, 0>(chunk, pairs, x, prev, w, coef),
-        Layout::Paired => project_laid_out::<DAMPED, LAMBDA, 1>(chunk, pairs, x, prev, w, coef),
-        Layout::Quad => project_laid_out::<DAMPED, LAMBDA, 2>(chunk, pairs, x, prev, w, coef),
-        Layout::Strided => project_laid_out::<DAMPED, LAMBDA, 3>(chunk, pairs, x, prev, w, coef),
-        Layout::Spaced => project_laid_out::<DAMPED, LAMBDA, 4>(chunk, pairs, x, prev, w, coef),
-        Layout::Gathered => project_laid_out::<DAMPED, LAMBDA, 5>(chunk, pairs, x, prev, w, coef),
+        Layout::Contiguous => {
+            project_laid_out::<DAMPED, LAMBDA, 0, W>(chunk, pairs, x, prev, w, coef)
+        }
+        Layout::Paired => project_laid_out::<DAMPED, LAMBDA, 1, W>(chunk, pairs, x, prev, w, coef),
+        Layout::Quad => project_laid_out::<DAMPED, LAMBDA, 2, W>(chunk, pairs, x, prev, w, coef),
+        Layout::Strided => project_laid_out::<DAMPED, LAMBDA, 3, W>(chunk, pairs, x, prev, w, coef),
+        Layout::Spaced => project_laid_out::<DAMPED, LAMBDA, 4, W>(chunk, pairs, x, prev, w, coef),
+        Layout::Gathered => {
+            project_laid_out::<DAMPED, LAMBDA, 5, W>(chunk, pairs, x, prev, w, coef)
+        }
     }
 }
 
+/// Projects a chunk in parts of `W` lanes (the path's vector width in f64), each loaded
+/// straight from the layout, projected and stored before the next: the lanes of a chunk share
+/// no particle, so the parts' order changes no bit.
 #[inline(always)]
-fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8>(
+fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8, const W: usize>(
     chunk: &Chunk,
     pairs: &mut Pairs,
     x: &mut [Vec<f64>; 3],
@@ -126,53 +136,56 @@ fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8>(
     w: &[f64],
     coef: &[Coef],
 ) {
-    let r = chunk.start..chunk.start + LANES;
     // A structured layout needs the first lane's particles only, kept in the chunk.
     let (p0, q0) = ([chunk.p0], [chunk.q0]);
+    let r = chunk.start..chunk.start + LANES;
     let (p, q): (&[u32], &[u32]) = if matches!(layout_of(LAYOUT), Layout::Gathered) {
-        (&pairs.p[r.clone()], &pairs.q[r.clone()])
+        (&pairs.p[r.clone()], &pairs.q[r])
     } else {
         (&p0, &q0)
     };
-    let mut e = Ends {
-        p: [[0.0; LANES]; 3],
-        q: [[0.0; LANES]; 3],
-    };
     let [x0, x1, x2] = x;
-    (e.p[0], e.q[0]) = load_ends::<LAYOUT>(x0, p, q);
-    (e.p[1], e.q[1]) = load_ends::<LAYOUT>(x1, p, q);
-    (e.p[2], e.q[2]) = load_ends::<LAYOUT>(x2, p, q);
-    let pr = if DAMPED {
-        let mut pr = e;
-        for a in 0..3 {
-            (pr.p[a], pr.q[a]) = load_ends::<LAYOUT>(&prev[a], p, q);
+    for off in (0..LANES).step_by(W) {
+        let r = chunk.start + off..chunk.start + off + W;
+        let mut e = Ends {
+            p: [[0.0; W]; 3],
+            q: [[0.0; W]; 3],
+        };
+        (e.p[0], e.q[0]) = load_ends::<LAYOUT, W>(x0, p, q, off);
+        (e.p[1], e.q[1]) = load_ends::<LAYOUT, W>(x1, p, q, off);
+        (e.p[2], e.q[2]) = load_ends::<LAYOUT, W>(x2, p, q, off);
+        let pr = if DAMPED {
+            let mut pr = e;
+            for a in 0..3 {
+                (pr.p[a], pr.q[a]) = load_ends::<LAYOUT, W>(&prev[a], p, q, off);
+            }
+            pr
+        } else {
+            e
+        };
+        let (wp, wq) = load_ends::<LAYOUT, W>(w, p, q, off);
+        let mut rest = [chunk.rest; W];
+        if !chunk.same_rest {
+            rest.copy_from_slice(&pairs.rest[r.clone()]);
         }
-        pr
-    } else {
-        e
-    };
-    let (wp, wq) = load_ends::<LAYOUT>(w, p, q);
-    let mut rest = [chunk.rest; LANES];
-    if !chunk.same_rest {
-        rest.copy_from_slice(&pairs.rest[r.clone()]);
+        let k = if chunk.uniform {
+            Coefs::splat(coef[chunk.group as usize])
+        } else {
+            let groups = &pairs.group[r.clone()];
+            Coefs::from_fn(|l| coef[groups[l] as usize])
+        };
+        let mut lambda = [0.0; W];
+        if LAMBDA {
+            lambda.copy_from_slice(&pairs.lambda[r.clone()]);
+        }
+        lanes::project::<W, DAMPED>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
+        if LAMBDA {
+            pairs.lambda[r].copy_from_slice(&lambda);
+        }
+        store_ends::<LAYOUT, W>(x0, p, q, off, &e.p[0], &e.q[0]);
+        store_ends::<LAYOUT, W>(x1, p, q, off, &e.p[1], &e.q[1]);
+        store_ends::<LAYOUT, W>(x2, p, q, off, &e.p[2], &e.q[2]);
     }
-    let k = if chunk.uniform {
-        Coefs::splat(coef[chunk.group as usize])
-    } else {
-        let groups = &pairs.group[r.clone()];
-        Coefs::from_fn(|l| coef[groups[l] as usize])
-    };
-    let mut lambda = [0.0; LANES];
-    if LAMBDA {
-        lambda.copy_from_slice(&pairs.lambda[r.clone()]);
-    }
-    lanes::project::<LANES, DAMPED>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
-    if LAMBDA {
-        pairs.lambda[r].copy_from_slice(&lambda);
-    }
-    store_ends::<LAYOUT>(x0, p, q, &e.p[0], &e.q[0]);
-    store_ends::<LAYOUT>(x1, p, q, &e.p[1], &e.q[1]);
-    store_ends::<LAYOUT>(x2, p, q, &e.p[2], &e.q[2]);
 }
 
 /// One end of a single constraint: position, previous position and inverse mass.

@@ -1,0 +1,138 @@
+//! Closed-form colliders inside the solver's fused frame (`SubstepHook::particle_contacts`)
+//! give the same bits, contact counts and statistics as the general loop, on 1 and 2 threads.
+
+use weft_collide::scenarios::{ground, sphere_drop};
+use weft_collide::{ColliderDesc, CollisionWorld, ContactStats, Friction, ShapeDesc};
+use weft_solver::glam::{DVec3, Quat, Vec3};
+use weft_solver::{Method, Motion, Particles, Solver, SubstepContext, SubstepHook};
+
+/// `CollisionWorld` without its per-particle contacts: forces the general loop.
+struct General<'a>(&'a mut CollisionWorld);
+
+impl SubstepHook for General<'_> {
+    fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
+        self.0.begin_substep(ctx, particles);
+    }
+
+    fn project(&mut self, ctx: &SubstepContext, particles: &mut Particles) -> usize {
+        self.0.project(ctx, particles)
+    }
+
+    fn end_substep(&mut self, ctx: &SubstepContext, particles: &mut Particles) {
+        self.0.end_substep(ctx, particles);
+    }
+}
+
+/// The sphere drop at 40², plus a moving, tilted capsule and an oscillating box in the
+/// cloth's way (friction against moving surfaces, several closed-form shapes in order), with
+/// `substeps` × `iterations`.
+fn scene(substeps: u32, iterations: u32) -> (Solver, CollisionWorld) {
+    let (mut solver, mut world) = sphere_drop(Method::Xpbd, 40).expect("scenario");
+    let mut settings = *solver.settings();
+    settings.iterations = iterations;
+    settings.substeps = substeps;
+    solver.set_settings(settings).expect("valid settings");
+    world
+        .add_collider(
+            &ColliderDesc::new(ShapeDesc::Capsule {
+                half_height: 0.4,
+                radius: 0.08,
+            })
+            .at(Vec3::new(-0.5, 0.55, 0.0))
+            .rotated(Quat::from_rotation_z(1.2))
+            .moving(Motion::Linear {
+                velocity: DVec3::new(0.3, 0.0, 0.1),
+            })
+            .with_friction(Friction::new(0.5, 0.4)),
+        )
+        .expect("capsule");
+    world
+        .add_collider(
+            &ColliderDesc::new(ShapeDesc::Cuboid {
+                half_extents: Vec3::new(0.15, 0.1, 0.15),
+            })
+            .at(Vec3::new(0.45, 0.5, 0.3))
+            .moving(Motion::Oscillate {
+                amplitude: DVec3::new(0.0, 0.1, 0.05),
+                frequency: 1.5,
+            }),
+        )
+        .expect("box");
+    world.add_collider(&ground(-0.6)).expect("ground");
+    (solver, world)
+}
+
+/// Bits of every position and velocity, then the contacts and statistics of each frame.
+type Run = (Vec<[u64; 6]>, Vec<usize>, Vec<ContactStats>);
+
+fn run(threads: usize, (substeps, iterations): (u32, u32), general: bool) -> Run {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+        .install(|| {
+            let (mut solver, mut world) = scene(substeps, iterations);
+            assert!(
+                world.particle_contacts().is_some(),
+                "closed-form shapes only"
+            );
+            let (mut contacts, mut stats) = (Vec::new(), Vec::new());
+            for _ in 0..45 {
+                let step = if general {
+                    solver.step_with(&mut General(&mut world))
+                } else {
+                    solver.step_with(&mut world)
+                };
+                contacts.push(step.expect("stable").contacts);
+                stats.push(world.stats());
+            }
+            let p = solver.particles();
+            let bits = p
+                .positions
+                .iter()
+                .zip(&p.velocities)
+                .map(|(x, v)| {
+                    let [a, b, c] = x.to_array().map(f64::to_bits);
+                    let [d, e, f] = v.to_array().map(f64::to_bits);
+                    [a, b, c, d, e, f]
+                })
+                .collect();
+            (bits, contacts, stats)
+        })
+}
+
+#[test]
+fn closed_form_colliders_in_the_fused_frame_match_the_general_loop() {
+    // One substep per frame shows every substep's statistics (they are kept per substep).
+    let mut swept = 0;
+    for steps in [(10, 1), (4, 2), (1, 2)] {
+        let general = run(1, steps, true);
+        let touched: usize = general.1.iter().sum();
+        assert!(touched > 2000, "the cloth reached the colliders: {touched}");
+        assert!(general.2.iter().any(|s| s.max_depth > 0.0));
+        swept += general.2.iter().map(|s| s.swept).sum::<usize>();
+        for threads in [1, 2] {
+            let fused = run(threads, steps, false);
+            assert!(
+                fused.0 == general.0,
+                "positions or velocities differ: {steps:?}, {threads} thread(s)"
+            );
+            assert_eq!(fused.1, general.1, "contacts per frame, {steps:?}");
+            assert_eq!(fused.2, general.2, "statistics of each frame, {steps:?}");
+        }
+    }
+    assert!(swept > 0, "some particle was swept");
+}
+
+#[test]
+fn meshes_and_self_collision_keep_the_general_loop() {
+    let (solver, mut world) = sphere_drop(Method::Xpbd, 8).expect("scenario");
+    assert!(world.particle_contacts().is_some());
+    world
+        .enable_self_collision(&solver, &[0], Default::default())
+        .expect("self-collision");
+    assert!(
+        world.particle_contacts().is_none(),
+        "self-collision pairs particles"
+    );
+}
