@@ -518,8 +518,9 @@ impl SubstepHook for CollisionWorld {
     }
 
     fn project(&mut self, _ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        // Once per substep, before the first projection: the colliders' sweep, then the
-        // self-collision's clamp (a move back along a swept path stays clear of colliders).
+        // Once per substep, before the first projection: the bodies' sweep and contact planes
+        // and the colliders' sweep, then the self-collision's clamp (a move back along a swept
+        // path stays clear of colliders).
         let fresh = std::mem::take(&mut self.fresh);
         if fresh {
             self.sweep(particles);
