@@ -12,7 +12,7 @@ use std::process::{Child, Command, Stdio};
 use std::thread::sleep;
 use std::time::{Duration, Instant};
 
-use common::{temp_dir, weft, write};
+use common::{signal, temp_dir, weft, write};
 use foxglove::Decode;
 use foxglove::messages::PointCloud;
 use glam::{UVec2, Vec2, Vec3};
@@ -248,7 +248,7 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     xdotool(&display, &["key", "q"]);
 
     // It quits on q and leaves a finished log.
-    let (status, out) = wait_exit(&mut viewer, "q");
+    let (status, out) = wait_exit(&mut viewer, Duration::from_secs(60), "q");
     assert!(status.success(), "viewer failed ({status}): {out}");
 
     let (inter, positions) = read(&log, i);
@@ -345,17 +345,18 @@ fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
     (viewer, window)
 }
 
-/// Waits for the viewer to exit (at most 60 s); returns its status and output.
-fn wait_exit(viewer: &mut Guard, what: &str) -> (std::process::ExitStatus, String) {
+/// Waits for the viewer to exit (at most `limit`); returns its status and output.
+fn wait_exit(
+    viewer: &mut Guard,
+    limit: Duration,
+    what: &str,
+) -> (std::process::ExitStatus, String) {
     let start = Instant::now();
     let status = loop {
         if let Some(s) = viewer.0.try_wait().expect("wait") {
             break s;
         }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the viewer did not quit on {what}"
-        );
+        assert!(start.elapsed() < limit, "the viewer did not quit on {what}");
         sleep(Duration::from_millis(100));
     };
     (status, viewer.0.wait_with_output_now())
@@ -370,12 +371,8 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
     let log = dir.join("session.mcap");
     let (display, _xvfb) = start_xvfb(1);
     let (mut viewer, _) = open_viewer(&display, &scene_path, &log);
-    let kill = Command::new("kill")
-        .args(["-INT", &viewer.0.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(kill.success());
-    let (status, out) = wait_exit(&mut viewer, "SIGINT");
+    signal(viewer.0.id(), "INT");
+    let (status, out) = wait_exit(&mut viewer, Duration::from_secs(60), "SIGINT");
     assert_eq!(status.code(), Some(130), "{out}");
     assert!(
         !log.with_file_name("session.partial.mcap").exists(),
@@ -419,18 +416,7 @@ fn a_record_write_that_fails_names_the_path() {
         .spawn()
         .expect("weft view starts");
     let mut viewer = Guard(viewer);
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = viewer.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "the viewer did not exit after 20 frames"
-        );
-        sleep(Duration::from_millis(100));
-    };
-    let out = viewer.0.wait_with_output_now();
+    let (status, out) = wait_exit(&mut viewer, Duration::from_secs(120), "its 20th frame");
     assert_eq!(status.code(), Some(1), "{out}");
     assert!(
         out.contains("/dev/full"),
