@@ -78,6 +78,16 @@ fn require(tool: &str, package: &str) {
     );
 }
 
+/// Checks the tools the viewer tests drive, and writes the test scene into a fresh directory
+/// named `name`: `(directory, scene path)`.
+fn prepare(name: &str) -> (std::path::PathBuf, String) {
+    require("Xvfb", "xvfb");
+    require("xdotool", "xdotool");
+    let dir = temp_dir(name);
+    let scene_path = write(&dir, "sheet.toml", SCENE);
+    (dir, scene_path)
+}
+
 /// Starts Xvfb on a free display number (searched from `offset`, so that the tests of this
 /// file start apart); returns the display name and its guard.
 fn start_xvfb(offset: u32) -> (String, Guard) {
@@ -188,10 +198,7 @@ fn read(path: &Path, i: usize) -> (Vec<Interaction>, Vec<(u64, Vec3)>) {
 
 #[test]
 fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
-    require("Xvfb", "xvfb");
-    require("xdotool", "xdotool");
-    let dir = temp_dir("e2e-drag");
-    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (dir, scene_path) = prepare("e2e-drag");
     let log = dir.join("session.mcap");
 
     // The viewer is opened with this camera (--eye, --target), so the test knows which
@@ -364,10 +371,7 @@ fn wait_exit(
 
 #[test]
 fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
-    require("Xvfb", "xvfb");
-    require("xdotool", "xdotool");
-    let dir = temp_dir("e2e-interrupt");
-    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (dir, scene_path) = prepare("e2e-interrupt");
     let log = dir.join("session.mcap");
     let (display, _xvfb) = start_xvfb(1);
     let (mut viewer, _) = open_viewer(&display, &scene_path, &log);
@@ -401,10 +405,7 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
 
 #[test]
 fn a_record_write_that_fails_names_the_path() {
-    require("Xvfb", "xvfb");
-    require("xdotool", "xdotool");
-    let dir = temp_dir("e2e-full");
-    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (_, scene_path) = prepare("e2e-full");
     let (display, _xvfb) = start_xvfb(2);
     let viewer = weft()
         .args(["view", &scene_path, "--record", "/dev/full"])
