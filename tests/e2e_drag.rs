@@ -311,26 +311,39 @@ fn xyz(v: Vec3) -> String {
     format!("{},{},{}", v.x, v.y, v.z)
 }
 
-/// Starts `weft view SCENE --record LOG` on `display` and waits for its window and a few
-/// frames; returns the process and the window id.
-fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
-    let viewer = weft()
-        .args(["view", scene, "--record"])
-        .arg(log)
-        .args([
-            "--size",
-            &format!("{W}x{H}"),
-            "--exit-after-frames",
-            "100000",
-        ])
-        .args(["--eye", &xyz(EYE), "--target", &xyz(TARGET)])
+/// Starts `weft` with `args` on the X display `display` (Wayland hidden), its output kept.
+fn viewer_on(display: &str, args: &[&str]) -> Guard {
+    let child = weft()
+        .args(args)
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("weft view starts");
-    let mut viewer = Guard(viewer);
+    Guard(child)
+}
+
+/// Starts `weft view SCENE --record LOG` on `display` and waits for its window and a few
+/// frames; returns the process and the window id.
+fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
+    let mut viewer = viewer_on(
+        display,
+        &[
+            "view",
+            scene,
+            "--record",
+            &log.to_string_lossy(),
+            "--size",
+            &format!("{W}x{H}"),
+            "--exit-after-frames",
+            "100000",
+            "--eye",
+            &xyz(EYE),
+            "--target",
+            &xyz(TARGET),
+        ],
+    );
     let start = Instant::now();
     let window = loop {
         let pid = viewer.0.id().to_string();
@@ -407,16 +420,17 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
 fn a_record_write_that_fails_names_the_path() {
     let (_, scene_path) = prepare("e2e-full");
     let (display, _xvfb) = start_xvfb(2);
-    let viewer = weft()
-        .args(["view", &scene_path, "--record", "/dev/full"])
-        .args(["--exit-after-frames", "20"])
-        .env("DISPLAY", &display)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("weft view starts");
-    let mut viewer = Guard(viewer);
+    let mut viewer = viewer_on(
+        &display,
+        &[
+            "view",
+            &scene_path,
+            "--record",
+            "/dev/full",
+            "--exit-after-frames",
+            "20",
+        ],
+    );
     let (status, out) = wait_exit(&mut viewer, Duration::from_secs(120), "its 20th frame");
     assert_eq!(status.code(), Some(1), "{out}");
     assert!(
