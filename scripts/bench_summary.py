@@ -9,13 +9,17 @@ Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.
 - the reference workload at N = 64/128/256 on 1 and 2 threads;
 - substeps × iterations at equal cost with the constraint error reached after 1 s;
 - collisions (sphere, triangle mesh, self) with and without, and their exponents;
-- self-collision vs constraint solve at N = 128; MCAP logging overhead.
+- self-collision vs constraint solve at N = 128; triangle-mesh contact (static and
+  deforming meshes); a character's body; MCAP logging overhead;
+- and says which figures quoted elsewhere are not produced by a bench (the peer comparison,
+  the self-collision clocks), pointing to where they are kept.
 
 Figures are criterion's median point estimates. The page starts with where they come from:
 the date, the commit (`git describe`), the CPU (`/proc/cpuinfo`'s model name) and the widest
 vector path the CPU offers, or the one forced with WEFT_SIMD. Usage:
-    python3 scripts/bench_summary.py [CRITERION_DIR] [--out docs/benchmarks.md]
-CRITERION_DIR defaults to $CRITERION_HOME, else $CARGO_TARGET_DIR/criterion, else
+    python3 scripts/bench_summary.py [CRITERION_DIR] [--out docs/benchmarks.md] [--note TEXT]
+--note adds a line to the header (e.g. the machine's load average during the run). CRITERION_DIR
+defaults to $CRITERION_HOME, else $CARGO_TARGET_DIR/criterion, else
 target/criterion. Without --out the page goes to standard output.
 """
 import contextlib
@@ -29,19 +33,23 @@ from pathlib import Path
 
 
 def parse_args(argv):
-    """(criterion directory or None, output path or None) from the command line."""
-    root, out = None, None
+    """(criterion directory or None, output path or None, note or None) from the command line."""
+    root, out, note = None, None, None
     it = iter(argv)
     for a in it:
         if a == "--out":
             out = next(it, None)
             if out is None:
                 sys.exit("bench_summary: --out needs a file")
+        elif a == "--note":
+            note = next(it, None)
+            if note is None:
+                sys.exit("bench_summary: --note needs a text")
         elif root is None:
             root = a
         else:
             sys.exit(f"bench_summary: unexpected argument {a!r}")
-    return root, out
+    return root, out, note
 
 
 def criterion_dir(arg):
@@ -189,6 +197,55 @@ def self_vs_solve(r):
     print()
 
 
+def mesh_contact(r):
+    print("## Triangle-mesh contact (`crates/weft-collide/benches/mesh_contact.rs`, XPBD, "
+          "each cloth stepped 30 frames into contact first)\n")
+    print("| `static_mesh/16384`: 128² cloth on a 20,480-triangle sphere mesh + ground | ms/frame |")
+    print("|---|---|")
+    for f, label in [("constraint_solve", "constraint solve (same state, no collisions)"),
+                     ("mesh", "mesh, Weft's f64 path"),
+                     ("mesh_parry", "mesh, parry's f32 projection"),
+                     ("sphere_solve", "constraint solve of the analytic-sphere scene"),
+                     ("sphere", "analytic sphere + ground")]:
+        print(f"| {label} | {fmt(ms(r, f'static_mesh/16384/{f}'))} |")
+    print()
+    print("| `deforming_mesh/8100`: 90² cloth on a breathing 5,120-triangle ball | ms/frame |")
+    print("|---|---|")
+    for f, label in [("constraint_solve", "constraint solve"),
+                     ("deforming", "animation + faces + refit + swept contact every substep")]:
+        print(f"| {label} | {fmt(ms(r, f'deforming_mesh/8100/{f}'))} |")
+    print()
+
+
+def character(r):
+    print("## A character's body (`crates/weft-character/benches/character.rs`)\n")
+    print("| what | µs |")
+    print("|---|---|")
+    for f, label in [("state/walker", "`Character::state(t)`, walker (24 joints, 20 shapes)"),
+                     ("state/cmu", "`Character::state(t)`, CMU clip (38 joints, 25 shapes)"),
+                     ("distance/8000", "signed distance of 8,000 points to the walker body, "
+                                       "bounding-sphere culled"),
+                     ("distance/8000/exhaustive", "the same, every shape tested"),
+                     ("skin/simple_skin", "simple_skin linear blend skinning")]:
+        v = r.get(f"character/{f}")
+        print(f"| {label} | {fmt(None if v is None else v[0] / 1e3)} |")
+    print()
+
+
+def not_benches():
+    print("## Figures that are not from a bench\n")
+    print("Two kinds of figure quoted in the README and the notes do not come from criterion and "
+          "are not on this page:\n")
+    print("- Weft against Taichi and the C grid kernel: `scripts/compare_peers.sh` (medians of "
+          "whole runs of each solver, interleaved); its dated runs are in "
+          "[performance-notes.md](performance-notes.md#against-the-peers).")
+    print("- Self-collision against the constraint solve per phase of a fold, and where its time "
+          "goes: the `self_collision_cost` example's own clocks "
+          "(`cargo run --release -p weft-collide --example self_collision_cost`); its dated runs "
+          "are in [performance-notes.md](performance-notes.md#where-self-collisions-time-goes-and-the-floor).")
+    print()
+
+
 def logging(r):
     print("## MCAP logging, default scene at 128² (`weft run` with and without `--out`)\n")
     a, b, w = (ms(r, f"weft_run/16384/{k}") for k in ["no_log", "mcap", "writer_only"])
@@ -235,7 +292,7 @@ def git(*args):
         return "unknown"
 
 
-def header(root, count):
+def header(root, count, note):
     date = datetime.date.today().isoformat()
     print("# Benchmarks\n")
     print("Generated by `python3 scripts/bench_summary.py --out docs/benchmarks.md` from "
@@ -244,12 +301,14 @@ def header(root, count):
     print(f"- date: {date}")
     print(f"- commit: {git('describe', '--always', '--dirty')}")
     print(f"- CPU: {cpu_model()}, {os.cpu_count()} logical CPUs")
-    print(f"- vector path: {simd_path()}")
+    print(f"- kernel path: {simd_path()}")
+    if note:
+        print(f"- {note}")
     print(f"- {count} benchmarks read from `{root}`\n")
 
 
 def main():
-    arg, out = parse_args(sys.argv[1:])
+    arg, out, note = parse_args(sys.argv[1:])
     root = criterion_dir(arg)
     r = load(root)
     if not r:
@@ -258,22 +317,25 @@ def main():
     if out:
         tmp = Path(out).with_suffix(".md.tmp")
         with open(tmp, "w") as f, contextlib.redirect_stdout(f):
-            write_page(r, root)
+            write_page(r, root, note)
         tmp.replace(out)
         print(f"wrote {out}", file=sys.stderr)
     else:
-        write_page(r, root)
+        write_page(r, root, note)
     return 0
 
 
-def write_page(r, root):
-    header(root, len(r))
+def write_page(r, root, note):
+    header(root, len(r), note)
     methods(r)
     reference(r)
     substeps(r, root)
     collisions(r)
     self_vs_solve(r)
+    mesh_contact(r)
+    character(r)
     logging(r)
+    not_benches()
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ use std::process::{Child, Command, Stdio};
 use std::thread::sleep;
 use std::time::{Duration, Instant};
 
-use common::{temp_dir, weft, write};
+use common::{signal, temp_dir, weft, write};
 use foxglove::Decode;
 use foxglove::messages::PointCloud;
 use glam::{UVec2, Vec2, Vec3};
@@ -76,6 +76,16 @@ fn require(tool: &str, package: &str) {
         found,
         "{tool} is missing: install {package} (scripts/install-test-deps.sh does)"
     );
+}
+
+/// Checks the tools the viewer tests drive, and writes the test scene into a fresh directory
+/// named `name`: `(directory, scene path)`.
+fn prepare(name: &str) -> (std::path::PathBuf, String) {
+    require("Xvfb", "xvfb");
+    require("xdotool", "xdotool");
+    let dir = temp_dir(name);
+    let scene_path = write(&dir, "sheet.toml", SCENE);
+    (dir, scene_path)
 }
 
 /// Starts Xvfb on a free display number (searched from `offset`, so that the tests of this
@@ -188,10 +198,7 @@ fn read(path: &Path, i: usize) -> (Vec<Interaction>, Vec<(u64, Vec3)>) {
 
 #[test]
 fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
-    require("Xvfb", "xvfb");
-    require("xdotool", "xdotool");
-    let dir = temp_dir("e2e-drag");
-    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (dir, scene_path) = prepare("e2e-drag");
     let log = dir.join("session.mcap");
 
     // The viewer is opened with this camera (--eye, --target), so the test knows which
@@ -248,7 +255,7 @@ fn dragging_the_cloth_in_the_viewer_moves_the_grabbed_particle_and_is_logged() {
     xdotool(&display, &["key", "q"]);
 
     // It quits on q and leaves a finished log.
-    let (status, out) = wait_exit(&mut viewer, "q");
+    let (status, out) = wait_exit(&mut viewer, Duration::from_secs(60), "q");
     assert!(status.success(), "viewer failed ({status}): {out}");
 
     let (inter, positions) = read(&log, i);
@@ -304,26 +311,39 @@ fn xyz(v: Vec3) -> String {
     format!("{},{},{}", v.x, v.y, v.z)
 }
 
-/// Starts `weft view SCENE --record LOG` on `display` and waits for its window and a few
-/// frames; returns the process and the window id.
-fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
-    let viewer = weft()
-        .args(["view", scene, "--record"])
-        .arg(log)
-        .args([
-            "--size",
-            &format!("{W}x{H}"),
-            "--exit-after-frames",
-            "100000",
-        ])
-        .args(["--eye", &xyz(EYE), "--target", &xyz(TARGET)])
+/// Starts `weft` with `args` on the X display `display` (Wayland hidden), its output kept.
+fn viewer_on(display: &str, args: &[&str]) -> Guard {
+    let child = weft()
+        .args(args)
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("weft view starts");
-    let mut viewer = Guard(viewer);
+    Guard(child)
+}
+
+/// Starts `weft view SCENE --record LOG` on `display` and waits for its window and a few
+/// frames; returns the process and the window id.
+fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
+    let mut viewer = viewer_on(
+        display,
+        &[
+            "view",
+            scene,
+            "--record",
+            &log.to_string_lossy(),
+            "--size",
+            &format!("{W}x{H}"),
+            "--exit-after-frames",
+            "100000",
+            "--eye",
+            &xyz(EYE),
+            "--target",
+            &xyz(TARGET),
+        ],
+    );
     let start = Instant::now();
     let window = loop {
         let pid = viewer.0.id().to_string();
@@ -345,17 +365,18 @@ fn open_viewer(display: &str, scene: &str, log: &Path) -> (Guard, String) {
     (viewer, window)
 }
 
-/// Waits for the viewer to exit (at most 60 s); returns its status and output.
-fn wait_exit(viewer: &mut Guard, what: &str) -> (std::process::ExitStatus, String) {
+/// Waits for the viewer to exit (at most `limit`); returns its status and output.
+fn wait_exit(
+    viewer: &mut Guard,
+    limit: Duration,
+    what: &str,
+) -> (std::process::ExitStatus, String) {
     let start = Instant::now();
     let status = loop {
         if let Some(s) = viewer.0.try_wait().expect("wait") {
             break s;
         }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the viewer did not quit on {what}"
-        );
+        assert!(start.elapsed() < limit, "the viewer did not quit on {what}");
         sleep(Duration::from_millis(100));
     };
     (status, viewer.0.wait_with_output_now())
@@ -363,19 +384,12 @@ fn wait_exit(viewer: &mut Guard, what: &str) -> (std::process::ExitStatus, Strin
 
 #[test]
 fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
-    require("Xvfb", "xvfb");
-    require("xdotool", "xdotool");
-    let dir = temp_dir("e2e-interrupt");
-    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (dir, scene_path) = prepare("e2e-interrupt");
     let log = dir.join("session.mcap");
     let (display, _xvfb) = start_xvfb(1);
     let (mut viewer, _) = open_viewer(&display, &scene_path, &log);
-    let kill = Command::new("kill")
-        .args(["-INT", &viewer.0.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(kill.success());
-    let (status, out) = wait_exit(&mut viewer, "SIGINT");
+    signal(viewer.0.id(), "INT");
+    let (status, out) = wait_exit(&mut viewer, Duration::from_secs(60), "SIGINT");
     assert_eq!(status.code(), Some(130), "{out}");
     assert!(
         !log.with_file_name("session.partial.mcap").exists(),
@@ -404,33 +418,20 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
 
 #[test]
 fn a_record_write_that_fails_names_the_path() {
-    require("Xvfb", "xvfb");
-    require("xdotool", "xdotool");
-    let dir = temp_dir("e2e-full");
-    let scene_path = write(&dir, "sheet.toml", SCENE);
+    let (_, scene_path) = prepare("e2e-full");
     let (display, _xvfb) = start_xvfb(2);
-    let viewer = weft()
-        .args(["view", &scene_path, "--record", "/dev/full"])
-        .args(["--exit-after-frames", "20"])
-        .env("DISPLAY", &display)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("weft view starts");
-    let mut viewer = Guard(viewer);
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = viewer.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "the viewer did not exit after 20 frames"
-        );
-        sleep(Duration::from_millis(100));
-    };
-    let out = viewer.0.wait_with_output_now();
+    let mut viewer = viewer_on(
+        &display,
+        &[
+            "view",
+            &scene_path,
+            "--record",
+            "/dev/full",
+            "--exit-after-frames",
+            "20",
+        ],
+    );
+    let (status, out) = wait_exit(&mut viewer, Duration::from_secs(120), "its 20th frame");
     assert_eq!(status.code(), Some(1), "{out}");
     assert!(
         out.contains("/dev/full"),

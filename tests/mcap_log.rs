@@ -100,13 +100,7 @@ fn interrupted_run_leaves_a_valid_log(signal: &str) {
     let dir = temp_dir(&format!("signal-{signal}"));
     let scene = write(&dir, "small.toml", SMALL);
     let mcap = dir.join("run.mcap");
-    let child = weft()
-        .args(["run", &scene, "--frames", "100000000", "--out"])
-        .arg(&mcap)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("starts");
+    let child = spawn_logging(&["run", &scene, "--frames", "100000000"], &mcap);
     std::thread::sleep(Duration::from_millis(800));
     let kill = std::process::Command::new("kill")
         .args([format!("-{signal}"), child.id().to_string()])

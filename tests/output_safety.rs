@@ -4,7 +4,6 @@
 
 mod common;
 
-use std::process::Stdio;
 use std::time::Duration;
 
 use common::*;
@@ -76,17 +75,10 @@ fn a_log_appears_only_when_finished_and_a_second_writer_is_refused() {
     let dir = temp_dir("second-writer");
     let scene = write(&dir, "s.toml", &big(64));
     let target = dir.join("a.mcap");
-    let first = weft()
-        .args(["run", &scene, "--frames", "100000000", "--out"])
-        .arg(&target)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("starts");
+    let first = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
     let part = partial(&target);
     assert!(
-        wait_for(Duration::from_secs(30), || std::fs::metadata(&part)
-            .is_ok_and(|m| m.len() > 0)),
+        partial_grows_past(&target, 0, Duration::from_secs(30)),
         "the first run never started writing {}",
         part.display()
     );
@@ -131,16 +123,17 @@ fn a_full_device_is_named_and_leaves_no_file_passed_off_as_whole() {
     // A regular file on a "disk" that fills up: a 64 KiB file-size limit (EFBIG, with
     // SIGXFSZ ignored) stands in for a small full filesystem.
     let target = dir.join("a.mcap");
-    let out = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!(
-            "trap '' XFSZ; ulimit -f 64; exec \"$0\" run '{scene}' --frames 200 --out '{}'",
-            target.display()
-        ))
-        .arg(env!("CARGO_BIN_EXE_weft"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("sh runs");
+    let out = run_on_full_disk(
+        64,
+        &[
+            "run",
+            &scene,
+            "--frames",
+            "200",
+            "--out",
+            &target.to_string_lossy(),
+        ],
+    );
     let (o, e) = texts(&out);
     assert_eq!(out.status.code(), Some(1), "{o}{e}");
     assert!(

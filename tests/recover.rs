@@ -5,7 +5,6 @@
 
 mod common;
 
-use std::process::Stdio;
 use std::time::Duration;
 
 use common::*;
@@ -39,17 +38,9 @@ fn messages_before_the_cut(bytes: &[u8]) -> usize {
 fn killed_log(dir: &std::path::Path) -> std::path::PathBuf {
     let scene = write(dir, "s.toml", &big(48));
     let target = dir.join("run.mcap");
-    let child = weft()
-        .args(["run", &scene, "--frames", "100000000", "--out"])
-        .arg(&target)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("starts");
+    let child = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
     let part = partial(&target);
-    let grew = wait_for(Duration::from_secs(60), || {
-        std::fs::metadata(&part).is_ok_and(|m| m.len() > 3 << 20)
-    });
+    let grew = partial_grows_past(&target, 3 << 20, Duration::from_secs(60));
     signal(child.id(), "KILL");
     let (_, _) = exits_within(child, Duration::from_secs(10));
     assert!(grew, "the log never grew past 3 MiB");

@@ -263,17 +263,20 @@ fn a_failing_frame_write_names_the_path_and_leaves_no_frame() {
     std::fs::create_dir_all(&out_dir).expect("out dir");
     // A 1-block file-size limit (EFBIG, SIGXFSZ ignored) stands in for a full disk: the
     // first PNG cannot be written whole.
-    let out = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!(
-            "trap '' XFSZ; ulimit -f 1; exec \"$0\" render '{scene}' --frames 2 --size 160x120 \
-             --out '{}' -q",
-            out_dir.display()
-        ))
-        .arg(env!("CARGO_BIN_EXE_weft"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("sh runs");
+    let out = run_on_full_disk(
+        1,
+        &[
+            "render",
+            &scene,
+            "--frames",
+            "2",
+            "--size",
+            "160x120",
+            "--out",
+            &out_dir.to_string_lossy(),
+            "-q",
+        ],
+    );
     let (o, e) = texts(&out);
     assert_eq!(out.status.code(), Some(1), "{o}{e}");
     let frame = out_dir.join("frame_00000.png");

@@ -17,8 +17,8 @@ fn stop_inside_a_long_frame(sig: &str) {
     let scene = write(&dir, "s.toml", &big(64));
     let target = dir.join("a.mcap");
     // 20000 substeps x 50 iterations on 4096 particles: one frame takes minutes.
-    let child = weft()
-        .args([
+    let child = spawn_logging(
+        &[
             "run",
             &scene,
             "--frames",
@@ -27,13 +27,9 @@ fn stop_inside_a_long_frame(sig: &str) {
             "sim.substeps=20000",
             "--set",
             "sim.iterations=50",
-            "--out",
-        ])
-        .arg(&target)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("starts");
+        ],
+        &target,
+    );
     let part = partial(&target);
     // The log's frame 0 is written as soon as the run starts: from then on frames are long.
     assert!(

@@ -5,10 +5,12 @@
 
 mod common;
 
-use std::process::Stdio;
 use std::time::Duration;
 
-use common::{big, exits_within, partial, signal, temp_dir, texts, wait_for, weft, write};
+use common::{
+    big, exits_within, partial, partial_grows_past, signal, spawn_logging, temp_dir, texts, weft,
+    write,
+};
 
 fn without_display(args: &[&str]) -> std::process::Output {
     weft()
@@ -111,17 +113,9 @@ fn record_refuses_a_log_another_weft_is_writing() {
     let dir = temp_dir("viewer-record-locked");
     let scene = write(&dir, "s.toml", &big(64));
     let target = dir.join("a.mcap");
-    let first = weft()
-        .args(["run", &scene, "--frames", "100000000", "--out"])
-        .arg(&target)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("starts");
+    let first = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
     let part = partial(&target);
-    let started = wait_for(Duration::from_secs(30), || {
-        std::fs::metadata(&part).is_ok_and(|m| m.len() > 0)
-    });
+    let started = partial_grows_past(&target, 0, Duration::from_secs(30));
     let out = without_display(&["view", "--record", &target.to_string_lossy()]);
     signal(first.id(), "INT");
     let (run, _) = exits_within(first, Duration::from_secs(20));

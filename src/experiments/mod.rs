@@ -49,6 +49,20 @@ pub struct RunResult {
     pub mcap: Option<String>,
 }
 
+impl RunResult {
+    /// The result of a run that never started.
+    pub fn not_run(r: &PlannedRun) -> Self {
+        Self {
+            index: r.index,
+            series: r.series.clone(),
+            label: r.label.clone(),
+            status: NOT_RUN.into(),
+            metrics: Default::default(),
+            mcap: None,
+        }
+    }
+}
+
 fn slug(s: &str) -> String {
     let mut out: String = s
         .chars()
@@ -245,7 +259,7 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                             "  run {:>3} {} {}: {NOT_RUN}",
                             r.index, r.series, r.label
                         ));
-                        return Ok(not_run(r));
+                        return Ok(RunResult::not_run(r));
                     }
                     let res = weft_scene::load_with(&scene_path, &r.overrides, &limits)
                         .map_err(|e| anyhow::anyhow!("{e}"))
@@ -306,18 +320,6 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
     } else {
         ExitCode::SUCCESS
     })
-}
-
-/// The result of a run that never started.
-fn not_run(r: &PlannedRun) -> RunResult {
-    RunResult {
-        index: r.index,
-        series: r.series.clone(),
-        label: r.label.clone(),
-        status: NOT_RUN.into(),
-        metrics: Default::default(),
-        mcap: None,
-    }
 }
 
 /// A run's folder (and, with `.mcap`, its log) relative to the output directory.

@@ -48,14 +48,7 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
                 with_results += 1;
                 result
             }
-            _ => RunResult {
-                index: r.index,
-                series: r.series.clone(),
-                label: r.label.clone(),
-                status: NOT_RUN.into(),
-                metrics: Default::default(),
-                mcap: None,
-            },
+            _ => RunResult::not_run(r),
         };
         rows.push(Row { run: r, result });
     }

@@ -7,7 +7,8 @@ use foxglove::messages::{
     Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, TriangleListPrimitive,
     Vector3,
 };
-use weft_scene::{ColliderSpec, ShapeSpec};
+use weft_collide::ShapeDesc;
+use weft_scene::ColliderSpec;
 use weft_solver::glam::{DQuat, DVec3};
 
 /// The frame every message is expressed in.
@@ -119,21 +120,21 @@ const GREY: Color = Color {
     a: 0.8,
 };
 
-fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: DQuat) {
+fn add_shape(e: &mut SceneEntity, shape: &ShapeDesc, position: DVec3, rotation: DQuat) {
     let p = pose(position, rotation);
     let color = Some(GREY);
     match shape {
-        ShapeSpec::Sphere { radius } => e.spheres.push(SpherePrimitive {
+        ShapeDesc::Sphere { radius } => e.spheres.push(SpherePrimitive {
             pose: Some(p),
             size: Some(vec3(DVec3::splat(2.0 * radius))),
             color,
         }),
-        ShapeSpec::Cuboid { half_extents } => e.cubes.push(CubePrimitive {
+        ShapeDesc::Cuboid { half_extents } => e.cubes.push(CubePrimitive {
             pose: Some(p),
             size: Some(vec3(2.0 * *half_extents)),
             color,
         }),
-        ShapeSpec::Capsule {
+        ShapeDesc::Capsule {
             half_height,
             radius,
         } => {
@@ -152,10 +153,10 @@ fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: 
             });
             for s in [-1.0, 1.0] {
                 let c = position + rotation * DVec3::new(0.0, s * half_height, 0.0);
-                add_shape(e, &ShapeSpec::Sphere { radius: *radius }, c, rotation);
+                add_shape(e, &ShapeDesc::Sphere { radius: *radius }, c, rotation);
             }
         }
-        ShapeSpec::Plane { normal } => {
+        ShapeDesc::HalfSpace { normal } => {
             let n = normal.normalize_or(DVec3::Y);
             let r = rotation * DQuat::from_rotation_arc(DVec3::Y, n);
             let centre = position - r * DVec3::new(0.0, 0.0005, 0.0);
@@ -165,7 +166,7 @@ fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: 
                 color,
             });
         }
-        ShapeSpec::ConvexHull { points } => {
+        ShapeDesc::ConvexHull { points } => {
             // Drawn as the points' bounding box.
             let lo = points.iter().copied().fold(DVec3::INFINITY, DVec3::min);
             let hi = points.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
@@ -175,12 +176,10 @@ fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: 
                 color,
             });
         }
-        ShapeSpec::Mesh {
-            positions,
-            triangles,
-        } => e.triangles.push(TriangleListPrimitive {
+        ShapeDesc::TriMesh(mesh) => e.triangles.push(TriangleListPrimitive {
             pose: Some(p),
-            points: positions
+            points: mesh
+                .vertices
                 .iter()
                 .map(|v| Point3 {
                     x: v.x,
@@ -190,11 +189,16 @@ fn add_shape(e: &mut SceneEntity, shape: &ShapeSpec, position: DVec3, rotation: 
                 .collect(),
             color,
             colors: vec![],
-            indices: triangles.iter().flatten().copied().collect(),
+            indices: mesh.triangles.iter().flatten().copied().collect(),
         }),
-        ShapeSpec::Compound(parts) => {
-            for (pp, pr, s) in parts {
-                add_shape(e, s, position + rotation * *pp, rotation * *pr);
+        ShapeDesc::Compound(parts) => {
+            for part in parts {
+                add_shape(
+                    e,
+                    &part.shape,
+                    position + rotation * part.position,
+                    rotation * part.rotation,
+                );
             }
         }
     }

@@ -3,7 +3,8 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::Duration;
 
 use foxglove::Decode;
 use foxglove::messages::PointCloud;
@@ -169,23 +170,20 @@ pub fn signal(pid: u32, signal: &str) {
 }
 
 /// Waits until `ready()` holds, polling every 20 ms, for at most `limit`; false on timeout.
-pub fn wait_for(limit: std::time::Duration, mut ready: impl FnMut() -> bool) -> bool {
+pub fn wait_for(limit: Duration, mut ready: impl FnMut() -> bool) -> bool {
     let start = std::time::Instant::now();
     while start.elapsed() < limit {
         if ready() {
             return true;
         }
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        std::thread::sleep(Duration::from_millis(20));
     }
     ready()
 }
 
 /// Waits for `child` to exit within `limit`; kills it and fails the test otherwise. Returns its
 /// output and how long it took.
-pub fn exits_within(
-    child: std::process::Child,
-    limit: std::time::Duration,
-) -> (Output, std::time::Duration) {
+pub fn exits_within(child: Child, limit: Duration) -> (Output, Duration) {
     let start = std::time::Instant::now();
     let pid = child.id();
     let (tx, rx) = std::sync::mpsc::channel();
@@ -213,4 +211,40 @@ pub fn partial(target: &Path) -> PathBuf {
 /// A bigger scene: a `n`×`n` cloth, so a frame takes a while and a log grows chunk by chunk.
 pub fn big(n: usize) -> String {
     SMALL.replace("resolution = [8, 8]", &format!("resolution = [{n}, {n}]"))
+}
+
+/// Starts `weft` with `args` followed by `--out target`, in the background (stdout dropped,
+/// stderr kept for the test's messages).
+pub fn spawn_logging(args: &[&str], target: &Path) -> Child {
+    weft()
+        .args(args)
+        .arg("--out")
+        .arg(target)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("weft starts")
+}
+
+/// Waits at most `limit` for the partial log of `target` to hold more than `bytes` bytes.
+pub fn partial_grows_past(target: &Path, bytes: u64, limit: Duration) -> bool {
+    let part = partial(target);
+    wait_for(limit, || {
+        std::fs::metadata(&part).is_ok_and(|m| m.len() > bytes)
+    })
+}
+
+/// Runs `weft` with `args` on a "disk" that fills up after `blocks` KiB: a file-size limit
+/// (EFBIG, with SIGXFSZ ignored) stands in for a full filesystem.
+pub fn run_on_full_disk(blocks: u32, args: &[&str]) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f {blocks}; exec \"$0\" \"$@\""
+        ))
+        .arg(env!("CARGO_BIN_EXE_weft"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("sh runs")
 }

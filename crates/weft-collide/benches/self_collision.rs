@@ -121,7 +121,7 @@ fn wrapped(n: usize, shape: ShapeDesc, at: DVec3) -> (Solver, CollisionWorld) {
     let mut solver = flat_cloth(n, thickness);
     let mut world = CollisionWorld::new(&solver);
     world
-        .add_collider(&ColliderDesc::new(shape).at(at.as_vec3()))
+        .add_collider(&ColliderDesc::new(shape).at(at))
         .unwrap();
     let collider = world.colliders()[0].clone();
     place(solver.particles_mut(), n, |_, _, x| {

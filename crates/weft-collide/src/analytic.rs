@@ -77,23 +77,26 @@ pub(crate) enum Analytic {
 
 impl Analytic {
     /// The closed form of `shape`, or `None` for shapes left to parry (hull, mesh, compound).
+    /// Its parameters are those parry holds (f32), widened: the closed form, parry's bounds
+    /// and the drawing describe one shape.
     pub fn of(shape: &ShapeDesc) -> Option<Self> {
+        let held = |x: f64| f64::from(x as f32);
         match *shape {
             ShapeDesc::Sphere { radius } => Some(Self::Sphere {
-                radius: f64::from(radius),
+                radius: held(radius),
             }),
             ShapeDesc::HalfSpace { normal } => Some(Self::HalfSpace {
-                normal: normal.as_dvec3().normalize(),
+                normal: normal.as_vec3().as_dvec3().normalize(),
             }),
             ShapeDesc::Cuboid { half_extents } => Some(Self::Cuboid {
-                half: half_extents.as_dvec3(),
+                half: half_extents.as_vec3().as_dvec3(),
             }),
             ShapeDesc::Capsule {
                 half_height,
                 radius,
             } => Some(Self::Capsule {
-                half_height: f64::from(half_height),
-                radius: f64::from(radius),
+                half_height: held(half_height),
+                radius: held(radius),
             }),
             _ => None,
         }
@@ -364,7 +367,6 @@ fn capsule_interval(
 
 #[cfg(test)]
 mod tests {
-    use glam::{Quat, Vec3};
 
     use crate::analytic_vs_parry::{Rng, shapes};
     use crate::collider::{Collider, ColliderDesc};
@@ -382,9 +384,9 @@ mod tests {
             let kind = shape.kind();
             let c = Collider::new(
                 &ColliderDesc::new(shape)
-                    .at(Vec3::new(0.2, 0.1, -0.4))
-                    .rotated(Quat::from_axis_angle(
-                        Vec3::new(1.0, 1.0, 0.0).normalize(),
+                    .at(DVec3::new(0.2, 0.1, -0.4))
+                    .rotated(DQuat::from_axis_angle(
+                        DVec3::new(1.0, 1.0, 0.0).normalize(),
                         0.7,
                     )),
             )

@@ -2,7 +2,7 @@
 //! at many deterministic pseudo-random points and segments, with rotated, translated and
 //! moving poses.
 
-use glam::{DVec3, Quat, Vec3};
+use glam::{DQuat, DVec3};
 use weft_solver::Motion;
 
 use crate::collider::{Collider, ColliderDesc};
@@ -35,10 +35,10 @@ pub(crate) fn shapes() -> Vec<ShapeDesc> {
     vec![
         ShapeDesc::Sphere { radius: 0.7 },
         ShapeDesc::HalfSpace {
-            normal: Vec3::new(0.3, 1.0, -0.2),
+            normal: DVec3::new(0.3, 1.0, -0.2),
         },
         ShapeDesc::Cuboid {
-            half_extents: Vec3::new(0.5, 0.3, 0.8),
+            half_extents: DVec3::new(0.5, 0.3, 0.8),
         },
         ShapeDesc::Capsule {
             half_height: 0.6,
@@ -54,9 +54,9 @@ fn colliders() -> Vec<Collider> {
     for shape in shapes() {
         let plain = ColliderDesc::new(shape.clone());
         let placed = ColliderDesc::new(shape)
-            .at(Vec3::new(0.4, -0.3, 1.1))
-            .rotated(Quat::from_axis_angle(
-                Vec3::new(1.0, 2.0, 0.5).normalize(),
+            .at(DVec3::new(0.4, -0.3, 1.1))
+            .rotated(DQuat::from_axis_angle(
+                DVec3::new(1.0, 2.0, 0.5).normalize(),
                 0.9,
             ));
         let moving = placed.clone().moving(Motion::Rotate {
@@ -211,7 +211,7 @@ fn surface_and_degenerate_points() {
     let centre = sphere.closest(DVec3::ZERO, 0.1).expect("centre");
     assert_eq!((centre.distance, centre.normal), (-1.0, DVec3::Y));
     let cuboid = Collider::new(&ColliderDesc::new(ShapeDesc::Cuboid {
-        half_extents: Vec3::new(1.0, 2.0, 3.0),
+        half_extents: DVec3::new(1.0, 2.0, 3.0),
     }))
     .expect("cuboid");
     let face = cuboid

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use glam::{DVec3, Quat, Vec3};
+use glam::{DQuat, DVec3, Mat4, Vec3};
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
 use parry3d::query::{PointProjection, PointQuery, PointQueryWithLocation, Ray};
@@ -18,15 +18,16 @@ use crate::surface::SurfacePoint;
 use crate::trimesh::MeshGeometry;
 use crate::trimesh::deforming::MeshAnimation;
 
-/// How to build a collider: shape, placement at t = 0, motion and friction.
+/// How to build a collider: shape, placement at t = 0, motion and friction, in f64 (the
+/// collider rounds shape and placement to the f32 parry holds, see [`ShapeDesc`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColliderDesc {
     /// The geometry, in the collider's frame.
     pub shape: ShapeDesc,
     /// Position of the collider's frame at rest (m).
-    pub position: Vec3,
+    pub position: DVec3,
     /// Orientation of the collider's frame at rest.
-    pub rotation: Quat,
+    pub rotation: DQuat,
     /// Prescribed motion applied to the rest placement ([`Motion::Static`] for a fixed collider).
     pub motion: Motion,
     /// Coulomb friction against cloth particles.
@@ -38,21 +39,21 @@ impl ColliderDesc {
     pub fn new(shape: ShapeDesc) -> Self {
         Self {
             shape,
-            position: Vec3::ZERO,
-            rotation: Quat::IDENTITY,
+            position: DVec3::ZERO,
+            rotation: DQuat::IDENTITY,
             motion: Motion::Static,
             friction: Friction::default(),
         }
     }
 
     /// Builder-style: sets the rest position.
-    pub fn at(mut self, position: Vec3) -> Self {
+    pub fn at(mut self, position: DVec3) -> Self {
         self.position = position;
         self
     }
 
     /// Builder-style: sets the rest orientation.
-    pub fn rotated(mut self, rotation: Quat) -> Self {
+    pub fn rotated(mut self, rotation: DQuat) -> Self {
         self.rotation = rotation;
         self
     }
@@ -120,7 +121,9 @@ impl Collider {
     /// Validates and builds a collider.
     pub fn new(desc: &ColliderDesc) -> Result<Self, ShapeError> {
         desc.friction.validate()?;
-        if !(desc.position.is_finite() && desc.rotation.is_finite()) {
+        // The rest placement as parry holds it (f32); the f64 pose starts from the same values.
+        let (position, rotation) = (desc.position.as_vec3(), desc.rotation.as_quat());
+        if !(position.is_finite() && rotation.is_finite()) {
             return Err(ShapeError::InvalidParameter {
                 name: "collider.position",
                 value: f64::NAN,
@@ -132,13 +135,15 @@ impl Collider {
             ShapeDesc::HalfSpace { .. } => None,
             _ => Some(shape.compute_local_aabb()),
         };
-        let rest = pose(desc.position, desc.rotation.normalize());
+        let rest = pose(position, rotation.normalize());
         let start = compose(desc.motion.transform(0.0), &rest);
-        let rest64 = WorldPose::new(desc.position.as_dvec3(), desc.rotation.as_dquat());
+        let rest64 = WorldPose::new(position.as_dvec3(), rotation.as_dquat());
         let start64 = carry(desc.motion, 0.0, &rest64);
         let mesh = match &desc.shape {
             ShapeDesc::TriMesh(m) => {
-                let vertices: Vec<DVec3> = m.vertices.iter().map(|v| v.as_dvec3()).collect();
+                // The mesh parry holds, widened: its contacts and its drawing are one surface.
+                let vertices: Vec<DVec3> =
+                    m.vertices.iter().map(|v| v.as_vec3().as_dvec3()).collect();
                 Some(Box::new(MeshGeometry::new(&vertices, &m.triangles)))
             }
             _ => None,
@@ -235,9 +240,22 @@ impl Collider {
         self.kind
     }
 
-    /// The current pose (at the end of the current substep).
+    /// The current pose (at the end of the current substep) as parry holds it (f32).
     pub fn pose(&self) -> &Pose {
         &self.pose
+    }
+
+    /// The current world pose `(position, rotation)` in f64: the rest placement carried by
+    /// the motion with [`weft_solver::RigidTransform::carry`], the one pose function the
+    /// log uses too.
+    pub fn world_pose(&self) -> (DVec3, DQuat) {
+        (self.pose64.translation, self.pose64.rotation)
+    }
+
+    /// [`Self::world_pose`] as an f32 matrix, for drawing.
+    pub fn world_matrix(&self) -> Mat4 {
+        let (position, rotation) = self.world_pose();
+        Mat4::from_rotation_translation(rotation.as_quat(), position.as_vec3())
     }
 
     /// The prescribed motion.
@@ -440,20 +458,22 @@ fn signed(p: Vec3, proj: &PointProjection, fallback: Vec3) -> (Vec3, Vec3, f32) 
 
 #[cfg(test)]
 mod tests {
+    use glam::Quat;
+
     use super::*;
     use crate::mesh::TriangleMesh;
     use crate::shape::CompoundPart;
 
-    fn at(shape: ShapeDesc, position: Vec3) -> Collider {
+    fn at(shape: ShapeDesc, position: DVec3) -> Collider {
         Collider::new(&ColliderDesc::new(shape).at(position)).expect("valid collider")
     }
 
     /// Signed distance and normal of a point outside and a point inside, per shape.
     #[test]
     fn signed_distance_and_normal_for_every_shape() {
-        let cube_points: Vec<Vec3> = (0..8)
-            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
-            .map(|v| v * 2.0 - Vec3::ONE)
+        let cube_points: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .map(|v| v * 2.0 - DVec3::ONE)
             .collect();
         // The same cube as a closed triangle mesh (vertex i has coordinates from its bits).
         let cube = TriangleMesh::new(
@@ -474,26 +494,26 @@ mod tests {
             ],
         )
         .expect("cube mesh");
-        let up = Vec3::Y * 10.0;
+        let up = DVec3::Y * 10.0;
         let shapes = [
             ShapeDesc::Sphere { radius: 1.0 },
             ShapeDesc::Cuboid {
-                half_extents: Vec3::ONE,
+                half_extents: DVec3::ONE,
             },
             ShapeDesc::Capsule {
                 half_height: 0.5,
                 radius: 0.5,
             },
-            ShapeDesc::HalfSpace { normal: Vec3::Y },
+            ShapeDesc::HalfSpace { normal: DVec3::Y },
             ShapeDesc::ConvexHull {
                 points: cube_points,
             },
             ShapeDesc::Compound(vec![
-                CompoundPart::at(Vec3::new(0.0, 0.5, 0.0), ShapeDesc::Sphere { radius: 0.5 }),
+                CompoundPart::at(DVec3::new(0.0, 0.5, 0.0), ShapeDesc::Sphere { radius: 0.5 }),
                 CompoundPart::at(
-                    Vec3::new(0.0, -2.0, 0.0),
+                    DVec3::new(0.0, -2.0, 0.0),
                     ShapeDesc::Cuboid {
-                        half_extents: Vec3::splat(0.5),
+                        half_extents: DVec3::splat(0.5),
                     },
                 ),
             ]),
@@ -503,14 +523,14 @@ mod tests {
             let kind = shape.kind();
             // The half-space's surface passes through its origin: lift it to match the others.
             let lift = if kind == "half-space" {
-                Vec3::Y
+                DVec3::Y
             } else {
-                Vec3::ZERO
+                DVec3::ZERO
             };
             let c = at(shape, up + lift);
             // Top surface of every shape is at y = 1 (local) → 11 (world).
             let above = c
-                .closest((up + Vec3::new(0.0, 1.3, 0.0)).as_dvec3(), 1.0)
+                .closest(up + DVec3::new(0.0, 1.3, 0.0), 1.0)
                 .unwrap_or_else(|| panic!("{kind}: nothing near"));
             assert!((above.distance - 0.3).abs() < 1e-4, "{kind}: {above:?}");
             assert!(
@@ -518,7 +538,7 @@ mod tests {
                 "{kind}: {above:?}"
             );
             let inside = c
-                .closest((up + Vec3::new(0.0, 0.9, 0.0)).as_dvec3(), 1.0)
+                .closest(up + DVec3::new(0.0, 0.9, 0.0), 1.0)
                 .expect("inside");
             assert!((inside.distance + 0.1).abs() < 1e-4, "{kind}: {inside:?}");
             assert!(
@@ -526,9 +546,38 @@ mod tests {
                 "{kind}: {inside:?}"
             );
             assert!(
-                (inside.point - (up + Vec3::Y).as_dvec3()).length() < 1e-4,
+                (inside.point - (up + DVec3::Y)).length() < 1e-4,
                 "{kind}: {inside:?}"
             );
         }
+    }
+
+    #[test]
+    fn world_pose_follows_rest_pose_and_motion() {
+        let desc = ColliderDesc::new(ShapeDesc::Sphere { radius: 0.1 })
+            .at(DVec3::new(0.0, 1.0, 0.0))
+            .rotated(DQuat::from_rotation_y(0.5))
+            .moving(Motion::Linear {
+                velocity: DVec3::new(2.0, 0.0, 0.0),
+            });
+        let mut c = Collider::new(&desc).expect("valid collider");
+        c.set_time(0.2, 0.25);
+        let (position, rotation) = c.world_pose();
+        assert!(
+            (position - DVec3::new(0.5, 1.0, 0.0)).length() < 1e-12,
+            "{position:?}"
+        );
+        assert!(rotation.angle_between(DQuat::from_rotation_y(0.5)) < 1e-7);
+        let m = c.world_matrix();
+        let origin = m.transform_point3(Vec3::ZERO);
+        assert!(
+            (origin - Vec3::new(0.5, 1.0, 0.0)).length() < 1e-6,
+            "{origin:?}"
+        );
+        let x = m.transform_vector3(Vec3::X);
+        assert!((x - Quat::from_rotation_y(0.5) * Vec3::X).length() < 1e-6);
+        // parry's f32 pose, which the queries of hulls and compounds use, agrees.
+        let (t, r) = (c.pose().translation, c.pose().rotation);
+        assert!(m.abs_diff_eq(Mat4::from_rotation_translation(r, t), 1e-6));
     }
 }

@@ -2,44 +2,52 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use crate::error::MeshError;
 
 /// A validated triangle soup: finite vertices, in-range indices, no degenerate triangle,
-/// no edge shared by more than two triangles.
+/// no edge shared by more than two triangles. Vertices are f64; they are checked, and
+/// collided with, as the f32 that parry holds ([`TriangleMesh::vertices_f32`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TriangleMesh {
     /// Vertex positions (m).
-    pub vertices: Vec<Vec3>,
+    pub vertices: Vec<DVec3>,
     /// Triangles, counter-clockwise seen from outside (the side particles are pushed to).
     pub triangles: Vec<[u32; 3]>,
 }
 
 impl TriangleMesh {
     /// Validates a mesh built in memory (errors name `<memory>` and line 0).
-    pub fn new(vertices: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
+    pub fn new(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
         let lines = vec![0; triangles.len()];
-        validate(Path::new("<memory>"), &vertices, &triangles, &lines, &[])?;
+        let rounded: Vec<Vec3> = vertices.iter().map(|v| v.as_vec3()).collect();
+        validate(Path::new("<memory>"), &rounded, &triangles, &lines, &[])?;
         Ok(Self {
             vertices,
             triangles,
         })
     }
 
+    /// The vertices rounded to f32, as parry holds them.
+    pub fn vertices_f32(&self) -> Vec<Vec3> {
+        self.vertices.iter().map(|v| v.as_vec3()).collect()
+    }
+
     /// Axis-aligned bounds `(min, max)` of the vertices.
-    pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.vertices.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), v| (lo.min(*v), hi.max(*v)),
-        )
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.vertices
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            })
     }
 
     /// A sphere of `radius` about the origin as a closed mesh: the icosahedron with each
     /// triangle split in four `subdivisions` times (20 · 4^k triangles), vertices projected
     /// onto the sphere. Its largest distance from the sphere, between vertices, is below
     /// `radius` · (1 − cos θ) with θ the largest edge's angle.
-    pub fn icosphere(radius: f32, subdivisions: u32) -> Self {
+    pub fn icosphere(radius: f64, subdivisions: u32) -> Self {
         let t = (1.0 + 5f64.sqrt()) / 2.0;
         let mut vertices: Vec<glam::DVec3> = [
             (-1.0, t, 0.0),
@@ -99,16 +107,13 @@ impl TriangleMesh {
             triangles = next;
         }
         Self {
-            vertices: vertices
-                .iter()
-                .map(|v| (*v * f64::from(radius)).as_vec3())
-                .collect(),
+            vertices: vertices.iter().map(|v| *v * radius).collect(),
             triangles,
         }
     }
 
     /// A copy scaled by `scale` about the origin, then moved by `offset`.
-    pub fn transformed(&self, scale: f32, offset: Vec3) -> Self {
+    pub fn transformed(&self, scale: f64, offset: DVec3) -> Self {
         Self {
             vertices: self.vertices.iter().map(|v| *v * scale + offset).collect(),
             triangles: self.triangles.clone(),

@@ -106,7 +106,7 @@ pub fn parse_obj(text: &str, path: impl AsRef<Path>) -> Result<TriangleMesh, Mes
     }
     validate(path, &vertices, &triangles, &lines, &vertex_lines)?;
     Ok(TriangleMesh {
-        vertices,
+        vertices: vertices.iter().map(|v| v.as_dvec3()).collect(),
         triangles,
     })
 }

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use glam::{DVec3, Quat, Vec3};
+use glam::DVec3;
 use weft_solver::{
     ClothMesh, ClothParams, Family, Forces, GridDesc, Mass, Method, Orientation, Settings, Solver,
     SolverBuilder,
@@ -100,8 +100,8 @@ fn falling_sheet(
 }
 
 /// The ground: a half-space below y = `height` with friction.
-pub fn ground(height: f32) -> ColliderDesc {
-    ColliderDesc::new(ShapeDesc::HalfSpace { normal: Vec3::Y }).at(Vec3::Y * height)
+pub fn ground(height: f64) -> ColliderDesc {
+    ColliderDesc::new(ShapeDesc::HalfSpace { normal: DVec3::Y }).at(DVec3::Y * height)
 }
 
 /// Sphere radius of [`sphere_drop`] (m); its centre is the origin.
@@ -116,11 +116,11 @@ pub fn sphere_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld),
     let mut world = CollisionWorld::new(&solver);
     world.add_collider(
         &ColliderDesc::new(ShapeDesc::Sphere {
-            radius: SPHERE_RADIUS as f32,
+            radius: SPHERE_RADIUS,
         })
         .with_friction(Friction::new(0.8, 0.6)),
     )?;
-    world.add_collider(&ground(-SPHERE_RADIUS as f32))?;
+    world.add_collider(&ground(-SPHERE_RADIUS))?;
     Ok((solver, world))
 }
 
@@ -197,8 +197,7 @@ pub fn mesh_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), C
     let mut world = CollisionWorld::new(&solver);
     world.add_collider(
         &ColliderDesc::new(ShapeDesc::from_obj(blob_path(), 1.0)?)
-            .at(Vec3::Y * 0.45)
-            .rotated(Quat::IDENTITY)
+            .at(DVec3::Y * 0.45)
             .with_friction(Friction::new(0.8, 0.6)),
     )?;
     world.add_collider(&ground(0.0))?;
@@ -216,12 +215,12 @@ pub fn icosphere_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorl
     let mut world = CollisionWorld::new(&solver);
     world.add_collider(
         &ColliderDesc::new(ShapeDesc::TriMesh(crate::mesh::TriangleMesh::icosphere(
-            SPHERE_RADIUS as f32,
+            SPHERE_RADIUS,
             ICOSPHERE_SUBDIVISIONS,
         )))
         .with_friction(Friction::new(0.8, 0.6)),
     )?;
-    world.add_collider(&ground(-SPHERE_RADIUS as f32))?;
+    world.add_collider(&ground(-SPHERE_RADIUS))?;
     Ok((solver, world))
 }
 
@@ -231,7 +230,7 @@ pub fn icosphere_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorl
 pub fn breathing_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorld), CollideError> {
     let solver = falling_sheet(method, n, 1.6, SPHERE_RADIUS + 0.25, 0.4)?;
     let mut world = CollisionWorld::new(&solver);
-    let ball = crate::mesh::TriangleMesh::icosphere(SPHERE_RADIUS as f32, 4);
+    let ball = crate::mesh::TriangleMesh::icosphere(SPHERE_RADIUS, 4);
     let breathe = |t: f64, rest: &[DVec3], out: &mut [DVec3]| {
         for (o, v) in out.iter_mut().zip(rest) {
             let phase = std::f64::consts::TAU * (t + 2.0 * v.y);
@@ -242,6 +241,6 @@ pub fn breathing_drop(method: Method, n: usize) -> Result<(Solver, CollisionWorl
         &ColliderDesc::new(ShapeDesc::TriMesh(ball)).with_friction(Friction::new(0.8, 0.6)),
         std::sync::Arc::new(breathe),
     )?;
-    world.add_collider(&ground(-1.1 * SPHERE_RADIUS as f32))?;
+    world.add_collider(&ground(-1.1 * SPHERE_RADIUS))?;
     Ok((solver, world))
 }

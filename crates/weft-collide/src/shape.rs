@@ -1,8 +1,9 @@
-//! Collider shapes as plain descriptions, and their parry `SharedShape`s.
+//! Collider shapes as plain descriptions in f64 (the one form a scene, a test and the
+//! collision world share), and their parry `SharedShape`s in f32.
 
 use std::path::Path;
 
-use glam::{Quat, Vec3};
+use glam::{DQuat, DVec3, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::{SharedShape, TriMesh, TriMeshFlags};
 
@@ -11,35 +12,37 @@ use crate::error::{MeshError, ShapeError};
 use crate::mesh::TriangleMesh;
 use crate::obj::load_obj;
 
-/// A collider's geometry in its own frame (metres).
+/// A collider's geometry in its own frame (metres), in f64. [`ShapeDesc::build`] rounds it to
+/// the f32 that parry holds; the closed-form and triangle-mesh queries use those same rounded
+/// values, widened, so that every query and the drawing see one shape.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeDesc {
     /// A ball centred on the origin.
     Sphere {
         /// Radius (m).
-        radius: f32,
+        radius: f64,
     },
     /// A box centred on the origin.
     Cuboid {
         /// Half the box's size along each axis (m).
-        half_extents: Vec3,
+        half_extents: DVec3,
     },
     /// A capsule along the local y axis, centred on the origin.
     Capsule {
         /// Half the length of its core segment (m).
-        half_height: f32,
+        half_height: f64,
         /// Radius (m).
-        radius: f32,
+        radius: f64,
     },
     /// The half-space below a plane through the origin (a ground).
     HalfSpace {
         /// Outward normal (normalised on build).
-        normal: Vec3,
+        normal: DVec3,
     },
     /// The convex hull of points.
     ConvexHull {
         /// The points (at least 4, not coplanar).
-        points: Vec<Vec3>,
+        points: Vec<DVec3>,
     },
     /// A triangle mesh, pushed out along its (pseudo-)normals; winding gives the outside.
     TriMesh(TriangleMesh),
@@ -51,19 +54,19 @@ pub enum ShapeDesc {
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompoundPart {
     /// Position of the part in the compound's frame (m).
-    pub position: Vec3,
+    pub position: DVec3,
     /// Orientation of the part in the compound's frame.
-    pub rotation: Quat,
+    pub rotation: DQuat,
     /// The part's shape (no triangle mesh, no half-space).
     pub shape: ShapeDesc,
 }
 
 impl CompoundPart {
     /// A part placed at `position` without rotation.
-    pub fn at(position: Vec3, shape: ShapeDesc) -> Self {
+    pub fn at(position: DVec3, shape: ShapeDesc) -> Self {
         Self {
             position,
-            rotation: Quat::IDENTITY,
+            rotation: DQuat::IDENTITY,
             shape,
         }
     }
@@ -83,10 +86,10 @@ fn positive(name: &'static str, value: f32) -> Result<(), ShapeError> {
 
 impl ShapeDesc {
     /// A triangle-mesh shape read from an OBJ file, scaled about the file's origin.
-    pub fn from_obj(path: impl AsRef<Path>, scale: f32) -> Result<Self, ShapeError> {
-        positive("scale", scale)?;
+    pub fn from_obj(path: impl AsRef<Path>, scale: f64) -> Result<Self, ShapeError> {
+        positive("scale", scale as f32)?;
         Ok(Self::TriMesh(
-            load_obj(path)?.transformed(scale, Vec3::ZERO),
+            load_obj(path)?.transformed(scale, DVec3::ZERO),
         ))
     }
 
@@ -103,14 +106,16 @@ impl ShapeDesc {
         }
     }
 
-    /// Validates the description and builds parry's shape.
+    /// Validates the description, rounded to f32 as parry holds it, and builds parry's shape.
     pub fn build(&self) -> Result<SharedShape, ShapeError> {
         match self {
             Self::Sphere { radius } => {
-                positive("sphere.radius", *radius)?;
-                Ok(SharedShape::ball(*radius))
+                let radius = *radius as f32;
+                positive("sphere.radius", radius)?;
+                Ok(SharedShape::ball(radius))
             }
-            Self::Cuboid { half_extents: h } => {
+            Self::Cuboid { half_extents } => {
+                let h = half_extents.as_vec3();
                 for c in h.to_array() {
                     positive("cuboid.half_extents", c)?;
                 }
@@ -120,17 +125,19 @@ impl ShapeDesc {
                 half_height,
                 radius,
             } => {
-                positive("capsule.radius", *radius)?;
-                if !(half_height.is_finite() && *half_height >= 0.0) {
+                let (half_height, radius) = (*half_height as f32, *radius as f32);
+                positive("capsule.radius", radius)?;
+                if !(half_height.is_finite() && half_height >= 0.0) {
                     return Err(ShapeError::InvalidParameter {
                         name: "capsule.half_height",
-                        value: (*half_height).into(),
+                        value: half_height.into(),
                         expected: "finite and >= 0",
                     });
                 }
-                Ok(SharedShape::capsule_y(*half_height, *radius))
+                Ok(SharedShape::capsule_y(half_height, radius))
             }
             Self::HalfSpace { normal } => {
+                let normal = normal.as_vec3();
                 let n = normal.normalize_or_zero();
                 if n == Vec3::ZERO || !n.is_finite() {
                     return Err(ShapeError::InvalidParameter {
@@ -142,6 +149,7 @@ impl ShapeDesc {
                 Ok(SharedShape::halfspace(n))
             }
             Self::ConvexHull { points } => {
+                let points: Vec<Vec3> = points.iter().map(|p| p.as_vec3()).collect();
                 if points.len() < 4 || points.iter().any(|p| !p.is_finite()) {
                     return Err(ShapeError::DegenerateHull {
                         points: points.len(),
@@ -181,30 +189,22 @@ impl ShapeDesc {
                         points: points.len(),
                     });
                 }
-                SharedShape::convex_hull(points).ok_or(ShapeError::DegenerateHull {
+                SharedShape::convex_hull(&points).ok_or(ShapeError::DegenerateHull {
                     points: points.len(),
                 })
             }
             Self::TriMesh(mesh) => {
                 // Re-validate: the fields are public and may have been edited after loading.
-                crate::mesh::validate(
-                    Path::new("<memory>"),
-                    &mesh.vertices,
-                    &mesh.triangles,
-                    &[],
-                    &[],
-                )?;
+                let vertices = mesh.vertices_f32();
+                crate::mesh::validate(Path::new("<memory>"), &vertices, &mesh.triangles, &[], &[])?;
                 // ORIENTED computes pseudo-normals, so that "inside" (behind the surface) is
                 // decided correctly at edges and vertices too.
-                let trimesh = TriMesh::with_flags(
-                    mesh.vertices.clone(),
-                    mesh.triangles.clone(),
-                    TriMeshFlags::ORIENTED,
-                )
-                .map_err(|e| MeshError::Parry {
-                    path: "<memory>".into(),
-                    reason: e.to_string(),
-                })?;
+                let trimesh =
+                    TriMesh::with_flags(vertices, mesh.triangles.clone(), TriMeshFlags::ORIENTED)
+                        .map_err(|e| MeshError::Parry {
+                        path: "<memory>".into(),
+                        reason: e.to_string(),
+                    })?;
                 Ok(SharedShape::new(trimesh))
             }
             Self::Compound(parts) => {
@@ -226,14 +226,15 @@ fn flatten(
     out: &mut Vec<(Pose, SharedShape)>,
 ) -> Result<(), ShapeError> {
     for part in parts {
-        if !(part.position.is_finite() && part.rotation.is_finite()) {
+        let (position, rotation) = (part.position.as_vec3(), part.rotation.as_quat());
+        if !(position.is_finite() && rotation.is_finite()) {
             return Err(ShapeError::InvalidParameter {
                 name: "compound.part.position",
                 value: f64::NAN,
                 expected: "finite position and rotation",
             });
         }
-        let local = *parent * pose(part.position, part.rotation.normalize());
+        let local = *parent * pose(position, rotation.normalize());
         match &part.shape {
             ShapeDesc::Compound(inner) => flatten(inner, &local, out)?,
             ShapeDesc::TriMesh(_) | ShapeDesc::HalfSpace { .. } => {

@@ -1,12 +1,11 @@
 //! Colliders as triangle meshes for drawing: each parry shape tessellated in its local frame
-//! (parry's own `to_trimesh` where it has one), and the world pose of a collider at a time.
+//! (parry's own `to_trimesh` where it has one).
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::Shape;
 
-use crate::collider::{Collider, ColliderDesc};
-use crate::convert::{compose, pose};
+use crate::collider::Collider;
 
 /// Longitude subdivisions of balls and capsules.
 const ROUND_THETA: u32 = 48;
@@ -88,31 +87,11 @@ impl Collider {
         let h = self.shape().as_halfspace()?;
         Some((self.pose().rotation * h.normal).normalize_or_zero())
     }
-
-    /// The collider's current world pose (where the last substep left it) as a matrix.
-    pub fn world_matrix(&self) -> Mat4 {
-        matrix(self.pose())
-    }
-}
-
-impl ColliderDesc {
-    /// The world pose at time `t` (s) of a collider built from this description, as a
-    /// matrix: its rest placement carried by its prescribed motion, as the collision world
-    /// places it.
-    pub fn world_matrix_at(&self, t: f64) -> Mat4 {
-        let rest = pose(self.position, self.rotation.normalize());
-        matrix(&compose(self.motion.transform(t), &rest))
-    }
-}
-
-fn matrix(p: &Pose) -> Mat4 {
-    Mat4::from_rotation_translation(p.rotation, p.translation)
 }
 
 #[cfg(test)]
 mod tests {
     use glam::{DVec3, Vec3};
-    use weft_solver::Motion;
 
     use super::*;
     use crate::collider::ColliderDesc;
@@ -149,7 +128,10 @@ mod tests {
     #[test]
     fn cuboid_bounds_are_the_half_extents() {
         let h = Vec3::new(0.5, 0.2, 1.5);
-        let m = build(ShapeDesc::Cuboid { half_extents: h }).tessellate();
+        let m = build(ShapeDesc::Cuboid {
+            half_extents: h.as_dvec3(),
+        })
+        .tessellate();
         check_indices(&m);
         let (lo, hi) = bounds(&m.0);
         assert!((hi - h).abs().max_element() < 1e-6, "{hi:?}");
@@ -159,10 +141,10 @@ mod tests {
 
     #[test]
     fn capsule_points_are_at_radius_from_its_core_segment() {
-        let (hh, r) = (0.4, 0.1);
+        let (hh, r) = (0.4f32, 0.1f32);
         let m = build(ShapeDesc::Capsule {
-            half_height: hh,
-            radius: r,
+            half_height: hh.into(),
+            radius: r.into(),
         })
         .tessellate();
         check_indices(&m);
@@ -177,7 +159,9 @@ mod tests {
     #[test]
     fn half_space_is_a_large_square_on_its_plane() {
         let n = Vec3::new(0.0, 1.0, 1.0).normalize();
-        let c = build(ShapeDesc::HalfSpace { normal: n });
+        let c = build(ShapeDesc::HalfSpace {
+            normal: n.as_dvec3(),
+        });
         assert!((c.half_space_normal().expect("a half-space") - n).length() < 1e-6);
         assert!(
             build(ShapeDesc::Sphere { radius: 1.0 })
@@ -198,11 +182,11 @@ mod tests {
     #[test]
     fn convex_hull_keeps_its_extreme_points() {
         let points = vec![
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::Y,
-            Vec3::Z,
-            Vec3::splat(0.1), // interior: dropped by the hull
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::splat(0.1), // interior: dropped by the hull
         ];
         let m = build(ShapeDesc::ConvexHull { points }).tessellate();
         check_indices(&m);
@@ -214,22 +198,25 @@ mod tests {
     #[test]
     fn triangle_mesh_is_passed_through() {
         let mesh = TriangleMesh {
-            vertices: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+            vertices: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
             triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
         };
         let m = build(ShapeDesc::TriMesh(mesh.clone())).tessellate();
-        assert_eq!(m.0, mesh.vertices);
+        assert_eq!(m.0, mesh.vertices_f32());
         assert_eq!(m.1, mesh.triangles);
     }
 
     #[test]
     fn compound_parts_sit_at_their_poses() {
         let c = build(ShapeDesc::Compound(vec![
-            CompoundPart::at(Vec3::new(1.0, 0.0, 0.0), ShapeDesc::Sphere { radius: 0.25 }),
             CompoundPart::at(
-                Vec3::new(-1.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                ShapeDesc::Sphere { radius: 0.25 },
+            ),
+            CompoundPart::at(
+                DVec3::new(-1.0, 0.0, 0.0),
                 ShapeDesc::Cuboid {
-                    half_extents: Vec3::splat(0.5),
+                    half_extents: DVec3::splat(0.5),
                 },
             ),
         ]));
@@ -243,27 +230,5 @@ mod tests {
                 .filter(|p| (**p - Vec3::X).length() < 0.3)
                 .count();
         assert!(near_ball > 100, "the ball's vertices are around x = 1");
-    }
-
-    #[test]
-    fn world_matrix_follows_rest_pose_and_motion() {
-        let desc = ColliderDesc::new(ShapeDesc::Sphere { radius: 0.1 })
-            .at(Vec3::new(0.0, 1.0, 0.0))
-            .rotated(Quat::from_rotation_y(0.5))
-            .moving(Motion::Linear {
-                velocity: DVec3::new(2.0, 0.0, 0.0),
-            });
-        let mut c = Collider::new(&desc).expect("valid collider");
-        let m = desc.world_matrix_at(0.25);
-        let origin = m.transform_point3(Vec3::ZERO);
-        assert!(
-            (origin - Vec3::new(0.5, 1.0, 0.0)).length() < 1e-6,
-            "{origin:?}"
-        );
-        let x = m.transform_vector3(Vec3::X);
-        assert!((x - Quat::from_rotation_y(0.5) * Vec3::X).length() < 1e-6);
-        // The collider's own pose agrees once the collision world moves it to t.
-        c.set_time(0.2, 0.25);
-        assert!(c.world_matrix().abs_diff_eq(m, 1e-6));
     }
 }

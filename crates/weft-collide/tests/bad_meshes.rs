@@ -6,7 +6,7 @@ use weft_collide::{
     ColliderDesc, CollisionWorld, CompoundPart, Friction, MeshError, ShapeDesc, ShapeError,
     TriangleMesh, load_obj, parse_obj,
 };
-use weft_solver::glam::Vec3;
+use weft_solver::glam::DVec3;
 
 const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
 
@@ -151,7 +151,7 @@ fn non_manifold_edge_names_the_third_face() {
 fn empty_mesh_is_an_error() {
     let err = parse_obj("# nothing\nv 0 0 0\n", "empty.obj").expect_err("must be rejected");
     assert!(matches!(err, MeshError::Empty { .. }), "{err:?}");
-    let err = TriangleMesh::new(vec![Vec3::ZERO], vec![]).expect_err("must be rejected");
+    let err = TriangleMesh::new(vec![DVec3::ZERO], vec![]).expect_err("must be rejected");
     assert!(matches!(err, MeshError::Empty { .. }), "{err:?}");
 }
 
@@ -171,7 +171,7 @@ fn bad_shapes_are_rejected_with_the_reason() {
     ));
     assert!(matches!(
         build(ShapeDesc::Cuboid {
-            half_extents: Vec3::new(1.0, f32::NAN, 1.0)
+            half_extents: DVec3::new(1.0, f64::NAN, 1.0)
         }),
         ShapeError::InvalidParameter {
             name: "cuboid.half_extents",
@@ -179,7 +179,9 @@ fn bad_shapes_are_rejected_with_the_reason() {
         }
     ));
     assert!(matches!(
-        build(ShapeDesc::HalfSpace { normal: Vec3::ZERO }),
+        build(ShapeDesc::HalfSpace {
+            normal: DVec3::ZERO
+        }),
         ShapeError::InvalidParameter {
             name: "half_space.normal",
             ..
@@ -187,7 +189,7 @@ fn bad_shapes_are_rejected_with_the_reason() {
     ));
     // Coplanar points have no volume: an error, not a panic inside the hull algorithm.
     let flat = (0..6)
-        .map(|i| Vec3::new(i as f32, (i * i) as f32, 0.0))
+        .map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0))
         .collect();
     assert!(matches!(
         build(ShapeDesc::ConvexHull { points: flat }),
@@ -199,8 +201,8 @@ fn bad_shapes_are_rejected_with_the_reason() {
     ));
     let mesh = parse_obj(TETRA, "tetra.obj").expect("valid");
     let err = build(ShapeDesc::Compound(vec![
-        CompoundPart::at(Vec3::ZERO, ShapeDesc::Sphere { radius: 1.0 }),
-        CompoundPart::at(Vec3::X, ShapeDesc::TriMesh(mesh)),
+        CompoundPart::at(DVec3::ZERO, ShapeDesc::Sphere { radius: 1.0 }),
+        CompoundPart::at(DVec3::X, ShapeDesc::TriMesh(mesh)),
     ]));
     assert!(
         matches!(
@@ -214,7 +216,7 @@ fn bad_shapes_are_rejected_with_the_reason() {
     );
     // A mesh edited after loading is re-validated when built.
     let mut edited = parse_obj(TETRA, "tetra.obj").expect("valid");
-    edited.vertices[2] = Vec3::splat(f32::INFINITY);
+    edited.vertices[2] = DVec3::splat(f64::INFINITY);
     assert!(matches!(
         build(ShapeDesc::TriMesh(edited)),
         ShapeError::Mesh(MeshError::NonFiniteVertex { vertex: 2, .. })

@@ -40,13 +40,13 @@ fn draped_cloth_with_dihedral_bending_loses_energy_under_xpbd_and_pbd() {
         world
             .add_collider(
                 &ColliderDesc::new(ShapeDesc::Sphere {
-                    radius: SPHERE_RADIUS as f32,
+                    radius: SPHERE_RADIUS,
                 })
                 .with_friction(Friction::new(0.8, 0.6)),
             )
             .expect("valid sphere");
         world
-            .add_collider(&ground(-SPHERE_RADIUS as f32))
+            .add_collider(&ground(-SPHERE_RADIUS))
             .expect("valid ground");
         // Potential energy above the ground, the most the cloth could turn into motion.
         let potential = MASS * 9.81 * (HEIGHT + SPHERE_RADIUS);

@@ -40,11 +40,9 @@ fn slide(friction: Friction) -> f64 {
     let mut world = CollisionWorld::new(&solver);
     world
         .add_collider(
-            &ColliderDesc::new(ShapeDesc::Cuboid {
-                half_extents: half.as_vec3(),
-            })
-            .rotated(tilt.as_quat())
-            .with_friction(friction),
+            &ColliderDesc::new(ShapeDesc::Cuboid { half_extents: half })
+                .rotated(tilt)
+                .with_friction(friction),
         )
         .expect("box");
     let centroid = |p: &[DVec3]| p.iter().sum::<DVec3>() / p.len() as f64;

@@ -1,7 +1,7 @@
 //! A kinematic collider follows its prescribed motion exactly and pushes the cloth ahead of it.
 
 use weft_collide::{ColliderDesc, CollisionWorld, Friction, ShapeDesc};
-use weft_solver::glam::{DQuat, DVec3, Quat, Vec3};
+use weft_solver::glam::{DQuat, DVec3, Vec3};
 mod common;
 
 use weft_solver::{ClothParams, Forces, Motion, Settings, SolverBuilder};
@@ -28,12 +28,10 @@ fn moving_sphere_follows_its_motion_and_pushes_a_curtain() {
     let velocity = DVec3::new(0.0, 0.0, 0.5);
     world
         .add_collider(
-            &ColliderDesc::new(ShapeDesc::Sphere {
-                radius: RADIUS as f32,
-            })
-            .at(start.as_vec3())
-            .moving(Motion::Linear { velocity })
-            .with_friction(Friction::new(0.3, 0.2)),
+            &ColliderDesc::new(ShapeDesc::Sphere { radius: RADIUS })
+                .at(start)
+                .moving(Motion::Linear { velocity })
+                .with_friction(Friction::new(0.3, 0.2)),
         )
         .expect("sphere");
     let seconds = 1.6;
@@ -94,10 +92,10 @@ fn rotating_box_pose_matches_motion() {
     world
         .add_collider(
             &ColliderDesc::new(ShapeDesc::Cuboid {
-                half_extents: Vec3::splat(0.1),
+                half_extents: DVec3::splat(0.1),
             })
-            .at(rest.as_vec3())
-            .rotated(Quat::from_rotation_x(0.3))
+            .at(rest)
+            .rotated(DQuat::from_rotation_x(0.3))
             .moving(motion),
         )
         .expect("box");

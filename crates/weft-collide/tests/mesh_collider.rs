@@ -45,14 +45,14 @@ fn cloth_dropped_on_obj_mesh_stays_outside() {
 #[test]
 fn fast_cloth_does_not_tunnel_through_thin_mesh() {
     use weft_collide::{ColliderDesc, CollisionWorld, ShapeDesc, TriangleMesh};
-    use weft_solver::glam::{DVec3, Vec3};
+    use weft_solver::glam::DVec3;
     use weft_solver::{ClothParams, Forces, GridDesc, Mass, Orientation, Settings, SolverBuilder};
     let quad = TriangleMesh::new(
         vec![
-            Vec3::new(-1.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, 1.0),
-            Vec3::new(-1.0, 0.0, 1.0),
+            DVec3::new(-1.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(-1.0, 0.0, 1.0),
         ],
         // Counter-clockwise seen from above: the outside is +y.
         vec![[0, 2, 1], [0, 3, 2]],

@@ -8,7 +8,7 @@ mod common;
 use std::sync::Arc;
 
 use weft_collide::{ColliderDesc, CollisionWorld, Friction, Keyframes, ShapeDesc, TriangleMesh};
-use weft_solver::glam::{DVec3, Vec3};
+use weft_solver::glam::DVec3;
 use weft_solver::{
     ClothParams, Forces, GridDesc, Mass, Orientation, Settings, Solver, SolverBuilder,
 };
@@ -28,7 +28,7 @@ fn inner_radius(m: &TriangleMesh) -> f64 {
     m.triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| m.vertices[i as usize].as_dvec3());
+            let [a, b, c] = t.map(|i| m.vertices[i as usize]);
             // The origin's closest point: minimise over a fine barycentric sampling is too
             // slow; the faces of a convex mesh about the origin are nearest at their plane.
             let n = (b - a).cross(c - a).normalize();
@@ -89,7 +89,7 @@ fn particles_inside_a_closed_mesh_leave_through_the_near_side() {
 #[test]
 fn cloth_on_a_fine_sphere_mesh_stays_a_thickness_off() {
     let radius = 0.4;
-    let sphere = TriangleMesh::icosphere(radius as f32, 5);
+    let sphere = TriangleMesh::icosphere(radius, 5);
     assert_eq!(sphere.triangles.len(), 20_480);
     let inner = inner_radius(&sphere);
     assert!(
@@ -166,7 +166,7 @@ fn fast_blade_does_not_tunnel_through_a_hanging_cloth() {
     let (z0, z1, t0, t1) = (-0.2, 0.16, 0.05, 0.065);
     let speed = (z1 - z0) / (t1 - t0);
     let keys = Keyframes::new(vec![t0, t1], vec![blade_at(z0), blade_at(z1)]).expect("keys");
-    let rest: Vec<Vec3> = blade_at(z0).iter().map(|v| v.as_vec3()).collect();
+    let rest = blade_at(z0);
     // Seen from +z the corners run counter-clockwise: the normal is +z.
     let blade = TriangleMesh::new(rest, vec![[0, 1, 2], [0, 2, 3]]).expect("blade");
     world

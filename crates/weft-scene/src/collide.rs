@@ -1,72 +1,19 @@
 //! Wires a scene's colliders and self-collision to `weft-collide`: one collision world per
-//! solver, holding every collider (colliders are f64 here, f32 inside parry).
+//! solver, holding every collider (colliders are f64 here, rounded to f32 inside parry).
 
-use weft_collide::{
-    ColliderDesc, CollisionWorld, CompoundPart, Friction, SelfCollisionParams, ShapeDesc,
-    TriangleMesh,
-};
+use weft_collide::{ColliderDesc, CollisionWorld, Friction, SelfCollisionParams};
 use weft_solver::Solver;
-use weft_solver::glam::{DQuat, DVec3, Quat, Vec3};
 
 use crate::error::{Origin, SceneError};
-use crate::scene::{ColliderSpec, Scene, ShapeSpec};
+use crate::scene::{ColliderSpec, Scene};
 
-fn v(p: DVec3) -> Vec3 {
-    p.as_vec3()
-}
-
-fn q(r: DQuat) -> Quat {
-    Quat::from_xyzw(r.x as f32, r.y as f32, r.z as f32, r.w as f32)
-}
-
-fn shape_desc(s: &ShapeSpec) -> Result<ShapeDesc, String> {
-    Ok(match s {
-        ShapeSpec::Sphere { radius } => ShapeDesc::Sphere {
-            radius: *radius as f32,
-        },
-        ShapeSpec::Cuboid { half_extents } => ShapeDesc::Cuboid {
-            half_extents: v(*half_extents),
-        },
-        ShapeSpec::Capsule {
-            half_height,
-            radius,
-        } => ShapeDesc::Capsule {
-            half_height: *half_height as f32,
-            radius: *radius as f32,
-        },
-        ShapeSpec::Plane { normal } => ShapeDesc::HalfSpace { normal: v(*normal) },
-        ShapeSpec::ConvexHull { points } => ShapeDesc::ConvexHull {
-            points: points.iter().map(|p| v(*p)).collect(),
-        },
-        ShapeSpec::Mesh {
-            positions,
-            triangles,
-        } => ShapeDesc::TriMesh(
-            TriangleMesh::new(positions.iter().map(|p| v(*p)).collect(), triangles.clone())
-                .map_err(|e| e.to_string())?,
-        ),
-        ShapeSpec::Compound(parts) => ShapeDesc::Compound(
-            parts
-                .iter()
-                .map(|(p, r, s)| {
-                    Ok(CompoundPart {
-                        position: v(*p),
-                        rotation: q(*r),
-                        shape: shape_desc(s)?,
-                    })
-                })
-                .collect::<Result<_, String>>()?,
-        ),
-    })
-}
-
-/// The collision crate's description of a collider.
-pub fn collider_desc(c: &ColliderSpec) -> Result<ColliderDesc, String> {
-    Ok(ColliderDesc::new(shape_desc(&c.shape)?)
-        .at(v(c.position))
-        .rotated(q(c.rotation))
+/// The collision crate's description of a collider (the shape is already in its form).
+pub fn collider_desc(c: &ColliderSpec) -> ColliderDesc {
+    ColliderDesc::new(c.shape.clone())
+        .at(c.position)
+        .rotated(c.rotation)
         .moving(c.motion)
-        .with_friction(Friction::new(c.static_friction, c.dynamic_friction)))
+        .with_friction(Friction::new(c.static_friction, c.dynamic_friction))
 }
 
 impl Scene {
@@ -103,9 +50,8 @@ impl Scene {
         let mut world = CollisionWorld::new(solver);
         for (i, c) in self.colliders.iter().enumerate() {
             let key = format!("collider[{i}]");
-            let desc = collider_desc(c).map_err(|m| self.collide_error(key.clone(), m))?;
             world
-                .add_collider(&desc)
+                .add_collider(&collider_desc(c))
                 .map_err(|e| self.collide_error(key, e.to_string()))?;
         }
         if let Some(sc) = &self.self_collision

@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use weft_collide::ShapeDesc;
 use weft_solver::glam::{DQuat, DVec3};
 use weft_solver::{ClothMesh, ClothParams, Forces, Method, Motion, Settings};
 
@@ -103,54 +104,13 @@ pub struct ClothSpec {
     pub motion: Motion,
 }
 
-/// A collider's geometry in its own frame (f64; converted by the collision crate).
-#[derive(Clone, Debug, PartialEq)]
-pub enum ShapeSpec {
-    /// Ball.
-    Sphere {
-        /// Radius (m).
-        radius: f64,
-    },
-    /// Box.
-    Cuboid {
-        /// Half extents (m).
-        half_extents: DVec3,
-    },
-    /// Capsule along local y.
-    Capsule {
-        /// Half height of the core segment (m).
-        half_height: f64,
-        /// Radius (m).
-        radius: f64,
-    },
-    /// Half-space below the plane through the collider's position.
-    Plane {
-        /// Outward normal.
-        normal: DVec3,
-    },
-    /// Convex hull.
-    ConvexHull {
-        /// Points (m).
-        points: Vec<DVec3>,
-    },
-    /// Triangle mesh.
-    Mesh {
-        /// Vertices (m, scaled).
-        positions: Vec<DVec3>,
-        /// Triangles.
-        triangles: Vec<[u32; 3]>,
-    },
-    /// Convex parts, each placed in the compound's frame.
-    Compound(Vec<(DVec3, DQuat, ShapeSpec)>),
-}
-
 /// A collider ready for the collision world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColliderSpec {
     /// Name.
     pub name: String,
-    /// Geometry.
-    pub shape: ShapeSpec,
+    /// Geometry, in the collision crate's one form (f64).
+    pub shape: ShapeDesc,
     /// Position (m).
     pub position: DVec3,
     /// Orientation.

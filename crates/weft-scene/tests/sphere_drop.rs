@@ -18,7 +18,7 @@ fn the_shipped_sheet_drapes_on_the_ball_without_penetration_for_every_method() {
         .iter()
         .find(|c| c.name == "ball")
         .expect("the scene has a ball");
-    let weft_scene::ShapeSpec::Sphere { radius } = ball.shape else {
+    let weft_collide::ShapeDesc::Sphere { radius } = ball.shape else {
         panic!("the ball is a sphere");
     };
     let centre_of_ball = ball.position;

@@ -3,7 +3,7 @@
 
 mod common;
 
-use weft_scene::ShapeSpec;
+use weft_collide::{CompoundPart, ShapeDesc};
 use weft_solver::Method;
 
 #[test]
@@ -11,11 +11,16 @@ fn the_shipped_tablecloth_drapes_over_the_table_edges() {
     let path = common::scenes_dir().join("table_drape.toml");
     let scene = common::load(&path, &[]);
     let table = &scene.colliders[0];
-    let ShapeSpec::Compound(parts) = &table.shape else {
+    let ShapeDesc::Compound(parts) = &table.shape else {
         panic!("the table is a compound");
     };
     // The table's top is its first part, a cuboid.
-    let (at, _, ShapeSpec::Cuboid { half_extents }) = &parts[0] else {
+    let CompoundPart {
+        position: at,
+        shape: ShapeDesc::Cuboid { half_extents },
+        ..
+    } = &parts[0]
+    else {
         panic!("the table's first part is its top, a cuboid");
     };
     let top = table.position.y + at.y + half_extents.y;

@@ -16,7 +16,7 @@ fn bumpy_sphere() -> TriangleMesh {
     let mut m = TriangleMesh::icosphere(0.5, 3);
     let mut rng = Rng(11);
     for v in &mut m.vertices {
-        *v *= 1.0 + 0.25 * rng.next() as f32;
+        *v = (v.as_vec3() * (1.0 + 0.25 * rng.next() as f32)).as_dvec3();
     }
     m
 }
@@ -29,7 +29,7 @@ fn bumpy_sheet() -> TriangleMesh {
     for j in 0..=n {
         for i in 0..=n {
             let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
-            vertices.push(Vec3::new(x, 0.1 * rng.next() as f32, z));
+            vertices.push(Vec3::new(x, 0.1 * rng.next() as f32, z).as_dvec3());
         }
     }
     let mut triangles = Vec::new();
@@ -48,7 +48,7 @@ fn bumpy_sheet() -> TriangleMesh {
 fn winding(m: &TriangleMesh, x: DVec3) -> f64 {
     let mut sum = 0.0;
     for t in &m.triangles {
-        let [a, b, c] = t.map(|i| m.vertices[i as usize].as_dvec3() - x);
+        let [a, b, c] = t.map(|i| m.vertices[i as usize] - x);
         let (la, lb, lc) = (a.length(), b.length(), c.length());
         let num = a.dot(b.cross(c));
         let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
@@ -63,7 +63,7 @@ fn points(m: &TriangleMesh, rng: &mut Rng, count: usize) -> Vec<DVec3> {
         .map(|k| {
             let t =
                 m.triangles[(rng.next() * m.triangles.len() as f64) as usize % m.triangles.len()];
-            let [a, b, _] = t.map(|i| m.vertices[i as usize].as_dvec3());
+            let [a, b, _] = t.map(|i| m.vertices[i as usize]);
             match k % 3 {
                 0 => rng.cube(0.8),
                 1 => a + rng.cube(0.05),
@@ -77,10 +77,7 @@ fn points(m: &TriangleMesh, rng: &mut Rng, count: usize) -> Vec<DVec3> {
 fn icosphere_is_closed_and_wound_outwards() {
     let m = TriangleMesh::icosphere(1.0, 2);
     assert_eq!(m.triangles.len(), 320);
-    let g = MeshGeometry::new(
-        &m.vertices.iter().map(|v| v.as_dvec3()).collect::<Vec<_>>(),
-        &m.triangles,
-    );
+    let g = MeshGeometry::new(&m.vertices, &m.triangles);
     assert!(g.closed());
     // Outward winding: positive volume (divergence theorem), near (4/3)π.
     let volume: f64 = g
@@ -93,17 +90,7 @@ fn icosphere_is_closed_and_wound_outwards() {
         volume > 4.0 && volume < 4.0 / 3.0 * std::f64::consts::PI,
         "{volume}"
     );
-    assert!(
-        !MeshGeometry::new(
-            &bumpy_sheet()
-                .vertices
-                .iter()
-                .map(|v| v.as_dvec3())
-                .collect::<Vec<_>>(),
-            &bumpy_sheet().triangles
-        )
-        .closed()
-    );
+    assert!(!MeshGeometry::new(&bumpy_sheet().vertices, &bumpy_sheet().triangles).closed());
 }
 
 /// Closest point, distance and inside/outside against brute force and the winding number,
@@ -120,8 +107,8 @@ fn closest_points_and_signs_match_brute_force_and_parry() {
         let turn = Quat::from_axis_angle(Vec3::new(0.2, 1.0, -0.4).normalize(), 1.1);
         let c = Collider::new(
             &ColliderDesc::new(ShapeDesc::TriMesh(m.clone()))
-                .at(place)
-                .rotated(turn),
+                .at(place.as_dvec3())
+                .rotated(turn.as_dquat()),
         )
         .expect("mesh collider");
         let pose = crate::analytic::WorldPose::new(place.as_dvec3(), turn.as_dquat());
@@ -133,7 +120,7 @@ fn closest_points_and_signs_match_brute_force_and_parry() {
             // Brute force over every triangle, in the mesh's frame.
             let mut best = (f64::INFINITY, DVec3::ZERO, Feature::Face);
             for t in &m.triangles {
-                let [a, b, cc] = t.map(|i| m.vertices[i as usize].as_dvec3());
+                let [a, b, cc] = t.map(|i| m.vertices[i as usize]);
                 let q = closest_on_triangle(local, a, b, cc);
                 let d = (local - q.point).length();
                 if d < best.0 {
@@ -218,7 +205,7 @@ fn sweep_finds_the_first_crossing() {
         let (from, to) = (rng.cube(0.9), rng.cube(0.9));
         let mut best: Option<f64> = None;
         for t in &m.triangles {
-            let [a, b, cc] = t.map(|i| m.vertices[i as usize].as_dvec3());
+            let [a, b, cc] = t.map(|i| m.vertices[i as usize]);
             let n = (b - a).cross(cc - a).normalize();
             if let Some(h) = super::ccd::segment_crossing(from, to, [a, b, cc], n, true) {
                 best = Some(best.map_or(h.t, |b: f64| b.min(h.t)));

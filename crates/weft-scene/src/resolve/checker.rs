@@ -150,8 +150,7 @@ impl<'a> Checker<'a> {
         // One OBJ reader serves colliders and cloths; its errors name the file and line.
         match weft_collide::parse_obj(&text, path) {
             Ok(m) => {
-                let positions: Vec<DVec3> =
-                    m.vertices.iter().map(|p| p.as_dvec3() * scale).collect();
+                let positions: Vec<DVec3> = m.vertices.iter().map(|p| *p * scale).collect();
                 let far = positions
                     .iter()
                     .position(|p| !p.is_finite() || p.abs().max_element() > ranges::COORDINATE.hi);

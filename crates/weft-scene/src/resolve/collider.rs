@@ -1,11 +1,13 @@
 //! A `[[collider]]` table: its shape (one of the primitives, a hull, an OBJ mesh or a compound
-//! of convex parts), pose, motion and friction, checked into a [`ColliderSpec`].
+//! of convex parts), pose, motion and friction, checked into a [`ColliderSpec`] whose shape
+//! is the collision crate's [`ShapeDesc`].
 
-use weft_solver::glam::{DQuat, DVec3};
+use weft_collide::{CompoundPart, ShapeDesc, TriangleMesh};
+use weft_solver::glam::DVec3;
 
 use super::{Checker, valid_name};
 use crate::ranges;
-use crate::scene::{ColliderSpec, ShapeSpec};
+use crate::scene::ColliderSpec;
 use crate::schema::{ColliderSection, PartSection, ShapeKind};
 
 struct Geometry<'s> {
@@ -17,7 +19,7 @@ struct Geometry<'s> {
     points: &'s Option<Vec<[f64; 3]>>,
 }
 
-fn shape(c: &mut Checker<'_>, key: &str, g: &Geometry<'_>) -> Option<ShapeSpec> {
+fn shape(c: &mut Checker<'_>, key: &str, g: &Geometry<'_>) -> Option<ShapeDesc> {
     let k = |f: &str| format!("{key}.{f}");
     let what = format!("by a {:?} shape", g.shape).to_lowercase();
     let need = |c: &mut Checker<'_>, f: &str, v: Option<f64>| -> f64 {
@@ -49,7 +51,7 @@ fn shape(c: &mut Checker<'_>, key: &str, g: &Geometry<'_>) -> Option<ShapeSpec> 
         c.unused(&k("points"), g.points, &what);
     }
     Some(match g.shape {
-        S::Sphere => ShapeSpec::Sphere {
+        S::Sphere => ShapeDesc::Sphere {
             radius: need(c, "radius", g.radius),
         },
         S::Cuboid => {
@@ -61,12 +63,12 @@ fn shape(c: &mut Checker<'_>, key: &str, g: &Geometry<'_>) -> Option<ShapeSpec> 
             if v.min_element() <= 0.0 {
                 c.bad(&k("half_extents"), "every component must be > 0");
             }
-            ShapeSpec::Cuboid { half_extents: v }
+            ShapeDesc::Cuboid { half_extents: v }
         }
         S::Capsule => {
             let half_height = g.half_height.unwrap_or(0.0);
             c.non_negative(&k("half_height"), half_height);
-            ShapeSpec::Capsule {
+            ShapeDesc::Capsule {
                 half_height,
                 radius: need(c, "radius", g.radius),
             }
@@ -76,7 +78,7 @@ fn shape(c: &mut Checker<'_>, key: &str, g: &Geometry<'_>) -> Option<ShapeSpec> 
             if n.length_squared() == 0.0 {
                 c.bad(&k("normal"), "must not be zero");
             }
-            ShapeSpec::Plane { normal: n }
+            ShapeDesc::HalfSpace { normal: n }
         }
         S::ConvexHull => {
             let points: Vec<DVec3> = g
@@ -93,7 +95,7 @@ fn shape(c: &mut Checker<'_>, key: &str, g: &Geometry<'_>) -> Option<ShapeSpec> 
                     format!("a hull needs at least 4 points, got {}", points.len()),
                 );
             }
-            ShapeSpec::ConvexHull { points }
+            ShapeDesc::ConvexHull { points }
         }
         S::Mesh | S::Compound => return None,
     })
@@ -127,12 +129,21 @@ pub(super) fn collider(c: &mut Checker<'_>, i: usize, s: &ColliderSection) -> Op
             let scale = s.scale.unwrap_or(1.0);
             c.within(&k("scale"), scale, &ranges::SCALE);
             match &s.mesh {
-                Some(path) => c
-                    .read_mesh(&k("mesh"), path, scale)
-                    .map(|(positions, triangles)| ShapeSpec::Mesh {
-                        positions,
-                        triangles,
-                    }),
+                Some(path) => {
+                    c.read_mesh(&k("mesh"), path, scale)
+                        .and_then(|(positions, triangles)| {
+                            match TriangleMesh::new(positions, triangles) {
+                                Ok(mesh) => Some(ShapeDesc::TriMesh(mesh)),
+                                Err(e) => {
+                                    c.bad(
+                                        &k("mesh"),
+                                        format!("bad mesh once scaled by {scale}: {e}"),
+                                    );
+                                    None
+                                }
+                            }
+                        })
+                }
                 None => {
                     c.bad(&k("mesh"), "missing: an OBJ file");
                     None
@@ -161,7 +172,7 @@ pub(super) fn collider(c: &mut Checker<'_>, i: usize, s: &ColliderSection) -> Op
                     out.push(sh);
                 }
             }
-            Some(ShapeSpec::Compound(out))
+            Some(ShapeDesc::Compound(out))
         }
         _ => shape(c, &key, &geometry),
     };
@@ -185,7 +196,7 @@ pub(super) fn collider(c: &mut Checker<'_>, i: usize, s: &ColliderSection) -> Op
     })
 }
 
-fn part(c: &mut Checker<'_>, key: &str, p: &PartSection) -> Option<(DVec3, DQuat, ShapeSpec)> {
+fn part(c: &mut Checker<'_>, key: &str, p: &PartSection) -> Option<CompoundPart> {
     let g = Geometry {
         shape: p.shape,
         radius: p.radius,
@@ -194,8 +205,12 @@ fn part(c: &mut Checker<'_>, key: &str, p: &PartSection) -> Option<(DVec3, DQuat
         normal: p.normal,
         points: &p.points,
     };
-    let sh = shape(c, key, &g)?;
-    let pos = c.vector(&format!("{key}.position"), p.position);
-    let rot = c.rotation(&format!("{key}.rotation_deg"), p.rotation_deg);
-    Some((pos, rot, sh))
+    let shape = shape(c, key, &g)?;
+    let position = c.vector(&format!("{key}.position"), p.position);
+    let rotation = c.rotation(&format!("{key}.rotation_deg"), p.rotation_deg);
+    Some(CompoundPart {
+        position,
+        rotation,
+        shape,
+    })
 }
