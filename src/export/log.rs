@@ -228,8 +228,7 @@ pub fn read_tracks(
     }
     let mut colliders = Vec::with_capacity(scene.colliders.len());
     for spec in &scene.colliders {
-        let desc = weft_scene::collider_desc(spec)
-            .map_err(|e| anyhow::anyhow!("collider {}: {e}", spec.name))?;
+        let desc = weft_scene::collider_desc(spec);
         let collider = weft_collide::Collider::new(&desc)
             .map_err(|e| anyhow::anyhow!("collider {}: {e}", spec.name))?;
         let (vertices, triangles) = collider.tessellate();

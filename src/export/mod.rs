@@ -80,11 +80,10 @@ fn needs(format: ExportFormat, scene: &weft_scene::Scene, frames: u64, log_bytes
     let (mut cv, mut ct) = (0u64, 0u64);
     for c in &scene.colliders {
         let (v, t) = match &c.shape {
-            weft_scene::ShapeSpec::Mesh {
-                positions,
-                triangles,
-            } => (positions.len() as u64, triangles.len() as u64),
-            weft_scene::ShapeSpec::ConvexHull { points } => {
+            weft_collide::ShapeDesc::TriMesh(mesh) => {
+                (mesh.vertices.len() as u64, mesh.triangles.len() as u64)
+            }
+            weft_collide::ShapeDesc::ConvexHull { points } => {
                 (points.len() as u64, 2 * points.len() as u64)
             }
             _ => (2000, 4000),

@@ -7,7 +7,8 @@
 //! here in one place: a variant, its [`StateShape::kind`], its parameters and its schema rule.
 
 use serde_json::{Map, Value, json};
-use weft_scene::{ColliderSpec, ShapeSpec};
+use weft_collide::ShapeDesc;
+use weft_scene::ColliderSpec;
 use weft_solver::glam::{DQuat, DVec3};
 
 /// The channel's topic.
@@ -140,38 +141,38 @@ fn vec3(v: DVec3) -> Value {
 
 impl ColliderState {
     /// The state of a shape placed at `position`, `rotation` (world).
-    pub fn of_shape(name: String, shape: &ShapeSpec, position: DVec3, rotation: DQuat) -> Self {
+    pub fn of_shape(name: String, shape: &ShapeDesc, position: DVec3, rotation: DQuat) -> Self {
         let shape = match shape {
-            ShapeSpec::Sphere { radius } => StateShape::Sphere { radius: *radius },
-            ShapeSpec::Capsule {
+            ShapeDesc::Sphere { radius } => StateShape::Sphere { radius: *radius },
+            ShapeDesc::Capsule {
                 half_height,
                 radius,
             } => StateShape::Capsule {
                 radius: *radius,
                 half_height: *half_height,
             },
-            ShapeSpec::Cuboid { half_extents } => StateShape::Cuboid {
+            ShapeDesc::Cuboid { half_extents } => StateShape::Cuboid {
                 half_extents: *half_extents,
             },
-            ShapeSpec::Plane { normal } => {
+            ShapeDesc::HalfSpace { normal } => {
                 let n = (rotation * normal.normalize_or(DVec3::Y)).normalize_or(DVec3::Y);
                 StateShape::Plane {
                     normal: n,
                     offset: n.dot(position),
                 }
             }
-            ShapeSpec::ConvexHull { .. } => StateShape::ConvexHull,
-            ShapeSpec::Mesh { .. } => StateShape::Mesh,
-            ShapeSpec::Compound(parts) => StateShape::Compound(
+            ShapeDesc::ConvexHull { .. } => StateShape::ConvexHull,
+            ShapeDesc::TriMesh(_) => StateShape::Mesh,
+            ShapeDesc::Compound(parts) => StateShape::Compound(
                 parts
                     .iter()
                     .enumerate()
-                    .map(|(i, (p, r, s))| {
+                    .map(|(i, part)| {
                         Self::of_shape(
                             format!("{name}/{i}"),
-                            s,
-                            position + rotation * *p,
-                            rotation * *r,
+                            &part.shape,
+                            position + rotation * part.position,
+                            rotation * part.rotation,
                         )
                     })
                     .collect(),
@@ -286,7 +287,7 @@ mod tests {
     use super::*;
     use weft_solver::Motion;
 
-    fn spec(shape: ShapeSpec, motion: Motion) -> ColliderSpec {
+    fn spec(shape: ShapeDesc, motion: Motion) -> ColliderSpec {
         ColliderSpec {
             name: "c".into(),
             shape,
@@ -301,7 +302,7 @@ mod tests {
     #[test]
     fn a_moving_sphere_is_at_its_analytic_position() {
         let c = spec(
-            ShapeSpec::Sphere { radius: 0.25 },
+            ShapeDesc::Sphere { radius: 0.25 },
             Motion::Linear {
                 velocity: DVec3::new(2.0, 0.0, -1.0),
             },
@@ -317,7 +318,7 @@ mod tests {
     #[test]
     fn a_plane_carries_its_world_normal_and_offset() {
         let c = spec(
-            ShapeSpec::Plane {
+            ShapeDesc::HalfSpace {
                 normal: DVec3::new(0.0, 2.0, 0.0),
             },
             Motion::Static,
@@ -333,10 +334,9 @@ mod tests {
     #[test]
     fn compound_parts_are_placed_in_the_world() {
         let c = spec(
-            ShapeSpec::Compound(vec![(
+            ShapeDesc::Compound(vec![weft_collide::CompoundPart::at(
                 DVec3::new(1.0, 0.0, 0.0),
-                DQuat::IDENTITY,
-                ShapeSpec::Capsule {
+                ShapeDesc::Capsule {
                     half_height: 0.3,
                     radius: 0.1,
                 },

@@ -103,7 +103,7 @@ fn main() {
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
     let mut ground_world = CollisionWorld::new(&solver);
     ground_world
-        .add_collider(&ground(-weft_collide::scenarios::SPHERE_RADIUS as f32))
+        .add_collider(&ground(-weft_collide::scenarios::SPHERE_RADIUS))
         .expect("ground");
     println!("static, 128² cloth, per frame (median of {reps}):");
     let solve = bare(reps, &solver);

@@ -3,7 +3,7 @@
 
 use weft_collide::scenarios::{ground, sphere_drop};
 use weft_collide::{ColliderDesc, CollisionWorld, ContactStats, Friction, ShapeDesc};
-use weft_solver::glam::{DVec3, Quat, Vec3};
+use weft_solver::glam::{DQuat, DVec3};
 use weft_solver::{Method, Motion, Particles, Solver, SubstepContext, SubstepHook};
 
 /// `CollisionWorld` without its per-particle contacts: forces the general loop.
@@ -38,8 +38,8 @@ fn scene(substeps: u32, iterations: u32) -> (Solver, CollisionWorld) {
                 half_height: 0.4,
                 radius: 0.08,
             })
-            .at(Vec3::new(-0.5, 0.55, 0.0))
-            .rotated(Quat::from_rotation_z(1.2))
+            .at(DVec3::new(-0.5, 0.55, 0.0))
+            .rotated(DQuat::from_rotation_z(1.2))
             .moving(Motion::Linear {
                 velocity: DVec3::new(0.3, 0.0, 0.1),
             })
@@ -49,9 +49,9 @@ fn scene(substeps: u32, iterations: u32) -> (Solver, CollisionWorld) {
     world
         .add_collider(
             &ColliderDesc::new(ShapeDesc::Cuboid {
-                half_extents: Vec3::new(0.15, 0.1, 0.15),
+                half_extents: DVec3::new(0.15, 0.1, 0.15),
             })
-            .at(Vec3::new(0.45, 0.5, 0.3))
+            .at(DVec3::new(0.45, 0.5, 0.3))
             .moving(Motion::Oscillate {
                 amplitude: DVec3::new(0.0, 0.1, 0.05),
                 frequency: 1.5,

@@ -30,7 +30,7 @@ impl SkinCollider {
     /// collision world keeps; the skinning, not these positions, gives every substep's
     /// vertices), no friction and no placement (set them on the result).
     pub fn desc(&self) -> Result<ColliderDesc, SkinError> {
-        let vertices = self.mesh.skin(0.0).iter().map(|v| v.as_vec3()).collect();
+        let vertices = self.mesh.skin(0.0);
         let mesh = TriangleMesh::new(vertices, self.mesh.triangles.clone())
             .map_err(|e| SkinError::Invalid(format!("skinned mesh as a collider: {e}")))?;
         Ok(ColliderDesc::new(ShapeDesc::TriMesh(mesh)))
