@@ -41,6 +41,67 @@ pub enum Command {
     /// Rebuild a valid log from one cut short (killed, power cut): every complete chunk's
     /// messages, the scene attachments and metadata, and status `recovered`.
     Recover(RecoverArgs),
+    /// Export a log's cloth and colliders for other tools: an OBJ sequence or an animated
+    /// glTF binary (GLB) that Blender imports.
+    Export(ExportArgs),
+}
+
+/// What `weft export` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportFormat {
+    /// One Wavefront OBJ per frame: `frame_00000.obj`, …
+    Obj,
+    /// One animated glTF binary, `<log stem>.glb`: the cloth animated by morph targets, the
+    /// colliders by their node transforms.
+    Glb,
+}
+
+/// How a GLB's animation goes from one exported frame to the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Interpolation {
+    /// Blend linearly (positions and translations; rotations by slerp).
+    Linear,
+    /// Hold each frame until the next.
+    Step,
+}
+
+impl Interpolation {
+    /// The name glTF gives it.
+    pub fn gltf(self) -> &'static str {
+        match self {
+            Interpolation::Linear => "LINEAR",
+            Interpolation::Step => "STEP",
+        }
+    }
+}
+
+/// `weft export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// A log written by `weft run --out` (or `weft view --record`).
+    pub log: PathBuf,
+    /// What to write.
+    #[arg(long, value_enum)]
+    pub format: ExportFormat,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Logged frames to export: `A..B` (B excluded), `A..=B`, `A..` or `..B` (default: all).
+    #[arg(long, value_name = "RANGE", value_parser = crate::export::select::FrameRange::parse)]
+    pub frames: Option<crate::export::select::FrameRange>,
+    /// Export every N-th of those frames, starting with the first.
+    #[arg(long, default_value_t = 1, value_name = "N",
+          value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: u64,
+    /// GLB: how the animation goes between exported frames.
+    #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
+    pub interpolation: Interpolation,
+    /// No summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Memory and file-size limits (the memory the export needs is estimated first).
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// `weft recover`.

@@ -8,6 +8,7 @@ mod app;
 mod cli;
 mod default_scene;
 mod experiments;
+mod export;
 mod limits;
 mod output;
 mod record;
@@ -51,6 +52,7 @@ fn main() -> ExitCode {
         Some(Command::Experiments(args)) => experiments::run(&args, &stop),
         Some(Command::Render(args)) => render_command(&args, &stop),
         Some(Command::Recover(args)) => recover::recover(&args),
+        Some(Command::Export(args)) => export::export(&args, &stop),
     };
     match result {
         Ok(code) => code,

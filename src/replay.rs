@@ -7,7 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, bail};
-use weft_scene::{MapFiles, Override};
+use weft_scene::{MapFiles, Override, Scene};
 
 use crate::cli::ReplayArgs;
 use crate::record::RecordOptions;
@@ -49,6 +49,58 @@ pub fn read_log(bytes: &[u8]) -> anyhow::Result<LoggedRun> {
     })
 }
 
+/// A malformed value names its key and shows (a short piece of) what it holds.
+fn parsed<T: std::str::FromStr>(key: &str, v: &str, what: &str) -> anyhow::Result<T> {
+    v.trim().parse().map_err(|_| {
+        anyhow::anyhow!(
+            "weft.run metadata: `{key}` must be {what}, got {:?}",
+            weft_scene::elide(v)
+        )
+    })
+}
+
+/// The `weft.run` metadata value `key`, parsed.
+fn run_value<T: std::str::FromStr>(log: &LoggedRun, key: &str, what: &str) -> anyhow::Result<T> {
+    let v = log
+        .run
+        .get(key)
+        .with_context(|| format!("weft.run metadata lacks `{key}`"))?;
+    parsed(key, v, what)
+}
+
+/// The scene a log was run with, rebuilt from its `scene/source.toml` and `files/…`
+/// attachments with the logged overrides (as `weft replay` and `weft export` need it).
+pub fn logged_scene(log: &LoggedRun, limits: &weft_scene::Limits) -> anyhow::Result<Scene> {
+    let name = log
+        .run
+        .get("scene")
+        .context("weft.run metadata lacks `scene`")?;
+    let overrides: String = run_value(log, "overrides", "a JSON list of KEY=VALUE")?;
+    let overrides: Vec<String> = serde_json::from_str(&overrides).map_err(|e| {
+        anyhow::anyhow!("weft.run metadata: `overrides` must be a JSON list of KEY=VALUE: {e}")
+    })?;
+    let overrides: Vec<Override> = overrides
+        .iter()
+        .map(|s| s.parse())
+        .collect::<Result<_, _>>()
+        .map_err(|e| anyhow::anyhow!("weft.run metadata: `overrides`: {e}"))?;
+    let source = log
+        .attachments
+        .get("scene/source.toml")
+        .context("the log has no scene/source.toml attachment")?;
+    let source = String::from_utf8_lossy(source).into_owned();
+    let files = MapFiles(
+        log.attachments
+            .iter()
+            .filter_map(|(k, v)| Some((k.strip_prefix("files/")?.to_owned(), v.clone())))
+            .collect(),
+    );
+    match weft_scene::from_text_with(name, &source, &overrides, &files, limits) {
+        Ok(s) => Ok(s),
+        Err(e) => bail!("the logged scene no longer validates:\n{e}"),
+    }
+}
+
 /// Runs `weft replay`.
 pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
     let bytes = weft_scene::read_regular(&args.log, u64::MAX)
@@ -58,32 +110,9 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
         bail!("{}", fault.message(&args.log));
     }
     let log = read_log(&bytes).with_context(|| format!("{}", args.log.display()))?;
-    let get = |k: &str| {
-        log.run
-            .get(k)
-            .with_context(|| format!("weft.run metadata lacks `{k}`"))
-    };
-    // A malformed value names its key and shows (a short piece of) what it holds.
-    fn parsed<T: std::str::FromStr>(key: &str, v: &str, what: &str) -> anyhow::Result<T> {
-        v.trim().parse().map_err(|_| {
-            anyhow::anyhow!(
-                "weft.run metadata: `{key}` must be {what}, got {:?}",
-                weft_scene::elide(v)
-            )
-        })
-    }
-    let name = get("scene")?.clone();
-    let logged_frames: u64 = parsed("frames", get("frames")?, "a frame count")?;
-    let mesh_every: u64 = parsed("mesh_every", get("mesh_every")?, "a frame count")?;
-    let timing: bool = parsed("timing", get("timing")?, "true or false")?;
-    let overrides: Vec<String> = serde_json::from_str(get("overrides")?).map_err(|e| {
-        anyhow::anyhow!("weft.run metadata: `overrides` must be a JSON list of KEY=VALUE: {e}")
-    })?;
-    let overrides: Vec<Override> = overrides
-        .iter()
-        .map(|s| s.parse())
-        .collect::<Result<_, _>>()
-        .map_err(|e| anyhow::anyhow!("weft.run metadata: `overrides`: {e}"))?;
+    let logged_frames: u64 = run_value(&log, "frames", "a frame count")?;
+    let mesh_every: u64 = run_value(&log, "mesh_every", "a frame count")?;
+    let timing: bool = run_value(&log, "timing", "true or false")?;
     // A log cut short (interrupted, recovered) holds fewer frames than were asked for: replay
     // the frames it holds.
     let frames = match &log.status {
@@ -98,22 +127,7 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
         }
         _ => logged_frames,
     };
-    let source = log
-        .attachments
-        .get("scene/source.toml")
-        .context("the log has no scene/source.toml attachment")?;
-    let source = String::from_utf8_lossy(source).into_owned();
-    let files = MapFiles(
-        log.attachments
-            .iter()
-            .filter_map(|(k, v)| Some((k.strip_prefix("files/")?.to_owned(), v.clone())))
-            .collect(),
-    );
-    let limits = args.limits.limits();
-    let scene = match weft_scene::from_text_with(&name, &source, &overrides, &files, &limits) {
-        Ok(s) => s,
-        Err(e) => bail!("the logged scene no longer validates:\n{e}"),
-    };
+    let scene = logged_scene(&log, &args.limits.limits())?;
     let out = args.out.clone().unwrap_or_else(|| {
         let mut p = args.log.clone().into_os_string();
         p.push(".replay.mcap");

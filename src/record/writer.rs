@@ -11,7 +11,7 @@ use foxglove::messages::{PointCloud, SceneUpdate};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::{Attachment, Compression, WriteOptions, Writer};
 
-use crate::record::messages;
+use crate::record::{collider_state, messages};
 use crate::sim::{FrameStats, Simulation};
 
 /// What a run logs besides particles.
@@ -53,6 +53,7 @@ pub struct Recorder {
     particles: Vec<u16>,
     meshes: Vec<u16>,
     colliders: Option<u16>,
+    collider_state: Option<u16>,
     moving_colliders: bool,
     stats: u16,
     sequence: u32,
@@ -99,6 +100,17 @@ impl Recorder {
             Some(w.add_channel(su, "/colliders", "protobuf", &none)?)
         };
         let stats = w.add_channel(st, "/stats", "json", &none)?;
+        // Added after every older schema and channel, so theirs keep their ids.
+        let collider_state = if scene.colliders.is_empty() {
+            None
+        } else {
+            let cs = w.add_schema(
+                collider_state::SCHEMA_NAME,
+                "jsonschema",
+                collider_state::schema().as_bytes(),
+            )?;
+            Some(w.add_channel(cs, collider_state::TOPIC, "json", &none)?)
+        };
         let overrides: Vec<String> = scene.overrides.iter().map(|o| o.to_string()).collect();
         let run: BTreeMap<String, String> = [
             ("scene", scene.name.clone()),
@@ -164,6 +176,7 @@ impl Recorder {
             particles,
             meshes,
             colliders,
+            collider_state,
             moving_colliders,
             stats,
             sequence: 0,
@@ -216,6 +229,12 @@ impl Recorder {
         {
             let m = messages::colliders(time, &sim.scene.colliders);
             self.put(ch, time, &m)?;
+        }
+        if let Some(ch) = self.collider_state {
+            let states = collider_state::states(time, &sim.scene.colliders);
+            let m = collider_state::message(stats.frame, time, &states);
+            self.buf = serde_json::to_vec(&m)?;
+            self.raw(ch, time)?;
         }
         let mut json = serde_json::json!({
             "frame": stats.frame,

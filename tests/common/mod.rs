@@ -50,6 +50,48 @@ mass = 0.1
 pins = ["top-left", "top-right"]
 "#;
 
+/// A cloth over a sphere moving at constant velocity, a tilted box, a capsule and the ground.
+pub const MOVING: &str = r#"[sim]
+method = "xpbd"
+dt = "1/60"
+substeps = 4
+
+[cloth.sheet]
+resolution = [8, 8]
+size = [0.5, 0.5]
+orientation = "horizontal"
+center = [0.0, 1.0, 0.0]
+mass = 0.1
+pins = []
+
+[[collider]]
+name = "ball"
+shape = "sphere"
+radius = 0.2
+position = [0.0, 0.5, 0.0]
+motion = { kind = "linear", velocity = [0.3, 0.0, -0.1] }
+
+[[collider]]
+name = "rod"
+shape = "capsule"
+radius = 0.05
+half_height = 0.3
+position = [1.0, 0.2, 0.0]
+motion = { kind = "oscillate", amplitude = [0.0, 0.1, 0.0], frequency = 2.0 }
+
+[[collider]]
+name = "box"
+shape = "cuboid"
+half_extents = [0.1, 0.2, 0.3]
+position = [-1.0, 0.3, 0.0]
+
+[[collider]]
+name = "ground"
+shape = "plane"
+normal = [0.0, 1.0, 0.0]
+position = [0.0, -0.5, 0.0]
+"#;
+
 /// stdout and stderr as text.
 pub fn texts(o: &Output) -> (String, String) {
     (

@@ -1,0 +1,284 @@
+//! What an export reads from a log: the logged frames (from `/stats`), each cloth's triangles
+//! (the first `/cloth/<name>/mesh` message, or the logged scene's when the log has no surface),
+//! its positions at the chosen frames (`/cloth/<name>/particles`), and each collider's mesh in
+//! its own frame (the logged scene's shape, tessellated) with its pose at those frames
+//! (`/colliders/state`, or the scene's prescribed motion for logs written before that channel).
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context, bail};
+use foxglove::Decode;
+use foxglove::messages::{PointCloud, SceneUpdate};
+use glam::Vec3;
+use weft_scene::Scene;
+use weft_solver::glam::{DQuat, DVec3};
+
+use crate::record::collider_state::{self, ColliderState};
+
+/// The export was stopped by SIGINT or SIGTERM.
+#[derive(Debug)]
+pub struct Stopped;
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("stopped")
+    }
+}
+
+impl std::error::Error for Stopped {}
+
+/// One cloth over the exported frames.
+pub struct ClothTrack {
+    /// The cloth's name.
+    pub name: String,
+    /// Its colour (the method's, as the log draws it), RGBA.
+    pub color: [f32; 4],
+    /// Its triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Positions per exported frame, as logged (float32).
+    pub positions: Vec<Vec<[f32; 3]>>,
+}
+
+/// One collider over the exported frames.
+pub struct ColliderTrack {
+    /// The collider's name.
+    pub name: String,
+    /// Its shape as triangles, in its own frame.
+    pub vertices: Vec<Vec3>,
+    /// Triangles of `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+    /// World pose (position, rotation) per exported frame.
+    pub poses: Vec<(DVec3, DQuat)>,
+}
+
+/// Everything an export writes.
+pub struct Tracks {
+    /// The exported frames' numbers.
+    pub frames: Vec<u64>,
+    /// Their simulated times (s).
+    pub times: Vec<f64>,
+    /// Cloths, in the scene's order.
+    pub cloths: Vec<ClothTrack>,
+    /// Colliders, in the scene's order.
+    pub colliders: Vec<ColliderTrack>,
+}
+
+/// The frames a log holds: frame number by log time, from `/stats`.
+pub fn logged_frames(bytes: &[u8], stop: &AtomicBool) -> anyhow::Result<BTreeMap<u64, u64>> {
+    let mut frames = BTreeMap::new();
+    for m in mcap::MessageStream::new(bytes)? {
+        if stop.load(Ordering::Relaxed) {
+            return Err(Stopped.into());
+        }
+        let m = m?;
+        if m.channel.topic != "/stats" {
+            continue;
+        }
+        let v: serde_json::Value =
+            serde_json::from_slice(&m.data).context("a /stats message is not JSON")?;
+        let frame = v["frame"]
+            .as_u64()
+            .context("a /stats message has no frame number")?;
+        frames.insert(m.log_time, frame);
+    }
+    if frames.is_empty() {
+        bail!("the log has no /stats messages: no frame to export");
+    }
+    Ok(frames)
+}
+
+fn rgba(c: foxglove::messages::Color) -> [f32; 4] {
+    [c.r as f32, c.g as f32, c.b as f32, c.a as f32]
+}
+
+/// A collider's pose as `/colliders/state` writes it.
+fn pose_of(v: &serde_json::Value) -> Option<(DVec3, DQuat)> {
+    let n = |a: &serde_json::Value, i: usize| a.get(i)?.as_f64();
+    let (p, r) = (&v["position"], &v["rotation"]);
+    Some((
+        DVec3::new(n(p, 0)?, n(p, 1)?, n(p, 2)?),
+        DQuat::from_xyzw(n(r, 0)?, n(r, 1)?, n(r, 2)?, n(r, 3)?),
+    ))
+}
+
+/// Reads the tracks of the frames `wanted` (log time → frame number, in order) for `scene`.
+pub fn read_tracks(
+    bytes: &[u8],
+    scene: &Scene,
+    wanted: &BTreeMap<u64, u64>,
+    stop: &AtomicBool,
+) -> anyhow::Result<Tracks> {
+    let slot: HashMap<u64, usize> = wanted.keys().enumerate().map(|(i, t)| (*t, i)).collect();
+    let n = wanted.len();
+    let cloth_index: HashMap<String, usize> = scene
+        .cloths
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (c.name.clone(), i))
+        .collect();
+    let mut positions: Vec<Vec<Option<Vec<[f32; 3]>>>> = vec![vec![None; n]; scene.cloths.len()];
+    let mut logged_triangles: Vec<Option<Vec<[u32; 3]>>> = vec![None; scene.cloths.len()];
+    let mut states: Vec<Option<serde_json::Value>> = vec![None; n];
+    let mut has_states = false;
+    for m in mcap::MessageStream::new(bytes)? {
+        if stop.load(Ordering::Relaxed) {
+            return Err(Stopped.into());
+        }
+        let m = m?;
+        let topic = m.channel.topic.as_str();
+        if topic == collider_state::TOPIC {
+            has_states = true;
+        }
+        let cloth = topic
+            .strip_prefix("/cloth/")
+            .and_then(|t| t.rsplit_once('/'))
+            .and_then(|(name, what)| Some((*cloth_index.get(name)?, what)));
+        match cloth {
+            Some((i, "mesh")) if logged_triangles[i].is_none() => {
+                let update = SceneUpdate::decode(&m.data[..])
+                    .with_context(|| format!("{topic}: not a foxglove.SceneUpdate"))?;
+                let indices = update
+                    .entities
+                    .first()
+                    .and_then(|e| e.triangles.first())
+                    .map(|t| t.indices.clone())
+                    .with_context(|| format!("{topic}: a message without triangles"))?;
+                if indices.len() % 3 != 0 {
+                    bail!("{topic}: {} indices, not whole triangles", indices.len());
+                }
+                logged_triangles[i] = Some(
+                    indices
+                        .chunks_exact(3)
+                        .map(|t| [t[0], t[1], t[2]])
+                        .collect(),
+                );
+            }
+            Some((i, "particles")) => {
+                let Some(&k) = slot.get(&m.log_time) else {
+                    continue;
+                };
+                let cloud = PointCloud::decode(&m.data[..])
+                    .with_context(|| format!("{topic}: not a foxglove.PointCloud"))?;
+                if cloud.point_stride != 12 || cloud.data.len() % 12 != 0 {
+                    bail!(
+                        "{topic}: points are not float32 x, y, z (stride {})",
+                        cloud.point_stride
+                    );
+                }
+                let f =
+                    |c: &[u8], o: usize| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]]);
+                positions[i][k] = Some(
+                    cloud
+                        .data
+                        .chunks_exact(12)
+                        .map(|c| [f(c, 0), f(c, 4), f(c, 8)])
+                        .collect(),
+                );
+            }
+            _ => {
+                if topic == collider_state::TOPIC
+                    && let Some(&k) = slot.get(&m.log_time)
+                {
+                    states[k] = Some(
+                        serde_json::from_slice(&m.data)
+                            .with_context(|| format!("{topic}: a message is not JSON"))?,
+                    );
+                }
+            }
+        }
+    }
+    let frames: Vec<u64> = wanted.values().copied().collect();
+    let times: Vec<f64> = wanted.keys().map(|t| *t as f64 * 1e-9).collect();
+    let mut cloths = Vec::with_capacity(scene.cloths.len());
+    for ((spec, logged), per_frame) in scene.cloths.iter().zip(logged_triangles).zip(positions) {
+        let count = spec.mesh.positions.len();
+        let mut track = Vec::with_capacity(n);
+        for (k, p) in per_frame.into_iter().enumerate() {
+            let p = p.with_context(|| {
+                format!(
+                    "/cloth/{}/particles has no message at frame {}",
+                    spec.name, frames[k]
+                )
+            })?;
+            if p.len() != count {
+                bail!(
+                    "/cloth/{}/particles holds {} points at frame {}; the logged scene's cloth \
+                     has {count}",
+                    spec.name,
+                    p.len(),
+                    frames[k]
+                );
+            }
+            track.push(p);
+        }
+        let triangles = logged.unwrap_or_else(|| spec.mesh.triangles.clone());
+        if let Some(bad) = triangles.iter().flatten().find(|&&i| i as usize >= count) {
+            bail!(
+                "/cloth/{}/mesh: index {bad} beyond its {count} points",
+                spec.name
+            );
+        }
+        cloths.push(ClothTrack {
+            name: spec.name.clone(),
+            color: rgba(crate::record::messages::method_color(spec.method)),
+            triangles,
+            positions: track,
+        });
+    }
+    let mut colliders = Vec::with_capacity(scene.colliders.len());
+    for spec in &scene.colliders {
+        let desc = weft_scene::collider_desc(spec)
+            .map_err(|e| anyhow::anyhow!("collider {}: {e}", spec.name))?;
+        let collider = weft_collide::Collider::new(&desc)
+            .map_err(|e| anyhow::anyhow!("collider {}: {e}", spec.name))?;
+        let (vertices, triangles) = collider.tessellate();
+        let mut poses = Vec::with_capacity(n);
+        for (k, &time) in times.iter().enumerate() {
+            let pose = if has_states {
+                let state = states[k].as_ref().with_context(|| {
+                    format!(
+                        "{} has no message at frame {}",
+                        collider_state::TOPIC,
+                        frames[k]
+                    )
+                })?;
+                let entry = state["colliders"]
+                    .as_array()
+                    .and_then(|cs| cs.iter().find(|c| c["name"] == spec.name.as_str()))
+                    .with_context(|| {
+                        format!(
+                            "{} at frame {} does not list collider {}",
+                            collider_state::TOPIC,
+                            frames[k],
+                            spec.name
+                        )
+                    })?;
+                pose_of(entry).with_context(|| {
+                    format!(
+                        "{} at frame {}: collider {} has no position or rotation",
+                        collider_state::TOPIC,
+                        frames[k],
+                        spec.name
+                    )
+                })?
+            } else {
+                let s = ColliderState::at(spec, time);
+                (s.position, s.rotation)
+            };
+            poses.push(pose);
+        }
+        colliders.push(ColliderTrack {
+            name: spec.name.clone(),
+            vertices,
+            triangles,
+            poses,
+        });
+    }
+    Ok(Tracks {
+        frames,
+        times,
+        cloths,
+        colliders,
+    })
+}
