@@ -38,7 +38,7 @@ pub fn scene_meshes(sim: &Simulation) -> SceneView {
         })
         .collect();
     let mut ground: Option<f32> = None;
-    let colliders = colliders(sim)
+    let mut colliders: Vec<TriMesh> = colliders(sim)
         .iter()
         .map(|c| match c.half_space_normal() {
             Some(n) if n.y > 0.999 => {
@@ -52,15 +52,25 @@ pub fn scene_meshes(sim: &Simulation) -> SceneView {
             }
         })
         .collect();
+    // A character's body parts, each rigid in its own frame: made once, posed every frame.
+    colliders.extend(crate::body::parts(sim).iter().map(|(_, p)| {
+        let (positions, indices) = crate::body::mesh::round_cone(p.r0, p.r1, p.half_height());
+        TriMesh { positions, indices }
+    }));
     SceneView {
         meshes: SceneMeshes { cloths, colliders },
         ground,
     }
 }
 
-/// The current world pose of each collider of `sim`.
+/// The current world pose of each collider of `sim`, then of each body part (in the order of
+/// [`scene_meshes`]).
 pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
-    colliders(sim).iter().map(|c| c.world_matrix()).collect()
+    colliders(sim)
+        .iter()
+        .map(|c| c.world_matrix())
+        .chain(crate::body::parts(sim).iter().map(|(_, p)| p.matrix()))
+        .collect()
 }
 
 /// Height of the floor drawn under `sim`: its upward half-space if it has one, else y = 0,
