@@ -73,3 +73,32 @@ fn shipped_garments_start_outside_the_walker() {
             .all(|&(lo, hi)| (lo - 0.28).abs() < 1e-9 && (hi - 0.28).abs() < 1e-9)
     );
 }
+
+#[test]
+fn an_edge_run_holds_the_outline_samples_from_corner_to_corner() {
+    let skirt = garment("skirt");
+    let front = skirt.panel("front").expect("front");
+    // The waistband (edge 2) runs from (0.20, 0.45) to (-0.20, 0.45), sampled about every
+    // 15 mm; edges 1..=2 start at the hem's right corner; edges 3..=0 wrap past the last corner.
+    let band = front.edge_run(2, 2).expect("edge 2");
+    let flat = |v: u32| front.flat[(v - front.vertices.start) as usize];
+    assert_eq!(flat(band[0]), weft_solver::glam::DVec2::new(0.20, 0.45));
+    assert_eq!(
+        flat(*band.last().expect("end")),
+        weft_solver::glam::DVec2::new(-0.20, 0.45)
+    );
+    assert!(band.iter().all(|&v| (flat(v).y - 0.45).abs() < 1e-12));
+    assert_eq!(band.len(), (0.40f64 / 0.015).ceil() as usize + 1);
+    let side_and_band = front.edge_run(1, 2).expect("edges 1-2");
+    assert_eq!(
+        flat(side_and_band[0]),
+        weft_solver::glam::DVec2::new(0.28, 0.0)
+    );
+    assert_eq!(side_and_band.last(), band.last());
+    let wrap = front.edge_run(3, 0).expect("edges 3-0");
+    assert_eq!(
+        flat(*wrap.last().expect("end")),
+        weft_solver::glam::DVec2::new(0.28, 0.0)
+    );
+    assert!(front.edge_run(4, 4).is_none());
+}
