@@ -69,6 +69,11 @@ impl Attachment {
         }
     }
 
+    /// The vertices' coordinates in the bone's frame (in `vertices()` order).
+    pub fn local(&self) -> &[DVec3] {
+        &self.local
+    }
+
     /// World positions of the attached vertices (in `vertices()` order) for the bone's world
     /// transform.
     pub fn positions(&self, bone: &Transform) -> Vec<DVec3> {

@@ -2,11 +2,11 @@
 //! frames, and evaluated at a pose into world shapes that carry their bones' velocities.
 
 use glam::DVec3;
+use weft_collide::body::RoundCone;
 
 use crate::animation::BoneState;
 use crate::body_table::{BodyTable, ShapeKind, ShapeSpec};
 use crate::error::BodyError;
-use crate::round_cone::RoundCone;
 use crate::shape::{Geometry, WorldShape};
 use crate::skeleton::Skeleton;
 

@@ -3,12 +3,12 @@
 //! colliders cloth meets).
 
 use glam::DVec3;
+use weft_collide::body::Contact;
 
 use crate::animation::{Animation, BoneState};
 use crate::body::Body;
 use crate::body_table::BodyTable;
 use crate::error::BodyError;
-use crate::round_cone::Contact;
 use crate::shape::WorldShape;
 use crate::walk::walk_cycle;
 

@@ -3,8 +3,8 @@
 use glam::DVec3;
 
 use crate::animation::BoneState;
-use crate::round_cone::{Contact, RoundCone, sphere_contact};
 use crate::transform::Transform;
+use weft_collide::body::{Contact, RoundCone, sphere_contact};
 
 /// A shape's geometry: a sphere, or a round cone (a capsule when both radii are equal).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,11 +1,13 @@
-//! Weft's collisions: colliders (static, kinematic or deforming triangle meshes), Coulomb
-//! friction and particle self-collision, plugged into the solver's substeps as a
-//! [`weft_solver::SubstepHook`] ([`CollisionWorld`]).
+//! Weft's collisions: colliders (static, kinematic or deforming triangle meshes), kinematic
+//! bodies of round cones (animated characters, [`body`]), Coulomb friction and particle
+//! self-collision, plugged into the solver's substeps as a [`weft_solver::SubstepHook`]
+//! ([`CollisionWorld`]).
 #![warn(missing_docs)]
 
 mod analytic;
 #[cfg(test)]
 mod analytic_vs_parry;
+pub mod body;
 mod collider;
 mod convert;
 mod error;
@@ -23,6 +25,7 @@ mod test_rand;
 mod trimesh;
 mod world;
 
+pub use body::{BodyPart, KinematicBody, RoundCone};
 pub use collider::{Collider, ColliderDesc};
 pub use error::{CollideError, MeshError, ShapeError};
 pub use friction::Friction;

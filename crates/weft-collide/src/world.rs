@@ -15,8 +15,10 @@ use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
 
+use crate::body::{BodyCollider, BodyPart, KinematicBody};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
+use crate::friction::Friction;
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::deforming::MeshAnimation;
@@ -24,7 +26,7 @@ use crate::trimesh::deforming::MeshAnimation;
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactStats {
-    /// Particle–collider contacts resolved in the last projection.
+    /// Particle–collider contacts (kinematic bodies included) resolved in the last projection.
     pub collider_contacts: usize,
     /// Particle–particle contacts resolved in the last projection.
     pub self_contacts: usize,
@@ -34,12 +36,18 @@ pub struct ContactStats {
     pub max_self_depth: f64,
     /// Particles stopped by continuous (swept) collision this substep.
     pub swept: usize,
+    /// Particle–body contact planes found this substep (see [`CollisionWorld::add_body`]).
+    pub body_planes: usize,
 }
 
 /// Colliders and self-collision for one solver; implements [`SubstepHook`].
 #[derive(Clone, Debug)]
 pub struct CollisionWorld {
     colliders: Vec<Collider>,
+    /// Kinematic bodies (animated characters), each its own kind of collider.
+    bodies: Vec<BodyCollider>,
+    /// Simulated time at the end of the last substep (s).
+    time: f64,
     thickness: Vec<f64>,
     self_collision: Option<SelfCollision>,
     /// Per collider, its world AABB at the current pose grown by [`Self::search_margin`], or
@@ -62,7 +70,7 @@ const ROUNDS: usize = 3;
 
 /// Particles per parallel task. Fixed, and every particle's contacts depend on that particle
 /// alone, so results are the same bit for bit for any number of threads.
-const CHUNK: usize = 1024;
+pub(crate) const CHUNK: usize = 1024;
 
 /// An axis-aligned box in f64: (min corner, max corner).
 type Bounds = (DVec3, DVec3);
@@ -77,6 +85,8 @@ impl CollisionWorld {
     pub fn new(solver: &Solver) -> Self {
         let mut world = Self {
             colliders: Vec::new(),
+            bodies: Vec::new(),
+            time: solver.time(),
             thickness: Vec::new(),
             self_collision: None,
             bounds: Vec::new(),
@@ -117,6 +127,45 @@ impl CollisionWorld {
         animation: Arc<dyn MeshAnimation>,
     ) -> Result<usize, ShapeError> {
         self.push(Collider::deforming(desc, animation)?)
+    }
+
+    /// Adds a kinematic body (an animated character's round cones, capsules and spheres):
+    /// its parts are evaluated at every substep's start and end time, particles are swept
+    /// against them in each part's moving frame and kept a thickness outside them, with
+    /// `friction` against the surface's own motion. Returns the body's index.
+    pub fn add_body(
+        &mut self,
+        body: Arc<dyn KinematicBody>,
+        friction: Friction,
+    ) -> Result<usize, ShapeError> {
+        friction.validate()?;
+        let parts = body.part_count();
+        if parts > usize::from(u16::MAX) {
+            return Err(ShapeError::InvalidParameter {
+                name: "body parts",
+                value: parts as f64,
+                expected: "at most 65535",
+            });
+        }
+        self.bodies
+            .push(BodyCollider::new(body, friction, self.time));
+        Ok(self.bodies.len() - 1)
+    }
+
+    /// Number of kinematic bodies.
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Body `body`'s parts at the end of the last substep (at the time it was added, before
+    /// any), or `None` if there is no such body. For drawing and logging.
+    pub fn body_parts(&self, body: usize) -> Option<&[BodyPart]> {
+        self.bodies.get(body).map(BodyCollider::parts)
+    }
+
+    /// Body `body`'s friction, or `None` if there is no such body.
+    pub fn body_friction(&self, body: usize) -> Option<Friction> {
+        self.bodies.get(body).map(BodyCollider::friction)
     }
 
     fn push(&mut self, c: Collider) -> Result<usize, ShapeError> {
@@ -220,14 +269,18 @@ impl CollisionWorld {
     /// Continuous collision for fast particles: a particle whose substep path crosses a
     /// collider's surface is stopped a thickness before it. In parallel over particles.
     fn sweep(&mut self, p: &mut Particles) {
+        self.stats.swept = self
+            .bodies
+            .iter()
+            .map(|b| b.sweep(p, &self.thickness))
+            .sum();
         if self.colliders.is_empty() {
-            self.stats.swept = 0;
             return;
         }
         let own: Vec<bool> = self.colliders.iter().map(|c| self.own_mesh(c)).collect();
         let parry = self.parry_meshes;
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
-        self.stats.swept = over_free_particles(
+        self.stats.swept += over_free_particles(
             p,
             0,
             |i, x, prev| sweep_one(colliders, bounds, &own, parry, prev, x, thickness[i]),
@@ -314,7 +367,7 @@ impl CollisionWorld {
 }
 
 /// The particles' positions to move, with their previous positions and inverse masses to read.
-fn moving_views(p: &mut Particles) -> (&mut [DVec3], &[DVec3], &[f64]) {
+pub(crate) fn moving_views(p: &mut Particles) -> (&mut [DVec3], &[DVec3], &[f64]) {
     let Particles {
         positions,
         prev_positions,
@@ -442,7 +495,7 @@ fn query(c: &Collider, parry: bool, x: DVec3, max_dist: f64) -> Option<crate::Su
 impl SubstepHook for CollisionWorld {
     /// A world with no collider and no self-collision does nothing, so the solver may fuse.
     fn is_active(&self) -> bool {
-        !self.colliders.is_empty() || self.self_collision.is_some()
+        !self.colliders.is_empty() || !self.bodies.is_empty() || self.self_collision.is_some()
     }
 
     fn begin_substep(&mut self, ctx: &SubstepContext, _particles: &Particles) {
@@ -455,6 +508,11 @@ impl SubstepHook for CollisionWorld {
                 (a.mins.as_dvec3() - m, a.maxs.as_dvec3() + m)
             });
         }
+        let reach = 2.0 * self.max_thickness;
+        for b in &mut self.bodies {
+            b.set_time(t0, ctx.time, reach);
+        }
+        self.time = ctx.time;
         self.fresh = true;
         self.stats = ContactStats::default();
     }
@@ -480,7 +538,15 @@ impl SubstepHook for CollisionWorld {
             }
             None => (0, 0.0),
         };
-        let (collider_contacts, swept) = self.resolve_colliders(particles, fresh);
+        let (mut collider_contacts, swept) = self.resolve_colliders(particles, fresh);
+        for b in &mut self.bodies {
+            let (contacts, deepest) = b.resolve(particles, &self.thickness, fresh);
+            collider_contacts += contacts;
+            self.stats.max_depth = self.stats.max_depth.max(deepest);
+            if fresh {
+                self.stats.body_planes += b.plane_count();
+            }
+        }
         self.stats.swept += swept;
         self.stats.collider_contacts = collider_contacts;
         self.stats.self_contacts = self_contacts;

@@ -120,6 +120,12 @@ pub enum SolverError {
         /// Number of particles.
         count: usize,
     },
+    /// A pin driver lists a particle twice.
+    #[error("pin driver lists particle {particle} twice")]
+    DrivenTwice {
+        /// The repeated particle.
+        particle: usize,
+    },
 }
 
 /// A cloth or pin that cannot be added to a solver.

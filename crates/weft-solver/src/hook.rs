@@ -18,9 +18,11 @@ pub struct SubstepContext {
 
 /// Acts on the particles inside every substep; the collision crate implements it.
 ///
-/// Order in one substep: integrate (predict) → [`SubstepHook::begin_substep`] → for each
-/// iteration: project constraints, then [`SubstepHook::project`] → velocities from positions →
-/// [`SubstepHook::end_substep`]. Mass-spring projects no constraints but still calls `project`
+/// Order in one substep: integrate (predict) → kinematic pins, driven pins
+/// ([`crate::PinDriver`], evaluated at the substep's end time) and the grabbed particle placed
+/// → [`SubstepHook::begin_substep`] → for each iteration: project constraints, then
+/// [`SubstepHook::project`] → velocities from positions (driven pins: the driver's velocities)
+/// → [`SubstepHook::end_substep`]. Mass-spring projects no constraints but still calls `project`
 /// once, so contacts are handled by projection for every method.
 ///
 /// A hook is `Send`: the whole frame, hook calls included, runs on one of rayon's threads.

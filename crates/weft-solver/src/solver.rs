@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use crate::chunk::CHUNK;
 use crate::constraints::{ConstraintSet, Residual, Rule};
 use crate::domains::{DomainStats, Domains, Finish, Integration, SimdPath};
+use crate::driver::PinDriver;
 use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
 use crate::hook::{SubstepContext, SubstepHook};
@@ -63,6 +64,12 @@ pub struct Solver {
     params: Vec<FamilyParams>,
     constraints: ConstraintSet,
     pins: Vec<KinematicPin>,
+    /// Driven pins: particles placed by a [`PinDriver`] at every substep's time.
+    drivers: Vec<Arc<dyn PinDriver>>,
+    /// Driven particles' velocities at the current substep's end (scratch).
+    driven_velocities: Vec<(usize, DVec3)>,
+    /// A driver's positions and velocities (scratch).
+    driven: (Vec<DVec3>, Vec<DVec3>),
     grab: Option<Grab>,
     /// The distance constraints cut into domains (the parallel SIMD solve).
     domains: Domains,
@@ -115,6 +122,9 @@ impl Solver {
             params,
             constraints,
             pins,
+            drivers: Vec::new(),
+            driven_velocities: Vec::new(),
+            driven: (Vec::new(), Vec::new()),
             grab: None,
             force: scratch.clone(),
             accel: scratch,
@@ -342,6 +352,44 @@ impl Solver {
         }
     }
 
+    /// Adds driven pins: `driver`'s particles get inverse mass 0 and are placed, from now on, at
+    /// the driver's positions and velocities for the current time and then, in every substep,
+    /// for the substep's end time (after the prediction, before the hook's
+    /// [`SubstepHook::begin_substep`]; see [`crate::driver`]). Returns the driver's index.
+    ///
+    /// Fails, changing nothing, if a particle does not exist or appears twice.
+    pub fn add_pin_driver(&mut self, driver: Arc<dyn PinDriver>) -> Result<usize, SolverError> {
+        let count = self.particles.len();
+        let mut seen = vec![false; count];
+        for &i in driver.particles() {
+            let i = i as usize;
+            if i >= count {
+                return Err(SolverError::NoSuchParticle { index: i, count });
+            }
+            if std::mem::replace(&mut seen[i], true) {
+                return Err(SolverError::DrivenTwice { particle: i });
+            }
+        }
+        let n = driver.particles().len();
+        let (mut x, mut v) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        driver.drive(self.time, &mut x, &mut v);
+        let p = &mut self.particles;
+        for (k, &i) in driver.particles().iter().enumerate() {
+            let i = i as usize;
+            p.inv_masses[i] = 0.0;
+            p.positions[i] = x[k];
+            p.prev_positions[i] = x[k];
+            p.velocities[i] = v[k];
+        }
+        self.drivers.push(driver);
+        Ok(self.drivers.len() - 1)
+    }
+
+    /// The pin drivers, in the order they were added.
+    pub fn pin_drivers(&self) -> &[Arc<dyn PinDriver>] {
+        &self.drivers
+    }
+
     /// Advances one frame of Δt with no hook.
     pub fn step(&mut self) -> Result<StepStats, SolverError> {
         self.step_with(&mut ())
@@ -397,6 +445,18 @@ impl Solver {
         for pin in &self.pins {
             self.targets
                 .push((pin.particle as usize, pin.motion.position(pin.rest, time)));
+        }
+        self.driven_velocities.clear();
+        let (x, v) = &mut self.driven;
+        for driver in &self.drivers {
+            let ids = driver.particles();
+            x.resize(ids.len(), DVec3::ZERO);
+            v.resize(ids.len(), DVec3::ZERO);
+            driver.drive(time, x, v);
+            for (k, &i) in ids.iter().enumerate() {
+                self.targets.push((i as usize, x[k]));
+                self.driven_velocities.push((i as usize, v[k]));
+            }
         }
         if let Some(g) = &self.grab {
             let f = (k + 1) as f64 / s.substeps as f64;
@@ -454,6 +514,10 @@ impl Solver {
             &mut p.prev_positions,
             &mut p.velocities,
         );
+        // The last substep's driven velocities, as the general loop leaves them.
+        for &(i, v) in &self.driven_velocities {
+            p.velocities[i] = v;
+        }
         whole
     }
 
@@ -549,6 +613,10 @@ impl Solver {
                         v[j] = (x[j] - prev[j]) * inv_h;
                     }
                 });
+            // Driven pins report the velocity of what carries them, not the chord.
+            for &(i, v) in &self.driven_velocities {
+                p.velocities[i] = v;
+            }
             hook.end_substep(&ctx, p);
             if self.forces.damping > 0.0 {
                 let keep = (-self.forces.damping * h).exp();

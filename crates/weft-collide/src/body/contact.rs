@@ -1,0 +1,124 @@
+//! One particle against a body's parts: the swept test in each part's moving frame, and the
+//! contact planes found once per substep and projected on at every iteration.
+
+use glam::DVec3;
+
+use super::grid::PartGrid;
+use super::motion::MovingPart;
+use crate::friction::Friction;
+
+/// A contact found at the substep's first projection: the part's tangent plane at the point
+/// nearest the particle, and how that surface point moved over the substep (for friction).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Plane {
+    /// The particle's index within its chunk.
+    pub particle: u32,
+    /// Closest surface point.
+    pub point: DVec3,
+    /// Outward unit normal there.
+    pub normal: DVec3,
+    /// Displacement of that material point over the substep.
+    pub shift: DVec3,
+}
+
+/// Steps of sphere tracing before a grazing path is given up.
+const TRACE_STEPS: usize = 48;
+
+/// Rounds over one particle's planes (a particle in the crease of two overlapping parts is
+/// pushed out of one into the other; a few rounds settle it).
+const ROUNDS: usize = 4;
+
+/// Sweeps the particle's substep path against every candidate part, in each part's moving
+/// frame: the start `prev` carried rigidly with the part to the substep's end, then the segment
+/// from there to `x` traced against the part's end geometry. A hit puts the particle a
+/// thickness `r` outside the surface where it met it (so a fast limb pushes it ahead instead
+/// of passing through it). Returns how many parts stopped it.
+pub(crate) fn sweep(
+    parts: &[MovingPart],
+    grid: &PartGrid,
+    prev: DVec3,
+    x: &mut DVec3,
+    r: f64,
+) -> usize {
+    let slow = 0.5 * r.max(1e-6);
+    let own = (*x - prev).length_squared() <= slow * slow;
+    let mut swept = 0;
+    let here = grid.candidates(*x);
+    let before = grid.candidates(prev);
+    let extra = before.iter().filter(|k| !here.contains(k));
+    for &k in here.iter().chain(extra) {
+        let part = &parts[k as usize];
+        if own && part.travel <= slow {
+            continue;
+        }
+        let from = part.carry(prev);
+        if (*x - from).length_squared() <= slow * slow {
+            continue;
+        }
+        if let Some((t, n)) = part.cone.sweep(from, *x, 1e-3 * r, TRACE_STEPS) {
+            *x = from + (*x - from) * t + n * r;
+            swept += 1;
+        }
+    }
+    swept
+}
+
+/// The contact planes of the particle at `x` (chunk index `j`) with thickness `r`: every
+/// candidate part whose surface lies within `reach` of it, or which holds it.
+pub(crate) fn planes(
+    parts: &[MovingPart],
+    grid: &PartGrid,
+    j: u32,
+    x: DVec3,
+    reach: f64,
+    out: &mut Vec<Plane>,
+) {
+    for &k in grid.candidates(x) {
+        let part = &parts[k as usize];
+        if let Some(c) = part.cone.contact_within(x, reach) {
+            out.push(Plane {
+                particle: j,
+                point: c.point,
+                normal: c.normal,
+                shift: part.displacement_at(c.point),
+            });
+        }
+    }
+}
+
+/// Projects one particle (its planes `planes`) to a thickness `r` outside every plane, with
+/// Coulomb friction against each surface's motion (Macklin et al. 2014, eq. 24): the relative
+/// tangential displacement over the substep, (x − x_prev) − shift, is cancelled or reduced.
+///
+/// Each plane is a supporting plane of a convex part, so a particle `r` outside it is at least
+/// `r` from the part. Returns (contacts resolved, deepest overlap).
+pub(crate) fn project(
+    planes: &[Plane],
+    prev: DVec3,
+    x: &mut DVec3,
+    r: f64,
+    friction: Friction,
+) -> (usize, f64) {
+    let (mut contacts, mut deepest) = (0, 0.0f64);
+    let tolerance = 1e-6 * r.max(1e-3);
+    for _ in 0..ROUNDS {
+        let mut moved = false;
+        for p in planes {
+            let depth = r - p.normal.dot(*x - p.point);
+            if depth <= tolerance {
+                continue;
+            }
+            *x += p.normal * depth;
+            let rel = (*x - prev) - p.shift;
+            let tangential = rel - p.normal * p.normal.dot(rel);
+            *x -= friction.correction(tangential, depth);
+            contacts += 1;
+            deepest = deepest.max(depth);
+            moved = true;
+        }
+        if !moved || planes.len() == 1 {
+            break;
+        }
+    }
+    (contacts, deepest)
+}
