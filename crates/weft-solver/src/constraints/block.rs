@@ -46,6 +46,8 @@ pub(crate) struct Block<const N: usize, S> {
     pub lambda: Vec<f64>,
     /// Contiguous range of each colour.
     pub colors: Vec<Range<usize>>,
+    /// Insertion index of each constraint (before sorting by colour).
+    pub order: Vec<u32>,
     /// Scratch corrections for the parallel path (one colour at a time).
     deltas: Vec<[DVec3; N]>,
 }
@@ -58,6 +60,7 @@ impl<const N: usize, S> Default for Block<N, S> {
             shapes: Vec::new(),
             lambda: Vec::new(),
             colors: Vec::new(),
+            order: Vec::new(),
             deltas: Vec::new(),
         }
     }
@@ -108,6 +111,7 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
             shapes: order.iter().map(|&i| self.shapes[i]).collect(),
             lambda: vec![0.0; order.len()],
             colors: ranges,
+            order: order.iter().map(|&i| i as u32).collect(),
             deltas: vec![[DVec3::ZERO; N]; largest],
         }
     }
