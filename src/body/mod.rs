@@ -5,7 +5,7 @@
 
 pub mod mesh;
 
-use weft_collide::BodyPart;
+use weft_collide::{BodyPart, KinematicBody};
 use weft_solver::glam::{DQuat, DVec3};
 
 use crate::sim::Simulation;
@@ -78,37 +78,23 @@ impl PartPose {
     }
 }
 
-/// The name a body part is logged under: `body/<part>` for the first body, `body<k>/<part>`
-/// for the others.
-pub fn part_name(body: usize, part: usize) -> String {
-    if body == 0 {
-        format!("body/{part}")
-    } else {
-        format!("body{body}/{part}")
-    }
+/// The name a body part is logged under: `body/<index in the body table>`.
+pub fn part_name(part: usize) -> String {
+    format!("body/{part}")
 }
 
-/// Every part of every kinematic body of `sim` as it is now (the end of the last substep),
-/// named, in body then part order (those of its first collision world with bodies: every
-/// solver group holds the same ones).
+/// Every part of the scene's character, named, as the collision world meets it now: its
+/// [`KinematicBody`] parts at the solvers' time (the end of the last substep; the character's
+/// clock is the solvers'). Empty for a scene without a character.
 pub fn parts(sim: &Simulation) -> Vec<(String, PartPose)> {
-    let Some(world) = sim
-        .groups
-        .iter()
-        .filter_map(|g| g.world.as_ref())
-        .find(|w| w.body_count() > 0)
-    else {
+    let (Some(spec), Some(group)) = (&sim.scene.character, sim.groups.first()) else {
         return Vec::new();
     };
-    (0..world.body_count())
-        .flat_map(|b| {
-            world
-                .body_parts(b)
-                .unwrap_or(&[])
-                .iter()
-                .enumerate()
-                .map(move |(i, p)| (part_name(b, i), PartPose::of(p)))
-        })
+    let mut out = Vec::new();
+    spec.character.parts_at(group.solver.time(), &mut out);
+    out.iter()
+        .enumerate()
+        .map(|(i, p)| (part_name(i), PartPose::of(p)))
         .collect()
 }
 

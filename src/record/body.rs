@@ -56,19 +56,21 @@ pub fn entities(time: f64, parts: &[(String, PartPose)]) -> Vec<SceneEntity> {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::Arc;
-
     use weft_character::{Character, Geometry};
-    use weft_collide::Friction;
     use weft_solver::glam::DVec3;
 
     use crate::record::{RecordOptions, Recorder, Status};
     use crate::sim::Simulation;
 
-    /// A small cloth far from the walker, and a ground: the walker's body joins the world.
+    /// The walker, a small cloth far from it, and a ground.
     const SCENE: &str = r#"[sim]
 dt = "1/60"
 substeps = 4
+
+[character]
+skeleton = "walker"
+body = "walker"
+wrap = "loop"
 
 [cloth.sheet]
 resolution = [4, 4]
@@ -85,17 +87,11 @@ normal = [0.0, 1.0, 0.0]
 position = [0.0, 0.0, 0.0]
 "#;
 
-    fn walking(character: &Arc<Character>) -> Simulation {
+    fn walking() -> Simulation {
         let scene =
             weft_scene::from_text("walker.toml", SCENE, &[], &weft_scene::DirFiles(".".into()))
                 .expect("the scene loads");
-        let mut sim = Simulation::new(scene).expect("the scene builds");
-        for g in &mut sim.groups {
-            let w = g.world.as_mut().expect("a collision world");
-            w.add_body(character.clone(), Friction::default())
-                .expect("the body joins");
-        }
-        sim
+        Simulation::new(scene).expect("the scene builds")
     }
 
     fn numbers(v: &serde_json::Value) -> DVec3 {
@@ -108,8 +104,9 @@ position = [0.0, 0.0, 0.0]
     /// has an entity on `/colliders`.
     #[test]
     fn logged_body_parts_are_the_characters_shapes_at_each_frame() {
-        let character = Arc::new(Character::walker());
-        let mut sim = walking(&character);
+        let mut sim = walking();
+        // The same walker, made apart from the scene: the analytic reference.
+        let character = Character::walker();
         let path = std::env::temp_dir().join(format!("weft-body-{}.mcap", std::process::id()));
         let file = std::fs::File::create(&path).expect("a temporary file");
         let options = RecordOptions {
