@@ -6,8 +6,8 @@
 
 mod common;
 
-use common::{load, scenes_dir};
 use common::watch::Watch;
+use common::{load, scenes_dir};
 use weft_character::{Attachment, WALK_PERIOD};
 use weft_scene::{Scene, SolverGroup};
 use weft_solver::glam::DVec3;
