@@ -1,7 +1,8 @@
 //! The walker in its T-shirt (assets/scenes/character.toml: 10,172 particles, 10 substeps,
 //! body contact, self-collision), one frame at a time once the seams have closed, and the
 //! same frame without self-collision and without any contact, so that the differences split
-//! the cost into solve, body contact and self-collision.
+//! the cost into solve, body contact and self-collision; and the whole frame with
+//! bend-distance bending instead of the preset's dihedral bending.
 #![allow(clippy::unwrap_used)]
 
 use std::path::Path;
@@ -49,6 +50,16 @@ fn bench(c: &mut Criterion) {
     group.bench_function("tshirt: solve only", |b| {
         b.iter(|| solve.solver.step_with(&mut Nothing).unwrap())
     });
+    // The jersey preset bends through dihedral angles (an atan2 per constraint, two sweeps);
+    // the same shirt with the cheap bend-distance constraints instead.
+    let mut cheap = dressed(&[
+        "cloth.tshirt.bend_dihedral_enabled=false",
+        "cloth.tshirt.bend_distance_enabled=true",
+    ]);
+    group.bench_function(
+        "tshirt, bend-distance: solve + body + self-collision",
+        |b| b.iter(|| cheap.step().unwrap()),
+    );
     group.finish();
 }
 
