@@ -1,5 +1,8 @@
 //! Builds the solvers of a scene: one per method, cloths in name order.
 
+use std::sync::Arc;
+
+use weft_character::{Attachment, AttachmentDriver};
 use weft_collide::CollisionWorld;
 use weft_solver::{
     Family, FamilyParams, Method, Motion, Settings, Solver, SolverBuilder, SolverError, StepStats,
@@ -101,7 +104,8 @@ impl Scene {
                 }
                 members.push(i);
             }
-            let solver = b.build();
+            let mut solver = b.build();
+            self.attach(&mut solver, &members)?;
             let (world, delayed_self_collision) = self.collision_world(&solver, &members)?;
             groups.push(SolverGroup {
                 method,
@@ -112,5 +116,50 @@ impl Scene {
             });
         }
         Ok(groups)
+    }
+}
+
+impl Scene {
+    /// Drives each garment's attached vertices with its bones (one driver per cloth), bound
+    /// at the solver's present time.
+    fn attach(&self, solver: &mut Solver, members: &[usize]) -> Result<(), SceneError> {
+        let Some(ch) = &self.character else {
+            return Ok(());
+        };
+        for (j, &i) in members.iter().enumerate() {
+            let c = &self.cloths[i];
+            if c.attachments.is_empty() {
+                continue;
+            }
+            let err = |e: &dyn std::fmt::Display| SceneError {
+                origin: Origin::File {
+                    path: self.name.clone(),
+                    line: None,
+                },
+                key: format!("cloth.{}.attach", c.name),
+                message: e.to_string(),
+            };
+            let bones = ch.character.animation().bones(solver.time());
+            let attachments = c
+                .attachments
+                .iter()
+                .map(|a| {
+                    Attachment::bind(
+                        a.bone,
+                        a.vertices.clone(),
+                        &c.mesh.positions,
+                        &bones[a.bone].transform,
+                    )
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| err(&e))?;
+            let first = solver.cloths()[j].particles.start;
+            let driver = AttachmentDriver::new(ch.character.clone(), first, attachments)
+                .map_err(|e| err(&e))?;
+            solver
+                .add_pin_driver(Arc::new(driver))
+                .map_err(|e| err(&e))?;
+        }
+        Ok(())
     }
 }

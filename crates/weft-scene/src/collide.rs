@@ -1,9 +1,11 @@
 //! Wires a scene's colliders and self-collision to `weft-collide`: one collision world per
 //! solver, holding every collider (colliders are f64 here, f32 inside parry).
 
+use std::sync::Arc;
+
 use weft_collide::{
-    ColliderDesc, CollisionWorld, CompoundPart, Friction, SelfCollisionParams, ShapeDesc,
-    TriangleMesh,
+    ColliderDesc, CollisionWorld, CompoundPart, Friction, KinematicBody, SelfCollisionParams,
+    ShapeDesc, TriangleMesh,
 };
 use weft_solver::Solver;
 use weft_solver::glam::{DQuat, DVec3, Quat, Vec3};
@@ -124,7 +126,7 @@ impl Scene {
                 .add_collider(&desc)
                 .map_err(|e| self.collide_error(key, e.to_string()))?;
         }
-        self.add_character(&mut world, solver, members)?;
+        self.add_character(&mut world)?;
         let mut delayed = None;
         if let Some(sc) = &self.self_collision
             && !self_cloths.is_empty()
@@ -159,14 +161,14 @@ impl Scene {
 }
 
 impl Scene {
-    /// Adds the scene's character (its body) to `world`; attachments are wired in
-    /// [`Scene::build`].
-    fn add_character(
-        &self,
-        _world: &mut CollisionWorld,
-        _solver: &Solver,
-        _members: &[usize],
-    ) -> Result<(), SceneError> {
+    /// Adds the scene's character (its body, moving with the clip) to `world`.
+    fn add_character(&self, world: &mut CollisionWorld) -> Result<(), SceneError> {
+        if let Some(ch) = &self.character {
+            let body: Arc<dyn KinematicBody> = ch.character.clone();
+            world
+                .add_body(body, Friction::new(ch.static_friction, ch.dynamic_friction))
+                .map_err(|e| self.collide_error("character".into(), e.to_string()))?;
+        }
         Ok(())
     }
 }

@@ -137,3 +137,41 @@ fn bad_character_and_garment_keys_are_errors_with_file_line_and_key() {
         );
     }
 }
+
+#[test]
+fn a_bvh_character_loads_and_a_broken_one_names_its_file_and_line() {
+    let text = format!(
+        "[character]\nskeleton = \"../characters/cmu_01_01_4s.bvh\"\nscale = {}\nbody = \"cmu\"\n\
+         wrap = \"clamp\"\n\n[cloth.cape]\ngarment = \"../garments/cape.toml\"\n\
+         attach = [{{ bone = \"Spine1\", panel = \"cape\", edges = [2, 2] }}]\n",
+        weft_character::CMU_SCALE
+    );
+    let files = weft_scene::DirFiles(scenes_dir());
+    let scene = weft_scene::from_text("cmu.toml", &text, &[], &files).expect("loads");
+    let ch = scene.character.expect("a character");
+    assert_eq!(ch.character.animation().skeleton().len(), 38);
+    assert_eq!(scene.cloths[0].attachments[0].bone_name, "Spine1");
+    // A BVH cut short: the error names the scene key, the file and the BVH's own line.
+    let mut map = std::collections::BTreeMap::new();
+    map.insert(
+        "short.bvh".to_owned(),
+        b"HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n".to_vec(),
+    );
+    let text = "[character]\nskeleton = \"short.bvh\"\n\n[cloth.c]\nresolution = [4, 4]\n";
+    let errs = match weft_scene::from_text("s.toml", text, &[], &weft_scene::MapFiles(map)) {
+        Ok(_) => panic!("accepted a truncated BVH"),
+        Err(e) => e.0,
+    };
+    let e = &errs[0];
+    assert_eq!(e.key, "character.skeleton");
+    assert!(
+        e.message
+            .contains("bad BVH file `short.bvh`: line 2: `Hips` opened here has no closing"),
+        "{}",
+        e.message
+    );
+    assert!(matches!(
+        e.origin,
+        weft_scene::Origin::File { line: Some(2), .. }
+    ));
+}

@@ -598,6 +598,14 @@ impl Solver {
                         );
                         stats.contacts = hook.project(&ctx, p);
                     }
+                    if self.constraints.seam_count() > 0 {
+                        self.constraints.hold_seams(
+                            &mut p.positions,
+                            &p.prev_positions,
+                            &p.inv_masses,
+                            rule,
+                        );
+                    }
                 }
                 None => stats.contacts = hook.project(&ctx, p),
             }

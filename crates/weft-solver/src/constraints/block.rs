@@ -258,6 +258,39 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
         }
     }
 
+    /// One sequential Gauss–Seidel sweep, in colour order, over the constraints for which
+    /// `keep(shape, positions)` holds.
+    pub fn project_where(
+        &mut self,
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        w: &[f64],
+        params: &[FamilyParams],
+        rule: Rule,
+        keep: impl Fn(&S, &[DVec3; N]) -> bool,
+    ) {
+        for k in 0..self.len() {
+            let idx = self.particles[k];
+            if !keep(&self.shapes[k], &idx.map(|i| x[i as usize])) {
+                continue;
+            }
+            let d = correction(
+                &self.shapes[k],
+                &idx,
+                self.group[k],
+                &mut self.lambda[k],
+                x,
+                prev,
+                w,
+                params,
+                rule,
+            );
+            for (j, dj) in d.iter().enumerate() {
+                x[idx[j] as usize] += *dj;
+            }
+        }
+    }
+
     /// One symmetric Gauss–Seidel sweep: the colours forward, then backward.
     ///
     /// A single forward sweep of stiff, overlapping constraints acts like the non-symmetric

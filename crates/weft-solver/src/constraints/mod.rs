@@ -142,6 +142,18 @@ impl ConstraintSet {
         self.seams.project(x, prev, w, &self.seam_params, rule);
     }
 
+    /// One more sweep over the closed seams alone (rest length 0, at most
+    /// [`Seam::HOLD_GAP`] open), after the substep's last contact pass: friction by position
+    /// undoes any tangential motion smaller than μ times the contact depth, the seam's own
+    /// pull included, so a seam lying on a body would stay open by that much. A wider seam is
+    /// left to the contacts: it may be caught across a limb, and must not be pulled through.
+    pub(crate) fn hold_seams(&mut self, x: &mut [DVec3], prev: &[DVec3], w: &[f64], rule: Rule) {
+        self.seams
+            .project_where(x, prev, w, &self.seam_params, rule, |s, p| {
+                s.rest == 0.0 && p[0].distance(p[1]) <= Seam::HOLD_GAP
+            });
+    }
+
     /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N).
     pub(crate) fn spring_forces(
         &self,

@@ -20,6 +20,10 @@ pub struct Seam {
 }
 
 impl Seam {
+    /// A closed seam at most this far open (m) is held shut once more after the contacts of
+    /// each substep (see `ConstraintSet::hold_seams`).
+    pub const HOLD_GAP: f64 = 0.01;
+
     /// A seam over a pair `gap` apart that closes over `closing_time` seconds.
     pub fn new(gap: f64, closing_time: f64) -> Self {
         let mut s = Self {
