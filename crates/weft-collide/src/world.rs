@@ -269,11 +269,11 @@ impl CollisionWorld {
     /// Continuous collision for fast particles: a particle whose substep path crosses a
     /// collider's surface is stopped a thickness before it. In parallel over particles.
     fn sweep(&mut self, p: &mut Particles) {
-        self.stats.swept = self
-            .bodies
-            .iter()
-            .map(|b| b.sweep(p, &self.thickness))
-            .sum();
+        self.stats.swept = 0;
+        for b in &mut self.bodies {
+            self.stats.swept += b.find(p, &self.thickness);
+            self.stats.body_planes += b.plane_count();
+        }
         if self.colliders.is_empty() {
             return;
         }
@@ -518,8 +518,9 @@ impl SubstepHook for CollisionWorld {
     }
 
     fn project(&mut self, _ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        // Once per substep, before the first projection: the colliders' sweep, then the
-        // self-collision's clamp (a move back along a swept path stays clear of colliders).
+        // Once per substep, before the first projection: the bodies' sweep and contact planes
+        // and the colliders' sweep, then the self-collision's clamp (a move back along a swept
+        // path stays clear of colliders).
         let fresh = std::mem::take(&mut self.fresh);
         if fresh {
             self.sweep(particles);
@@ -540,12 +541,9 @@ impl SubstepHook for CollisionWorld {
         };
         let (mut collider_contacts, swept) = self.resolve_colliders(particles, fresh);
         for b in &mut self.bodies {
-            let (contacts, deepest) = b.resolve(particles, &self.thickness, fresh);
+            let (contacts, deepest) = b.resolve(particles, &self.thickness);
             collider_contacts += contacts;
             self.stats.max_depth = self.stats.max_depth.max(deepest);
-            if fresh {
-                self.stats.body_planes += b.plane_count();
-            }
         }
         self.stats.swept += swept;
         self.stats.collider_contacts = collider_contacts;

@@ -17,6 +17,9 @@ use crate::world::{CHUNK, moving_views};
 /// Preferred edge of the broad phase's cells (m): a few limb radii.
 const CELL: f64 = 0.05;
 
+/// Below this many contact planes a substep's projections run on the calling thread.
+const SERIAL_PLANES: usize = 4096;
+
 /// A body in the world.
 #[derive(Clone, Debug)]
 pub(crate) struct BodyCollider {
@@ -93,74 +96,89 @@ impl BodyCollider {
         self.grid.build(&self.moving, reach, CELL);
     }
 
-    /// Sweeps every free particle's substep path against the moving parts; returns how many
-    /// were stopped. In parallel over fixed chunks, each particle on its own: the same bits on
-    /// any thread count.
-    pub fn sweep(&self, p: &mut Particles, thickness: &[f64]) -> usize {
-        if self.moving.is_empty() {
-            return 0;
-        }
-        let (positions, prev, inv) = moving_views(p);
-        let (parts, grid) = (&self.moving, &self.grid);
-        positions
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(k, xs)| {
-                let mut n = 0;
-                for (j, x) in xs.iter_mut().enumerate() {
-                    let i = k * CHUNK + j;
-                    if inv[i] != 0.0 {
-                        n += sweep(parts, grid, prev[i], x, thickness[i]);
-                    }
-                }
-                n
-            })
-            .sum()
-    }
-
-    /// Projects free particles out of the parts, to a thickness outside, with friction; on
-    /// the substep's first projection (`fresh`) the contact planes are found first (every part
-    /// within twice the thickness). Returns (contacts, deepest overlap).
-    pub fn resolve(&mut self, p: &mut Particles, thickness: &[f64], fresh: bool) -> (usize, f64) {
+    /// Once per substep, before self-collision: sweeps every free particle's substep path
+    /// against the moving parts, then finds its contact planes (every part within twice its
+    /// thickness, or holding it) — one broad-phase lookup per particle for both. Returns how
+    /// many particles the sweep stopped. In parallel over fixed chunks, each particle on its
+    /// own: the same bits on any thread count.
+    ///
+    /// Self-collision then moves particles by a fraction of a thickness; the planes, supporting
+    /// planes of convex parts found within two thicknesses, still hold for them.
+    pub fn find(&mut self, p: &mut Particles, thickness: &[f64]) -> usize {
         let chunks = p.len().div_ceil(CHUNK);
         if self.chunks.len() != chunks {
             self.chunks = vec![Vec::new(); chunks];
         }
-        let (parts, grid, friction) = (&self.moving, &self.grid, self.friction);
+        let (parts, grid) = (&self.moving, &self.grid);
         let (positions, prev, inv) = moving_views(p);
-        let (contacts, deepest, found) = positions
+        let (swept, found) = positions
             .par_chunks_mut(CHUNK)
             .zip(self.chunks.par_iter_mut())
             .enumerate()
             .map(|(k, (xs, list))| {
-                if fresh {
-                    list.clear();
-                    for (j, x) in xs.iter().enumerate() {
-                        let i = k * CHUNK + j;
-                        if inv[i] != 0.0 {
-                            planes(parts, grid, j as u32, *x, 2.0 * thickness[i], list);
-                        }
+                list.clear();
+                let mut swept = 0;
+                for (j, x) in xs.iter_mut().enumerate() {
+                    let i = k * CHUNK + j;
+                    if inv[i] == 0.0 {
+                        continue;
                     }
+                    let r = thickness[i];
+                    let mut here = grid.candidates(*x);
+                    let n = sweep(parts, grid, here, prev[i], x, r);
+                    if n > 0 {
+                        swept += n;
+                        here = grid.candidates(*x);
+                    }
+                    planes(parts, here, j as u32, *x, 2.0 * r, list);
                 }
-                let (mut contacts, mut deepest) = (0, 0.0f64);
-                let mut rest: &[Plane] = list;
-                while let Some(first) = rest.first() {
-                    let j = first.particle;
-                    let n = rest.iter().take_while(|q| q.particle == j).count();
-                    let (mine, others) = rest.split_at(n);
-                    rest = others;
-                    let i = k * CHUNK + j as usize;
-                    let x: &mut DVec3 = &mut xs[j as usize];
-                    let (c, d) = project(mine, prev[i], x, thickness[i], friction);
-                    contacts += c;
-                    deepest = deepest.max(d);
-                }
-                (contacts, deepest, list.len())
+                (swept, list.len())
             })
-            .reduce(|| (0, 0.0, 0), |a, b| (a.0 + b.0, a.1.max(b.1), a.2 + b.2));
-        if fresh {
-            self.plane_count = found;
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        self.plane_count = found;
+        swept
+    }
+
+    /// Projects free particles onto this substep's contact planes (see [`Self::find`]), to a
+    /// thickness outside, with friction. Returns (contacts, deepest overlap).
+    pub fn resolve(&mut self, p: &mut Particles, thickness: &[f64]) -> (usize, f64) {
+        if self.chunks.len() != p.len().div_ceil(CHUNK) {
+            return (0, 0.0);
         }
-        (contacts, deepest)
+        let friction = self.friction;
+        let (positions, prev, _) = moving_views(p);
+        let chunk = |k: usize, xs: &mut [DVec3], list: &[Plane]| {
+            let (mut contacts, mut deepest) = (0, 0.0f64);
+            let mut rest = list;
+            while let Some(first) = rest.first() {
+                let j = first.particle;
+                let n = rest.iter().take_while(|q| q.particle == j).count();
+                let (mine, others) = rest.split_at(n);
+                rest = others;
+                let i = k * CHUNK + j as usize;
+                let (c, d) = project(mine, prev[i], &mut xs[j as usize], thickness[i], friction);
+                contacts += c;
+                deepest = deepest.max(d);
+            }
+            (contacts, deepest)
+        };
+        let combine = |a: (usize, f64), b: (usize, f64)| (a.0 + b.0, a.1.max(b.1));
+        // Each particle's projection depends on it alone, so the order (and the thread count)
+        // never changes the result: a few planes are cheaper projected here than handed out.
+        if self.plane_count < SERIAL_PLANES {
+            positions
+                .chunks_mut(CHUNK)
+                .zip(&self.chunks)
+                .enumerate()
+                .map(|(k, (xs, list))| chunk(k, xs, list))
+                .fold((0, 0.0), combine)
+        } else {
+            positions
+                .par_chunks_mut(CHUNK)
+                .zip(self.chunks.par_iter())
+                .enumerate()
+                .map(|(k, (xs, list))| chunk(k, xs, list))
+                .reduce(|| (0, 0.0), combine)
+        }
     }
 }

@@ -28,23 +28,37 @@ const TRACE_STEPS: usize = 48;
 /// pushed out of one into the other; a few rounds settle it).
 const ROUNDS: usize = 4;
 
+/// How far a particle of thickness `r` may move relative to a part in one substep without
+/// being swept: half its thickness (a path that short cannot cross the surface unseen — the
+/// contact planes, found within two thicknesses, catch it).
+fn slow(r: f64) -> f64 {
+    0.5 * r.max(1e-6)
+}
+
 /// Sweeps the particle's substep path against every candidate part, in each part's moving
 /// frame: the start `prev` carried rigidly with the part to the substep's end, then the segment
 /// from there to `x` traced against the part's end geometry. A hit puts the particle a
 /// thickness `r` outside the surface where it met it (so a fast limb pushes it ahead instead
 /// of passing through it). Returns how many parts stopped it.
+///
+/// `here` are the candidates at `x`. A particle that itself moved less than [`slow`] can
+/// only be crossed by a part that moved more, which the grid (grown by each part's travel)
+/// lists at `x`; a faster particle also takes the candidates at `prev`.
 pub(crate) fn sweep(
     parts: &[MovingPart],
     grid: &PartGrid,
+    here: &[u16],
     prev: DVec3,
     x: &mut DVec3,
     r: f64,
 ) -> usize {
-    let slow = 0.5 * r.max(1e-6);
+    let slow = slow(r);
     let own = (*x - prev).length_squared() <= slow * slow;
+    let before: &[u16] = if own { &[] } else { grid.candidates(prev) };
+    if here.is_empty() && before.is_empty() {
+        return 0;
+    }
     let mut swept = 0;
-    let here = grid.candidates(*x);
-    let before = grid.candidates(prev);
     let extra = before.iter().filter(|k| !here.contains(k));
     for &k in here.iter().chain(extra) {
         let part = &parts[k as usize];
@@ -63,17 +77,17 @@ pub(crate) fn sweep(
     swept
 }
 
-/// The contact planes of the particle at `x` (chunk index `j`) with thickness `r`: every
-/// candidate part whose surface lies within `reach` of it, or which holds it.
+/// The contact planes of the particle at `x` (chunk index `j`): every part of `candidates`
+/// whose surface lies within `reach` of it, or which holds it.
 pub(crate) fn planes(
     parts: &[MovingPart],
-    grid: &PartGrid,
+    candidates: &[u16],
     j: u32,
     x: DVec3,
     reach: f64,
     out: &mut Vec<Plane>,
 ) {
-    for &k in grid.candidates(x) {
+    for &k in candidates {
         let part = &parts[k as usize];
         if let Some(c) = part.cone.contact_within(x, reach) {
             out.push(Plane {

@@ -33,16 +33,17 @@ impl PartGrid {
     /// `cell` (m).
     pub fn build(&mut self, parts: &[MovingPart], reach: f64, cell: f64) {
         self.pairs.clear();
-        let influence: Vec<(DVec3, DVec3, f64)> = parts
+        let influence: Vec<(usize, DVec3, DVec3, f64)> = parts
             .iter()
-            .map(|p| {
+            .enumerate()
+            .map(|(k, p)| {
                 let (a, ra, b, rb) = p.cone.ends();
-                (a, b, ra.max(rb) + reach + p.travel)
+                (k, a, b, ra.max(rb) + reach + p.travel)
             })
             .collect();
         let Some((lo, hi)) = influence
             .iter()
-            .map(|&(a, b, r)| (a.min(b) - DVec3::splat(r), a.max(b) + DVec3::splat(r)))
+            .map(|&(_, a, b, r)| (a.min(b) - DVec3::splat(r), a.max(b) + DVec3::splat(r)))
             .reduce(|(l0, h0), (l1, h1)| (l0.min(l1), h0.max(h1)))
         else {
             self.dims = [0; 3];
@@ -58,7 +59,7 @@ impl PartGrid {
         let dims = (size / edge).ceil().max(DVec3::ONE);
         self.dims = [dims.x as usize, dims.y as usize, dims.z as usize];
         let half_diag = 0.5 * edge * 3f64.sqrt();
-        for (k, &(a, b, r)) in influence.iter().enumerate() {
+        for &(k, a, b, r) in &influence {
             let (cl, ch) = (
                 self.cell_of(a.min(b) - DVec3::splat(r)),
                 self.cell_of(a.max(b) + DVec3::splat(r)),
@@ -109,7 +110,7 @@ impl PartGrid {
     }
 
     /// The parts listed in the cell holding `p` (none outside the grid).
-    #[inline]
+    #[inline(always)]
     pub fn candidates(&self, p: DVec3) -> &[u16] {
         if self.dims[0] == 0 {
             return &[];
