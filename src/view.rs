@@ -144,3 +144,42 @@ pub fn renderer_for(
 pub fn initial_camera(sim: &Simulation) -> Camera {
     framing_camera(sim, &scene_meshes(sim))
 }
+
+#[cfg(test)]
+mod tests {
+    use weft_character::Geometry;
+
+    use super::*;
+
+    /// What the renderer is given for a character: one mesh per body part after the
+    /// colliders, which its pose of the frame puts on the character's surface at the solvers'
+    /// time (worked out apart, by weft-character).
+    #[test]
+    fn the_body_is_drawn_on_the_characters_surface_as_it_walks() {
+        let source = std::path::Path::new("assets/scenes/skirt.toml");
+        let scene = weft_scene::load(source, &[]).expect("the skirt scene");
+        let mut sim = Simulation::new(scene).expect("solvers");
+        let meshes = scene_meshes(&sim).meshes.colliders;
+        let character = sim.scene.character.clone().expect("a character").character;
+        let shapes = character.body().shapes().len();
+        assert_eq!(meshes.len(), colliders(&sim).len() + shapes);
+        for frame in 0..8 {
+            if frame > 0 {
+                sim.step().expect("a step");
+            }
+            let poses = frame_poses(&sim);
+            let state = character.state(sim.groups[0].solver.time());
+            let first = poses.len() - shapes;
+            for (i, s) in state.shapes.iter().enumerate() {
+                for v in &meshes[first + i].positions {
+                    let w = poses[first + i].transform_point3(*v).as_dvec3();
+                    let d = match s.geometry {
+                        Geometry::Sphere { center, radius } => (w - center).length() - radius,
+                        Geometry::RoundCone(c) => c.signed_distance(w),
+                    };
+                    assert!(d.abs() < 1e-5, "frame {frame}, part {i}: {d} m off");
+                }
+            }
+        }
+    }
+}
