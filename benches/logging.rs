@@ -8,7 +8,11 @@
 //! stepping. Opening and finishing the log (once per run) are outside the timing.
 
 // The binary crate has no library target; its modules are included by path.
-#[allow(dead_code)]
+// (their unit tests compile here too, without a harness to use their imports)
+#[allow(dead_code, unused_imports)]
+#[path = "../src/body/mod.rs"]
+mod body;
+#[allow(dead_code, unused_imports)]
 #[path = "../src/record/mod.rs"]
 mod record;
 #[allow(dead_code)]

@@ -5,6 +5,7 @@
 #[macro_use]
 mod say;
 mod app;
+mod body;
 mod cli;
 mod default_scene;
 mod experiments;

@@ -38,7 +38,7 @@ pub fn scene_meshes(sim: &Simulation) -> SceneView {
         })
         .collect();
     let mut ground: Option<f32> = None;
-    let colliders = colliders(sim)
+    let mut colliders: Vec<TriMesh> = colliders(sim)
         .iter()
         .map(|c| match c.half_space_normal() {
             Some(n) if n.y > 0.999 => {
@@ -52,15 +52,25 @@ pub fn scene_meshes(sim: &Simulation) -> SceneView {
             }
         })
         .collect();
+    // A character's body parts, each rigid in its own frame: made once, posed every frame.
+    colliders.extend(crate::body::parts(sim).iter().map(|(_, p)| {
+        let (positions, indices) = crate::body::mesh::round_cone(p.r0, p.r1, p.half_height());
+        TriMesh { positions, indices }
+    }));
     SceneView {
         meshes: SceneMeshes { cloths, colliders },
         ground,
     }
 }
 
-/// The current world pose of each collider of `sim`.
+/// The current world pose of each collider of `sim`, then of each body part (in the order of
+/// [`scene_meshes`]).
 pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
-    colliders(sim).iter().map(|c| c.world_matrix()).collect()
+    colliders(sim)
+        .iter()
+        .map(|c| c.world_matrix())
+        .chain(crate::body::parts(sim).iter().map(|(_, p)| p.matrix()))
+        .collect()
 }
 
 /// Height of the floor drawn under `sim`: its upward half-space if it has one, else y = 0,
@@ -133,4 +143,43 @@ pub fn renderer_for(
 /// The camera that frames the scene now ([`framing_camera`]).
 pub fn initial_camera(sim: &Simulation) -> Camera {
     framing_camera(sim, &scene_meshes(sim))
+}
+
+#[cfg(test)]
+mod tests {
+    use weft_character::Geometry;
+
+    use super::*;
+
+    /// What the renderer is given for a character: one mesh per body part after the
+    /// colliders, which its pose of the frame puts on the character's surface at the solvers'
+    /// time (worked out apart, by weft-character).
+    #[test]
+    fn the_body_is_drawn_on_the_characters_surface_as_it_walks() {
+        let source = std::path::Path::new("assets/scenes/skirt.toml");
+        let scene = weft_scene::load(source, &[]).expect("the skirt scene");
+        let mut sim = Simulation::new(scene).expect("solvers");
+        let meshes = scene_meshes(&sim).meshes.colliders;
+        let character = sim.scene.character.clone().expect("a character").character;
+        let shapes = character.body().shapes().len();
+        assert_eq!(meshes.len(), colliders(&sim).len() + shapes);
+        for frame in 0..8 {
+            if frame > 0 {
+                sim.step().expect("a step");
+            }
+            let poses = frame_poses(&sim);
+            let state = character.state(sim.groups[0].solver.time());
+            let first = poses.len() - shapes;
+            for (i, s) in state.shapes.iter().enumerate() {
+                for v in &meshes[first + i].positions {
+                    let w = poses[first + i].transform_point3(*v).as_dvec3();
+                    let d = match s.geometry {
+                        Geometry::Sphere { center, radius } => (w - center).length() - radius,
+                        Geometry::RoundCone(c) => c.signed_distance(w),
+                    };
+                    assert!(d.abs() < 1e-5, "frame {frame}, part {i}: {d} m off");
+                }
+            }
+        }
+    }
 }

@@ -12,6 +12,7 @@
 //! | `panel.rs` | the egui side panel |
 //! | `recording.rs` | `--record`: the MCAP log and its `/interaction` channel |
 
+pub mod character;
 pub mod clock;
 pub mod command;
 pub mod grab;

@@ -11,6 +11,8 @@ use weft_render::RenderOptions;
 use weft_solver::glam::DVec3;
 use weft_solver::{Family, Method};
 
+mod character;
+
 use crate::app::command::Command;
 use crate::app::session::{SceneSource, Session};
 
@@ -23,6 +25,8 @@ pub struct PanelState {
     pub error: Option<String>,
     /// The scenes offered.
     pub scenes: Vec<SceneSource>,
+    /// Those of them with a character (the garments offered), found when first shown.
+    pub garments: Option<Vec<SceneSource>>,
 }
 
 /// What the window must do after the panel ran.
@@ -67,6 +71,10 @@ pub fn show(
         ui.heading("Weft");
         scene_section(ui, session, state, &mut out);
         ui.separator();
+        if session.sim.scene.character.is_some() {
+            character::section(ui, session, state, &mut out);
+            ui.separator();
+        }
         stats_section(ui, session);
         ui.separator();
         solver_section(ui, session, state);
@@ -180,7 +188,7 @@ fn scene_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out
     }
 }
 
-fn short(label: &str) -> String {
+pub(crate) fn short(label: &str) -> String {
     Path::new(label)
         .file_name()
         .map_or_else(|| label.to_owned(), |f| f.to_string_lossy().into_owned())

@@ -173,10 +173,17 @@ impl Session {
 
     /// Switches to another scene (refused while recording: a log holds one scene).
     pub fn switch_scene(&mut self, source: SceneSource) -> anyhow::Result<()> {
+        self.load(source, &[])
+    }
+
+    /// Loads the scene `source` with `overrides` in place of the current one, from time 0
+    /// (refused while recording: a log holds one scene; a scene that does not load leaves
+    /// the current one as it is).
+    pub fn load(&mut self, source: SceneSource, overrides: &[Override]) -> anyhow::Result<()> {
         if self.log.is_some() {
             anyhow::bail!("a recorded session keeps its scene; stop and start a new one");
         }
-        let scene = source.load(&[]).map_err(|e| {
+        let scene = source.load(overrides).map_err(|e| {
             let lines: Vec<String> = e.0.iter().map(|e| e.to_string()).collect();
             anyhow::anyhow!(lines.join("\n"))
         })?;

@@ -60,7 +60,7 @@ pub struct Tracks {
     pub times: Vec<f64>,
     /// Cloths, in the scene's order.
     pub cloths: Vec<ClothTrack>,
-    /// Colliders, in the scene's order.
+    /// Colliders, in the scene's order, then the character's body parts.
     pub colliders: Vec<ColliderTrack>,
 }
 
@@ -235,32 +235,7 @@ pub fn read_tracks(
         let mut poses = Vec::with_capacity(n);
         for (k, &time) in times.iter().enumerate() {
             let pose = if has_states {
-                let state = states[k].as_ref().with_context(|| {
-                    format!(
-                        "{} has no message at frame {}",
-                        collider_state::TOPIC,
-                        frames[k]
-                    )
-                })?;
-                let entry = state["colliders"]
-                    .as_array()
-                    .and_then(|cs| cs.iter().find(|c| c["name"] == spec.name.as_str()))
-                    .with_context(|| {
-                        format!(
-                            "{} at frame {} does not list collider {}",
-                            collider_state::TOPIC,
-                            frames[k],
-                            spec.name
-                        )
-                    })?;
-                pose_of(entry).with_context(|| {
-                    format!(
-                        "{} at frame {}: collider {} has no position or rotation",
-                        collider_state::TOPIC,
-                        frames[k],
-                        spec.name
-                    )
-                })?
+                logged_pose(&states, k, &frames, &spec.name)?
             } else {
                 let s = ColliderState::at(spec, time);
                 (s.position, s.rotation)
@@ -274,10 +249,46 @@ pub fn read_tracks(
             poses,
         });
     }
+    colliders.extend(super::body::tracks(
+        scene, has_states, &states, &frames, &times,
+    )?);
     Ok(Tracks {
         frames,
         times,
         cloths,
         colliders,
+    })
+}
+
+/// Collider `name`'s pose at exported frame `k` as `/colliders/state` logged it.
+pub fn logged_pose(
+    states: &[Option<serde_json::Value>],
+    k: usize,
+    frames: &[u64],
+    name: &str,
+) -> anyhow::Result<(DVec3, DQuat)> {
+    let state = states[k].as_ref().with_context(|| {
+        format!(
+            "{} has no message at frame {}",
+            collider_state::TOPIC,
+            frames[k]
+        )
+    })?;
+    let entry = state["colliders"]
+        .as_array()
+        .and_then(|cs| cs.iter().find(|c| c["name"] == name))
+        .with_context(|| {
+            format!(
+                "{} at frame {} does not list collider {name}",
+                collider_state::TOPIC,
+                frames[k],
+            )
+        })?;
+    pose_of(entry).with_context(|| {
+        format!(
+            "{} at frame {}: collider {name} has no position or rotation",
+            collider_state::TOPIC,
+            frames[k],
+        )
     })
 }

@@ -5,6 +5,7 @@
 //! through `output.rs` (a partial renamed when whole, never over the log). A signal stops the
 //! export between two messages or frames: files finished stay, the one in progress goes.
 
+pub mod body;
 pub mod estimate;
 pub mod glb;
 pub mod log;
@@ -91,6 +92,9 @@ fn needs(format: ExportFormat, scene: &weft_scene::Scene, frames: u64, log_bytes
         cv += v;
         ct += t;
     }
+    let body_parts = body::part_count(scene) as u64;
+    cv += 2000 * body_parts;
+    ct += 4000 * body_parts;
     let held = frames * particles.iter().sum::<u64>() * 12;
     match format {
         ExportFormat::Obj => {
@@ -109,7 +113,7 @@ fn needs(format: ExportFormat, scene: &weft_scene::Scene, frames: u64, log_bytes
                 cloth_triangles,
                 cv,
                 ct,
-                scene.colliders.len() as u64,
+                scene.colliders.len() as u64 + body_parts,
             );
             Needs {
                 memory: log_bytes + held + size,

@@ -9,6 +9,8 @@
 use serde_json::{Map, Value, json};
 use weft_collide::ShapeDesc;
 use weft_scene::ColliderSpec;
+
+use crate::body::PartPose;
 use weft_solver::glam::{DQuat, DVec3};
 
 /// The channel's topic.
@@ -32,6 +34,21 @@ pub enum StateShape {
         radius: f64,
         /// Half the length of the core segment (m).
         half_height: f64,
+    },
+    /// A round cone (a body part): the spheres of radii `r0` at `a` and `r1` at `b` joined by
+    /// the cone tangent to both; in its local frame `a` is at y = −`half_height` and `b` at
+    /// +`half_height`.
+    RoundCone {
+        /// Radius at `a` (m).
+        r0: f64,
+        /// Radius at `b` (m).
+        r1: f64,
+        /// Half the distance between the end points (m).
+        half_height: f64,
+        /// First end point (world, m).
+        a: DVec3,
+        /// Second end point (world, m).
+        b: DVec3,
     },
     /// A box centred on the pose.
     Cuboid {
@@ -69,9 +86,10 @@ pub struct ColliderState {
 
 impl StateShape {
     /// Every kind, as written in `"shape"`.
-    pub const KINDS: [&'static str; 7] = [
+    pub const KINDS: [&'static str; 8] = [
         "sphere",
         "capsule",
+        "round-cone",
         "cuboid",
         "plane",
         "convex-hull",
@@ -84,6 +102,7 @@ impl StateShape {
         match self {
             StateShape::Sphere { .. } => "sphere",
             StateShape::Capsule { .. } => "capsule",
+            StateShape::RoundCone { .. } => "round-cone",
             StateShape::Cuboid { .. } => "cuboid",
             StateShape::Plane { .. } => "plane",
             StateShape::ConvexHull => "convex-hull",
@@ -97,6 +116,7 @@ impl StateShape {
         match kind {
             "sphere" => &["radius"],
             "capsule" => &["radius", "half_height"],
+            "round-cone" => &["r0", "r1", "half_height", "a", "b"],
             "cuboid" => &["half_extents"],
             "plane" => &["normal", "offset"],
             "compound" => &["parts"],
@@ -116,6 +136,19 @@ impl StateShape {
             } => {
                 o.insert("radius".into(), json!(radius));
                 o.insert("half_height".into(), json!(half_height));
+            }
+            StateShape::RoundCone {
+                r0,
+                r1,
+                half_height,
+                a,
+                b,
+            } => {
+                o.insert("r0".into(), json!(r0));
+                o.insert("r1".into(), json!(r1));
+                o.insert("half_height".into(), json!(half_height));
+                o.insert("a".into(), vec3(*a));
+                o.insert("b".into(), vec3(*b));
             }
             StateShape::Cuboid { half_extents } => {
                 o.insert("half_extents".into(), vec3(*half_extents));
@@ -186,6 +219,33 @@ impl ColliderState {
         }
     }
 
+    /// The state of a body part at its pose: a sphere when its ends coincide, a capsule when
+    /// its radii are equal, else a round cone.
+    pub fn of_part(name: String, part: &PartPose) -> Self {
+        let shape = if part.is_sphere() {
+            StateShape::Sphere { radius: part.r0 }
+        } else if part.is_capsule() {
+            StateShape::Capsule {
+                radius: part.r0,
+                half_height: part.half_height(),
+            }
+        } else {
+            StateShape::RoundCone {
+                r0: part.r0,
+                r1: part.r1,
+                half_height: part.half_height(),
+                a: part.a,
+                b: part.b,
+            }
+        };
+        Self {
+            name,
+            position: part.position,
+            rotation: part.rotation,
+            shape,
+        }
+    }
+
     /// The state of a scene collider at time `time` (s), moved by its motion.
     pub fn at(collider: &ColliderSpec, time: f64) -> Self {
         let (position, rotation) = collider
@@ -208,11 +268,20 @@ impl ColliderState {
     }
 }
 
-/// Every collider of `colliders` at time `time` (s).
-pub fn states(time: f64, colliders: &[ColliderSpec]) -> Vec<ColliderState> {
+/// Every collider of `colliders` at time `time` (s), then every body part of `body` (named,
+/// at that time's pose).
+pub fn states(
+    time: f64,
+    colliders: &[ColliderSpec],
+    body: &[(String, PartPose)],
+) -> Vec<ColliderState> {
     colliders
         .iter()
         .map(|c| ColliderState::at(c, time))
+        .chain(
+            body.iter()
+                .map(|(name, p)| ColliderState::of_part(name.clone(), p)),
+        )
         .collect()
 }
 
@@ -248,7 +317,14 @@ pub fn schema() -> String {
             "radius": {"type": "number", "exclusiveMinimum": 0,
                        "description": "sphere or capsule radius (m)"},
             "half_height": {"type": "number", "minimum": 0,
-                            "description": "capsule: half the core segment, along local y (m)"},
+                            "description": "capsule, round cone: half the core segment, along \
+                                            local y (m)"},
+            "r0": {"type": "number", "exclusiveMinimum": 0,
+                   "description": "round cone: radius at a, local y = -half_height (m)"},
+            "r1": {"type": "number", "exclusiveMinimum": 0,
+                   "description": "round cone: radius at b, local y = +half_height (m)"},
+            "a": number_array(3, "round cone: the end point of radius r0 (world, m)"),
+            "b": number_array(3, "round cone: the end point of radius r1 (world, m)"),
             "half_extents": number_array(3, "cuboid half extents along the local axes (m)"),
             "normal": number_array(3, "plane: outward unit normal, world frame"),
             "offset": {"type": "number",

@@ -25,7 +25,7 @@ pub fn timestamp(time: f64) -> Timestamp {
     Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
 }
 
-fn vec3(v: DVec3) -> Vector3 {
+pub(super) fn vec3(v: DVec3) -> Vector3 {
     Vector3 {
         x: v.x,
         y: v.y,
@@ -33,7 +33,7 @@ fn vec3(v: DVec3) -> Vector3 {
     }
 }
 
-fn pose(position: DVec3, rotation: DQuat) -> Pose {
+pub(super) fn pose(position: DVec3, rotation: DQuat) -> Pose {
     Pose {
         position: Some(vec3(position)),
         orientation: Some(Quaternion {
@@ -113,7 +113,7 @@ pub fn method_color(method: weft_solver::Method) -> Color {
     Color { r, g, b, a: 1.0 }
 }
 
-const GREY: Color = Color {
+pub(super) const GREY: Color = Color {
     r: 0.6,
     g: 0.6,
     b: 0.62,

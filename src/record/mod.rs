@@ -1,5 +1,6 @@
 //! Logging runs to MCAP: Foxglove messages and the writer.
 
+mod body;
 pub mod collider_state;
 pub mod messages;
 pub mod verify;

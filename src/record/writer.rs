@@ -11,7 +11,7 @@ use foxglove::messages::{PointCloud, SceneUpdate};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::{Attachment, Compression, WriteOptions, Writer};
 
-use crate::record::{collider_state, messages};
+use crate::record::{body, collider_state, messages};
 use crate::sim::{FrameStats, Simulation};
 
 /// What a run logs besides particles.
@@ -84,6 +84,9 @@ impl Recorder {
         let st = w.add_schema("weft.FrameStats", "jsonschema", STATS_SCHEMA.as_bytes())?;
         let none = BTreeMap::new();
         let scene = &sim.scene;
+        // A character's body is logged with the colliders, and moves every frame.
+        let has_body = !crate::body::parts(sim).is_empty();
+        let no_colliders = scene.colliders.is_empty() && !has_body;
         let mut particles = Vec::new();
         let mut meshes = Vec::new();
         for c in &scene.cloths {
@@ -94,14 +97,14 @@ impl Recorder {
                 meshes.push(w.add_channel(su, &topic, "protobuf", &none)?);
             }
         }
-        let colliders = if scene.colliders.is_empty() {
+        let colliders = if no_colliders {
             None
         } else {
             Some(w.add_channel(su, "/colliders", "protobuf", &none)?)
         };
         let stats = w.add_channel(st, "/stats", "json", &none)?;
         // Added after every older schema and channel, so theirs keep their ids.
-        let collider_state = if scene.colliders.is_empty() {
+        let collider_state = if no_colliders {
             None
         } else {
             let cs = w.add_schema(
@@ -167,10 +170,11 @@ impl Recorder {
         for (path, bytes) in &scene.files {
             attach(format!("files/{path}"), "model/obj", bytes)?;
         }
-        let moving_colliders = scene
-            .colliders
-            .iter()
-            .any(|c| c.motion != weft_solver::Motion::Static);
+        let moving_colliders = has_body
+            || scene
+                .colliders
+                .iter()
+                .any(|c| c.motion != weft_solver::Motion::Static);
         Ok(Self {
             w,
             particles,
@@ -212,6 +216,7 @@ impl Recorder {
     /// Logs the current state of every cloth, the colliders and the frame's statistics.
     pub fn frame(&mut self, sim: &Simulation, stats: &FrameStats) -> anyhow::Result<()> {
         let time = stats.time;
+        let parts = crate::body::parts(sim);
         for (i, c) in sim.scene.cloths.iter().enumerate() {
             let x = sim.cloth_positions(i);
             let ch = self.particles[i];
@@ -227,11 +232,12 @@ impl Recorder {
         if let Some(ch) = self.colliders
             && (stats.frame == 0 || self.moving_colliders)
         {
-            let m = messages::colliders(time, &sim.scene.colliders);
+            let mut m = messages::colliders(time, &sim.scene.colliders);
+            m.entities.extend(body::entities(time, &parts));
             self.put(ch, time, &m)?;
         }
         if let Some(ch) = self.collider_state {
-            let states = collider_state::states(time, &sim.scene.colliders);
+            let states = collider_state::states(time, &sim.scene.colliders, &parts);
             let m = collider_state::message(stats.frame, time, &states);
             self.buf = serde_json::to_vec(&m)?;
             self.raw(ch, time)?;

@@ -13,6 +13,10 @@ Usage: read_collider_state.py LOG.mcap
   motion prescribes: static, linear x0 + v t, or oscillating x0 + A sin(2 pi f t) (t is the
   message's log time), to 1e-9 m. Colliders whose motion is a rotation are checked for their
   unit quaternion only.
+* a scene with a `[character]` also lists its body parts (`body/<i>`, after the colliders), the
+  same ones every frame; each part's pose agrees with its own parameters as documented:
+  `position` is halfway between the end points `a` and `b` of a round cone, `rotation` turns
+  (0, +-half_height, 0) onto `b` and `a`, and `half_height` is half their distance (1e-9 m).
 """
 
 import json
@@ -44,6 +48,32 @@ def expected_position(collider: dict, t: float) -> list:
     return None  # a rotation about a pivot moves the position too: not checked here
 
 
+def rotate(q: list, v: list) -> list:
+    """The vector v turned by the unit quaternion q = [x, y, z, w]."""
+    x, y, z, w = q
+    u = [x, y, z]
+    cross = lambda a, b: [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                          a[0] * b[1] - a[1] * b[0]]
+    t = [2.0 * c for c in cross(u, v)]
+    return [v[i] + w * t[i] + cross(u, t)[i] for i in range(3)]
+
+
+def check_part(part: dict) -> float:
+    """How far a body part's pose is from its own end points (m); 0 for a sphere."""
+    assert part["shape"] in ("round-cone", "capsule", "sphere"), part["shape"]
+    if part["shape"] != "round-cone":
+        assert part["radius"] > 0.0, part
+        return 0.0
+    assert part["r0"] > 0.0 and part["r1"] > 0.0, part
+    h, p, a, b = part["half_height"], part["position"], part["a"], part["b"]
+    up = rotate(part["rotation"], [0.0, h, 0.0])
+    worst = abs(2.0 * h - math.dist(a, b))
+    for i in range(3):
+        worst = max(worst, abs(p[i] - 0.5 * (a[i] + b[i])), abs(p[i] + up[i] - b[i]),
+                    abs(p[i] - up[i] - a[i]))
+    return worst
+
+
 def main(log_path: str) -> int:
     with open(log_path, "rb") as f:
         reader = make_reader(f, validate_crcs=True)
@@ -70,14 +100,23 @@ def main(log_path: str) -> int:
         attachments = {a.name: a.data for a in reader.iter_attachments()}
     scene = tomllib.loads(attachments["scene/effective.toml"].decode())
     colliders = scene.get("collider", [])
-    assert colliders, "the scene has no [[collider]]"
+    character = "character" in scene
+    assert colliders or character, "the scene has no [[collider]] and no [character]"
+    parts = None
     assert [(t, v["frame"]) for t, v in states] == stats, "one message per /stats frame"
     worst = 0.0
     for log_time, value in states:
         t = log_time * 1e-9
         assert abs(value["time"] - t) < 1e-9, (value["time"], t)
-        by_name = {c["name"]: c for c in value["colliders"]}
+        body = [c for c in value["colliders"] if c["name"].startswith("body/")]
+        by_name = {c["name"]: c for c in value["colliders"] if c not in body}
         assert len(by_name) == len(colliders), sorted(by_name)
+        assert bool(body) == character, "body parts listed exactly when there is a character"
+        names = [c["name"] for c in body]
+        assert parts is None or names == parts, "the same body parts every frame"
+        parts = names
+        body_worst = max([check_part(c) for c in body], default=0.0)
+        assert body_worst < 1e-9, f"frame {value['frame']}: a body part is {body_worst} m off"
         for c in colliders:
             got = by_name[c["name"]]
             assert got["shape"] == c["shape"], (got["shape"], c["shape"])
@@ -92,7 +131,8 @@ def main(log_path: str) -> int:
     assert worst < 1e-9, f"positions differ from the analytic motion by {worst} m"
     print(
         f"read_collider_state.py: {log_path}: schema valid, {len(states)} frames, "
-        f"{len(colliders)} collider(s) at their analytic poses (worst {worst:.1e} m)"
+        f"{len(colliders)} collider(s) at their analytic poses (worst {worst:.1e} m), "
+        f"{len(parts or [])} body part(s)"
     )
     return 0
 

@@ -17,6 +17,10 @@ use crate::skeleton::{Joint, Skeleton};
 /// Duration of one stride (two steps), s.
 pub const WALK_PERIOD: f64 = 1.1;
 
+/// How far the arms hang away from the body (rad, about the walker's forward axis): enough
+/// for a sleeve and a shirt's side seam to pass between arm and torso.
+pub const ABDUCT: f64 = 0.20;
+
 /// Frames in one stride of the built-in clip (40 frames per second).
 pub const WALK_FRAMES: usize = 44;
 
@@ -104,7 +108,7 @@ pub fn walk_pose(skeleton: &Skeleton, t: f64) -> Pose {
     set("Chest", DQuat::from_rotation_y(-0.12 * p.sin()));
     set("Neck", DQuat::from_rotation_y(0.03 * p.sin()));
     set("Head", DQuat::from_rotation_y(0.02 * p.sin()) * rx(-0.03));
-    for (side, phase, abduct) in [("Left", p, 0.10), ("Right", p + PI, -0.10)] {
+    for (side, phase, abduct) in [("Left", p, ABDUCT), ("Right", p + PI, -ABDUCT)] {
         let l = limbs(phase);
         set(&format!("{side}UpLeg"), rx(l.thigh));
         set(&format!("{side}Leg"), rx(l.knee));

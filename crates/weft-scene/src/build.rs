@@ -1,8 +1,14 @@
 //! Builds the solvers of a scene: one per method, cloths in name order.
 
-use weft_collide::CollisionWorld;
-use weft_solver::{Method, Motion, Settings, Solver, SolverBuilder, SolverError, StepStats};
+use std::sync::Arc;
 
+use weft_character::{Attachment, AttachmentDriver};
+use weft_collide::CollisionWorld;
+use weft_solver::{
+    Family, FamilyParams, Method, Motion, Settings, Solver, SolverBuilder, SolverError, StepStats,
+};
+
+use crate::collide::DelayedSelfCollision;
 use crate::error::{Origin, SceneError};
 use crate::scene::Scene;
 
@@ -15,16 +21,37 @@ pub struct SolverGroup {
     pub solver: Solver,
     /// Indices into [`Scene::cloths`], in the solver's cloth order.
     pub cloths: Vec<usize>,
-    /// Colliders and self-collision acting on this solver, if any.
+    /// Colliders, the character's body and self-collision acting on this solver, if any.
     pub world: Option<CollisionWorld>,
+    /// Self-collision waiting for garment seams to close, if any.
+    pub delayed_self_collision: Option<DelayedSelfCollision>,
 }
 
 impl SolverGroup {
-    /// Steps the solver one frame through its collision world (if any).
+    /// Steps the solver one frame through its collision world (if any); turns on delayed
+    /// self-collision after the frame in which the seams closed.
     pub fn step(&mut self) -> Result<StepStats, SolverError> {
-        match self.world.as_mut() {
+        let stats = match self.world.as_mut() {
             Some(w) => self.solver.step_with(w),
             None => self.solver.step(),
+        }?;
+        self.sew_done();
+        Ok(stats)
+    }
+
+    /// Turns on delayed self-collision if its time has come (the current positions become
+    /// its rest state).
+    pub fn sew_done(&mut self) {
+        if let Some(d) = &self.delayed_self_collision
+            && self.solver.time() >= d.at - 1e-9
+            && let Some(w) = self.world.as_mut()
+        {
+            // The cloths and parameters were checked when the scene was built.
+            if w.enable_self_collision(&self.solver, &d.cloths, d.params)
+                .is_ok()
+            {
+                self.delayed_self_collision = None;
+            }
         }
     }
 }
@@ -58,6 +85,17 @@ impl Scene {
                 let idx = b
                     .add_cloth(c.name.clone(), &c.mesh, c.params, c.thickness)
                     .map_err(|e| err(key.clone(), &e))?;
+                if !c.seams.is_empty() {
+                    let stretch = c.params.get(Family::Stretch);
+                    let seam = FamilyParams {
+                        spring_stiffness: stretch.spring_stiffness,
+                        spring_damping: stretch.spring_damping,
+                        damping: stretch.damping,
+                        ..FamilyParams::seam_default()
+                    };
+                    b.add_seams(idx, &c.seams, c.seam_time, seam)
+                        .map_err(|e| err(format!("{key}.seam_time"), &e))?;
+                }
                 if c.motion != Motion::Static {
                     for &v in &c.mesh.pinned {
                         b.add_kinematic_pin(idx, v, c.motion)
@@ -66,15 +104,62 @@ impl Scene {
                 }
                 members.push(i);
             }
-            let solver = b.build();
-            let world = self.collision_world(&solver, &members)?;
+            let mut solver = b.build();
+            self.attach(&mut solver, &members)?;
+            let (world, delayed_self_collision) = self.collision_world(&solver, &members)?;
             groups.push(SolverGroup {
                 method,
                 solver,
                 cloths: members,
                 world,
+                delayed_self_collision,
             });
         }
         Ok(groups)
+    }
+}
+
+impl Scene {
+    /// Drives each garment's attached vertices with its bones (one driver per cloth), bound
+    /// at the solver's present time.
+    fn attach(&self, solver: &mut Solver, members: &[usize]) -> Result<(), SceneError> {
+        let Some(ch) = &self.character else {
+            return Ok(());
+        };
+        for (j, &i) in members.iter().enumerate() {
+            let c = &self.cloths[i];
+            if c.attachments.is_empty() {
+                continue;
+            }
+            let err = |e: &dyn std::fmt::Display| SceneError {
+                origin: Origin::File {
+                    path: self.name.clone(),
+                    line: None,
+                },
+                key: format!("cloth.{}.attach", c.name),
+                message: e.to_string(),
+            };
+            let bones = ch.character.animation().bones(solver.time());
+            let attachments = c
+                .attachments
+                .iter()
+                .map(|a| {
+                    Attachment::bind(
+                        a.bone,
+                        a.vertices.clone(),
+                        &c.mesh.positions,
+                        &bones[a.bone].transform,
+                    )
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| err(&e))?;
+            let first = solver.cloths()[j].particles.start;
+            let driver = AttachmentDriver::new(ch.character.clone(), first, attachments)
+                .map_err(|e| err(&e))?;
+            solver
+                .add_pin_driver(Arc::new(driver))
+                .map_err(|e| err(&e))?;
+        }
+        Ok(())
     }
 }

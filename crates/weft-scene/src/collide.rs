@@ -1,10 +1,23 @@
 //! Wires a scene's colliders and self-collision to `weft-collide`: one collision world per
 //! solver, holding every collider (colliders are f64 here, rounded to f32 inside parry).
 
-use weft_collide::{ColliderDesc, CollisionWorld, Friction, SelfCollisionParams};
+use std::sync::Arc;
+
+use weft_collide::{ColliderDesc, CollisionWorld, Friction, KinematicBody, SelfCollisionParams};
 use weft_solver::Solver;
 
 use crate::error::{Origin, SceneError};
+
+/// Self-collision to turn on once a garment's seams have closed.
+#[derive(Clone, Debug)]
+pub struct DelayedSelfCollision {
+    /// Solver time at which to turn it on (s): the latest seam closing time.
+    pub at: f64,
+    /// The solver's cloths that take part.
+    pub cloths: Vec<usize>,
+    /// Its parameters.
+    pub params: SelfCollisionParams,
+}
 use crate::scene::{ColliderSpec, Scene};
 
 /// The collision crate's description of a collider (the shape is already in its form).
@@ -29,12 +42,17 @@ impl Scene {
     }
 
     /// The collision world for `solver`, whose cloths are scene cloths `members`; `None`
-    /// when the scene has no collider and no self-collision among these cloths.
+    /// when the scene has no collider, no character and no self-collision among these cloths.
+    ///
+    /// When one of the self-colliding cloths is a garment whose seams are still closing,
+    /// self-collision is not turned on here: it is returned, to be turned on once the seams
+    /// have closed (see [`crate::SolverGroup::step`]), with the sewn garment as its rest state,
+    /// so that the two sides of a seam are not held a thickness apart.
     pub fn collision_world(
         &self,
         solver: &Solver,
         members: &[usize],
-    ) -> Result<Option<CollisionWorld>, SceneError> {
+    ) -> Result<(Option<CollisionWorld>, Option<DelayedSelfCollision>), SceneError> {
         let self_cloths: Vec<usize> = match &self.self_collision {
             Some(sc) => members
                 .iter()
@@ -44,8 +62,8 @@ impl Scene {
                 .collect(),
             None => Vec::new(),
         };
-        if self.colliders.is_empty() && self_cloths.is_empty() {
-            return Ok(None);
+        if self.colliders.is_empty() && self_cloths.is_empty() && self.character.is_none() {
+            return Ok((None, None));
         }
         let mut world = CollisionWorld::new(solver);
         for (i, c) in self.colliders.iter().enumerate() {
@@ -54,6 +72,8 @@ impl Scene {
                 .add_collider(&collider_desc(c))
                 .map_err(|e| self.collide_error(key, e.to_string()))?;
         }
+        self.add_character(&mut world)?;
+        let mut delayed = None;
         if let Some(sc) = &self.self_collision
             && !self_cloths.is_empty()
         {
@@ -63,10 +83,38 @@ impl Scene {
                 search_margin: sc.search_margin,
                 adaptive_margin: sc.adaptive_search_margin,
             };
-            world
-                .enable_self_collision(solver, &self_cloths, params)
-                .map_err(|e| self.collide_error("self_collision".into(), e.to_string()))?;
+            let sewn_at = self_cloths
+                .iter()
+                .map(|&j| &self.cloths[members[j]])
+                .filter(|c| !c.seams.is_empty())
+                .map(|c| c.seam_time)
+                .fold(None, |a: Option<f64>, t| Some(a.map_or(t, |a| a.max(t))));
+            match sewn_at {
+                Some(at) if at > 0.0 => {
+                    delayed = Some(DelayedSelfCollision {
+                        at,
+                        cloths: self_cloths,
+                        params,
+                    })
+                }
+                _ => world
+                    .enable_self_collision(solver, &self_cloths, params)
+                    .map_err(|e| self.collide_error("self_collision".into(), e.to_string()))?,
+            }
         }
-        Ok(Some(world))
+        Ok((Some(world), delayed))
+    }
+}
+
+impl Scene {
+    /// Adds the scene's character (its body, moving with the clip) to `world`.
+    fn add_character(&self, world: &mut CollisionWorld) -> Result<(), SceneError> {
+        if let Some(ch) = &self.character {
+            let body: Arc<dyn KinematicBody> = ch.character.clone();
+            world
+                .add_body(body, Friction::new(ch.static_friction, ch.dynamic_friction))
+                .map_err(|e| self.collide_error("character".into(), e.to_string()))?;
+        }
+        Ok(())
     }
 }

@@ -1,5 +1,5 @@
 //! Weft's scene files: the TOML format (`[sim]`, `[cloth.<name>]`, `[wind]`, `[[collider]]`,
-//! `[self_collision]`), `--set` overrides, validation with file/line/key errors, and the
+//! `[self_collision]`, `[character]`), `--set` overrides, validation with file/line/key errors, and the
 //! solvers a scene yields (one per method, stepped in lockstep).
 #![warn(missing_docs)]
 
@@ -18,12 +18,12 @@ pub mod schema;
 mod source;
 
 pub use build::SolverGroup;
-pub use collide::collider_desc;
+pub use collide::{DelayedSelfCollision, collider_desc};
 pub use error::{LONGEST_WORD, Origin, SceneError, SceneErrors, elide};
 pub use limits::{BYTES_PER_PARTICLE, Limits, PER_PARTICLE_SELF_COLLISION, estimate_bytes, human};
 pub use load::{from_text, from_text_with, load, load_with};
 pub use overrides::{Override, parse_value};
 pub use scene::{
-    CappedDirFiles, ClothSpec, ColliderSpec, DEFAULT_MAX_FILE_BYTES, DirFiles, Files, MapFiles,
-    Scene, SelfCollisionSpec, read_regular,
+    AttachSpec, CappedDirFiles, CharacterSpec, ClothSpec, ColliderSpec, DEFAULT_MAX_FILE_BYTES,
+    DirFiles, Files, MapFiles, Scene, SelfCollisionSpec, read_regular,
 };

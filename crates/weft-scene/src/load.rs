@@ -159,6 +159,7 @@ pub fn from_text_with(
         cloths: parts.cloths,
         colliders: parts.colliders,
         self_collision: parts.self_collision,
+        character: parts.character,
         files: checker.read,
     })
 }

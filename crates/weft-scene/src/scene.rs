@@ -102,6 +102,35 @@ pub struct ClothSpec {
     pub thickness: f64,
     /// Motion of its pins.
     pub motion: Motion,
+    /// Garment seams: vertex pairs (mesh indices) to sew (empty for other cloths).
+    pub seams: Vec<[u32; 2]>,
+    /// Time over which the seams close (s).
+    pub seam_time: f64,
+    /// Vertices attached to the character's bones.
+    pub attachments: Vec<AttachSpec>,
+}
+
+/// Garment vertices pinned to a bone of the scene's character.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AttachSpec {
+    /// The bone's index in the skeleton.
+    pub bone: usize,
+    /// The bone's name.
+    pub bone_name: String,
+    /// Mesh vertices of the cloth.
+    pub vertices: Vec<u32>,
+}
+
+/// The scene's animated character: skeleton, clip and body.
+#[derive(Clone, Debug)]
+pub struct CharacterSpec {
+    /// The character (animation and body); its clock is the solvers' (t = 0 at the first
+    /// frame).
+    pub character: std::sync::Arc<weft_character::Character>,
+    /// Static friction between the body and cloth.
+    pub static_friction: f64,
+    /// Dynamic friction between the body and cloth.
+    pub dynamic_friction: f64,
 }
 
 /// A collider ready for the collision world.
@@ -163,6 +192,8 @@ pub struct Scene {
     pub colliders: Vec<ColliderSpec>,
     /// Self-collision, when on.
     pub self_collision: Option<SelfCollisionSpec>,
+    /// The animated character, when the scene has one.
+    pub character: Option<CharacterSpec>,
     /// Files the scene read (OBJ meshes), by the path written in the scene.
     pub files: BTreeMap<String, Vec<u8>>,
 }

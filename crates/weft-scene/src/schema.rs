@@ -31,6 +31,66 @@ pub struct SceneFile {
     /// `[self_collision]`: particle–particle collision among cloths.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub self_collision: Option<SelfCollisionSection>,
+    /// `[character]`: an animated skeleton and its body, which garments are attached to.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub character: Option<CharacterSection>,
+}
+
+/// How a clip continues past its end: `loop` or `clamp`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WrapName {
+    /// Repeat the clip.
+    #[default]
+    Loop,
+    /// Hold the last frame.
+    Clamp,
+}
+
+/// `[character]`: the skeleton and clip (the built-in `walker` or a BVH file), the body table
+/// (built-in `walker` or `cmu`, or a file) and how the clip plays.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CharacterSection {
+    /// `walker` (the procedural walk cycle) or a BVH file, relative to the scene.
+    #[serde(default = "default_walker")]
+    pub skeleton: String,
+    /// BVH length unit in metres (BVH files only; e.g. 0.01 for centimetres).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
+    /// `walker`, `cmu` (built-in body tables) or a body-table TOML file.
+    #[serde(default = "default_walker")]
+    pub body: String,
+    /// `loop` or `clamp`.
+    #[serde(default)]
+    pub wrap: WrapName,
+    /// Static friction between the body and cloth.
+    #[serde(default = "default_static_friction")]
+    pub static_friction: f64,
+    /// Dynamic friction between the body and cloth.
+    #[serde(default = "default_dynamic_friction")]
+    pub dynamic_friction: f64,
+}
+
+fn default_walker() -> String {
+    "walker".into()
+}
+
+/// One attachment of a garment cloth: the vertices along outline edges of a panel, pinned to
+/// a bone of the `[character]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttachSection {
+    /// The bone (joint name in the skeleton).
+    pub bone: String,
+    /// The panel (name in the garment file).
+    pub panel: String,
+    /// First and last outline edge, inclusive (as in the garment's seams).
+    pub edges: [i64; 2],
+    /// The part of that run to attach, as fractions of its vertices from its first corner
+    /// to its last (default `[0, 1]`: all of it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub span: Option<[f64; 2]>,
 }
 
 /// A method name: `xpbd`, `pbd`, `mass-spring` or `implicit-mass-spring` (alias `implicit`).
@@ -391,6 +451,16 @@ cloth_section! {
         /// family keys override what it derives.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub material: Option<crate::material::MaterialSpec>,
+        /// A garment file (panels and seams, weft-character's format) instead of a grid or
+        /// mesh, relative to the scene.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub garment: Option<String>,
+        /// Time over which the garment's seams close (s, default 0.5).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub seam_time: Option<f64>,
+        /// Garment vertices attached to the character's bones.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub attach: Option<Vec<AttachSection>>,
     }
     families {
         Stretch: stretch_enabled, stretch_compliance, stretch_damping,

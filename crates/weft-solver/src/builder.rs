@@ -3,7 +3,7 @@
 use glam::DVec3;
 
 use crate::cloth::ClothMesh;
-use crate::constraints::{BlockBuilder, ConstraintSet, Dihedral, Distance, Tether};
+use crate::constraints::{BlockBuilder, ConstraintSet, Dihedral, Distance, Seam, Tether};
 use crate::error::{BuildError, ParamError};
 use crate::forces::Forces;
 use crate::motion::{KinematicPin, Motion};
@@ -27,6 +27,8 @@ pub struct SolverBuilder {
     distance: BlockBuilder<2, Distance>,
     dihedral: BlockBuilder<4, Dihedral>,
     tethers: BlockBuilder<2, Tether>,
+    seams: BlockBuilder<2, Seam>,
+    seam_params: Vec<FamilyParams>,
     pins: Vec<KinematicPin>,
 }
 
@@ -44,6 +46,8 @@ impl SolverBuilder {
             distance: BlockBuilder::default(),
             dihedral: BlockBuilder::default(),
             tethers: BlockBuilder::default(),
+            seams: BlockBuilder::default(),
+            seam_params: Vec::new(),
             pins: Vec::new(),
         })
     }
@@ -150,6 +154,48 @@ impl SolverBuilder {
         Ok(cloth)
     }
 
+    /// Sews vertex pairs `pairs` of cloth `cloth` (vertex indices in its mesh): each pair gets
+    /// a [`Seam`] whose rest length ramps from the pair's present distance to zero over
+    /// `closing_time` seconds (from the solver's time 0), then holds it closed. `params` says
+    /// how stiff the seams are for each method (XPBD compliance and damping, PBD stiffness,
+    /// mass-spring stiffness and damping); returns the index of this set of seams.
+    pub fn add_seams(
+        &mut self,
+        cloth: usize,
+        pairs: &[[u32; 2]],
+        closing_time: f64,
+        params: FamilyParams,
+    ) -> Result<usize, BuildError> {
+        let range = self
+            .cloths
+            .get(cloth)
+            .map(|c| c.particles.clone())
+            .ok_or(BuildError::NoSuchVertex { cloth, vertex: 0 })?;
+        if !(closing_time.is_finite() && closing_time >= 0.0) {
+            return Err(ParamError {
+                name: "seam.closing_time".into(),
+                value: closing_time,
+                expected: "finite and >= 0",
+            }
+            .into());
+        }
+        params.validate_as("seam")?;
+        let group = self.seam_params.len() as u32;
+        for &[a, b] in pairs {
+            for v in [a, b] {
+                if range.start + v as usize >= range.end {
+                    return Err(BuildError::NoSuchVertex { cloth, vertex: v });
+                }
+            }
+            let (i, j) = (range.start + a as usize, range.start + b as usize);
+            let gap = self.particles.positions[i].distance(self.particles.positions[j]);
+            self.seams
+                .push([i as u32, j as u32], group, Seam::new(gap, closing_time));
+        }
+        self.seam_params.push(params);
+        Ok(group as usize)
+    }
+
     /// Pins vertex `vertex` of cloth `cloth` (inverse mass 0) to follow `motion` from its rest position.
     pub fn add_kinematic_pin(
         &mut self,
@@ -182,6 +228,8 @@ impl SolverBuilder {
             distance: self.distance.finish(&free),
             dihedral: self.dihedral.finish(&free),
             tethers: self.tethers.finish(&free),
+            seams: self.seams.finish(&free),
+            seam_params: self.seam_params,
         };
         let n = self.particles.len();
         Solver::assemble(

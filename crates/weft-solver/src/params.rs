@@ -114,6 +114,21 @@ impl FamilyParams {
 
     /// Checks every value is finite and in range; `family` names the parameter in the error.
     pub fn validate(&self, family: Family) -> Result<(), ParamError> {
+        self.validate_as(family.name())
+    }
+
+    /// Defaults for seams: held closed almost rigidly (XPBD compliance 10⁻⁹ m/N, PBD
+    /// stiffness 1) and, for the spring methods, the stretch family's default stiffness.
+    pub fn seam_default() -> Self {
+        Self {
+            enabled: true,
+            compliance: 1e-9,
+            ..Self::default_for(Family::Stretch)
+        }
+    }
+
+    /// As [`FamilyParams::validate`], naming the parameters `<name>.<field>`.
+    pub fn validate_as(&self, name: &str) -> Result<(), ParamError> {
         let non_negative = Self::check_non_negative as fn(f64) -> Result<(), &'static str>;
         [
             ("compliance", self.compliance, non_negative),
@@ -129,7 +144,7 @@ impl FamilyParams {
         .into_iter()
         .try_for_each(|(field, value, check)| {
             check(value).map_err(|expected| ParamError {
-                name: format!("{}.{field}", family.name()),
+                name: format!("{name}.{field}"),
                 value,
                 expected,
             })

@@ -305,6 +305,12 @@ impl Solver {
             .distance_residual(&self.particles.positions)
     }
 
+    /// The distance between the two vertices of every seam pair (m), in the order they were
+    /// added (see [`crate::SolverBuilder::add_seams`]).
+    pub fn seam_gaps(&self) -> Vec<f64> {
+        self.constraints.seam_gaps(&self.particles.positions)
+    }
+
     /// Holds particle `i` (inverse mass 0) where it is, until [`Solver::release`].
     pub fn grab(&mut self, i: usize) -> Result<(), SolverError> {
         if i >= self.particles.len() {
@@ -431,6 +437,7 @@ impl Solver {
         self.forces.wind.aero.is_none()
             && self.constraints.dihedral.len() == 0
             && self.constraints.tethers.len() == 0
+            && self.constraints.seams.len() == 0
     }
 
     /// Time at the end of substep `k`, and the pin and grab targets there, into `self.targets`.
@@ -552,6 +559,8 @@ impl Solver {
                 break;
             }
             let time = self.substep_targets(k);
+            // Seams pull towards the rest length of the substep's end.
+            self.constraints.set_seam_time(time);
             let ctx = SubstepContext {
                 method: s.method,
                 time,
@@ -608,6 +617,14 @@ impl Solver {
                             rule,
                         );
                         stats.contacts = hook.project(&ctx, p);
+                    }
+                    if self.constraints.seam_count() > 0 {
+                        self.constraints.hold_seams(
+                            &mut p.positions,
+                            &p.prev_positions,
+                            &p.inv_masses,
+                            rule,
+                        );
                     }
                 }
                 None => stats.contacts = hook.project(&ctx, p),

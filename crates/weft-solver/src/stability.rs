@@ -25,7 +25,7 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::constraints::{Block, ConstraintSet, Dihedral, Distance, Shape, Tether};
+use crate::constraints::{Block, ConstraintSet, Dihedral, Distance, Seam, Shape, Tether};
 use crate::params::FamilyParams;
 
 /// How fast a cloth's springs can ring and how much their dampers can bite.
@@ -234,6 +234,17 @@ fn highest_mode(
             &mut kz,
             &mut cz,
         );
+        let g = |s: &Seam, p: &[DVec3; 2]| s.evaluate(p).map(|(_, g)| g);
+        product(
+            &constraints.seams,
+            x,
+            &sw,
+            &constraints.seam_params,
+            g,
+            &z,
+            &mut kz,
+            &mut cz,
+        );
         lambda = dot(&z, &kz);
         damping = dot(&z, &cz);
         std::mem::swap(&mut z, &mut kz);
@@ -265,6 +276,13 @@ pub(crate) fn bound(
         let len = d.length();
         (len > 1e-9).then(|| [d / len, -d / len])
     });
+    rows.add(
+        &constraints.seams,
+        x,
+        w,
+        &constraints.seam_params,
+        |s, p| s.evaluate(p).map(|(_, g)| g),
+    );
     let max = |v: &[f64]| v[range.clone()].iter().copied().fold(0.0, f64::max);
     let (mode_omega, mode_gamma) = highest_mode(constraints, x, w, params, range.clone());
     StabilityBound {

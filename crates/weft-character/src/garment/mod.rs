@@ -42,6 +42,42 @@ pub struct PanelMesh {
     pub triangles: Range<usize>,
     /// Flat (2-D) rest coordinates of its vertices (m), in `vertices` order.
     pub flat: Vec<DVec2>,
+    /// For each outline edge, the index (among the boundary samples) of its first sample.
+    pub edge_starts: Vec<usize>,
+}
+
+impl PanelMesh {
+    /// The mesh vertices along outline edges `first..=last` (forward, wrapping past the last
+    /// corner), from the run's first corner to its last inclusive; `None` if an edge does not
+    /// exist.
+    pub fn edge_run(&self, first: usize, last: usize) -> Option<Vec<u32>> {
+        let m = self.edge_starts.len();
+        if first >= m || last >= m {
+            return None;
+        }
+        let mut out = Vec::new();
+        let mut k = first;
+        loop {
+            let end = if k + 1 == m {
+                self.boundary
+            } else {
+                self.edge_starts[k + 1]
+            };
+            out.extend((self.edge_starts[k]..end).map(|j| self.vertices.start + j as u32));
+            if k == last {
+                out.push(self.vertices.start + (end % self.boundary) as u32);
+                return Some(out);
+            }
+            k = (k + 1) % m;
+        }
+    }
+}
+
+impl Garment {
+    /// The panel called `name`.
+    pub fn panel(&self, name: &str) -> Option<&PanelMesh> {
+        self.panels.iter().find(|p| p.name == name)
+    }
 }
 
 /// A garment that cannot be built; names the line and key where it can.

@@ -84,6 +84,7 @@ pub fn build_garment(spec: &GarmentSpec) -> Result<Garment, GarmentError> {
             boundary: boundary.len(),
             triangles: first_triangle..triangles.len(),
             flat: tri.points,
+            edge_starts: starts.clone(),
         });
         starts_of.push((starts, boundary.len()));
     }

@@ -132,6 +132,21 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// Reads `path` as text (a garment, BVH or body-table file); names `what` in errors.
+    pub(super) fn read_text(&mut self, key: &str, path: &str, what: &str) -> Option<String> {
+        match self.files.read(path) {
+            Ok(bytes) => {
+                let text = String::from_utf8_lossy(&bytes).into_owned();
+                self.read.insert(path.to_owned(), bytes);
+                Some(text)
+            }
+            Err(e) => {
+                self.bad(key, format!("cannot read {what} file `{path}`: {e}"));
+                None
+            }
+        }
+    }
+
     pub(super) fn read_mesh(
         &mut self,
         key: &str,

@@ -6,10 +6,11 @@ use weft_solver::{
     Settings,
 };
 
+use super::garment::{DEFAULT_SEAM_TIME, garment};
 use super::{Checker, valid_name};
 use crate::family::{self, Field, Setting};
 use crate::ranges;
-use crate::scene::ClothSpec;
+use crate::scene::{CharacterSpec, ClothSpec};
 use crate::schema::{ClothSection, OrientationName, PinSpec};
 
 fn named_pin(name: &str) -> Option<Pin> {
@@ -31,6 +32,8 @@ pub(super) fn cloth(
     name: &str,
     s: &ClothSection,
     settings: &Settings,
+    character: Option<&CharacterSpec>,
+    has_character: bool,
 ) -> Option<ClothSpec> {
     let k = |field: &str| format!("cloth.{name}.{field}");
     let before = c.errors.len();
@@ -96,7 +99,46 @@ pub(super) fn cloth(
     let thickness = s.thickness.unwrap_or(0.005);
     c.within(&k("thickness"), thickness, &ranges::THICKNESS);
     let motion = c.motion(&k("motion"), &s.motion);
-    let mesh = if let Some(path) = &s.mesh {
+    let seam_time = s.seam_time.unwrap_or(DEFAULT_SEAM_TIME);
+    let mut seams = Vec::new();
+    let mut attachments = Vec::new();
+    if s.garment.is_none() {
+        c.unused(&k("seam_time"), &s.seam_time, "without a garment");
+        c.unused(&k("attach"), &s.attach, "without a garment");
+    }
+    let mesh = if s.garment.is_some() {
+        c.unused(
+            &k("mesh"),
+            &s.mesh,
+            "with a garment (give one or the other)",
+        );
+        c.unused(&k("resolution"), &s.resolution, "by a garment cloth");
+        c.unused(&k("size"), &s.size, "by a garment cloth");
+        c.unused(&k("orientation"), &s.orientation, "by a garment cloth");
+        c.unused(&k("scale"), &s.scale, "by a garment cloth");
+        c.unused(
+            &k("pins"),
+            &s.pins,
+            "by a garment cloth (attach it to a bone)",
+        );
+        c.non_negative(&k("seam_time"), seam_time);
+        let explicit = s.mass.is_some() || s.density.is_some() || material.is_some();
+        let g = garment(
+            c,
+            name,
+            s,
+            explicit.then_some(mass),
+            center,
+            character,
+            has_character,
+        )?;
+        if c.errors.len() > before {
+            return None;
+        }
+        seams = g.seams;
+        attachments = g.attachments;
+        g.mesh
+    } else if let Some(path) = &s.mesh {
         c.unused(&k("resolution"), &s.resolution, "by a mesh cloth");
         c.unused(&k("size"), &s.size, "by a mesh cloth");
         c.unused(&k("orientation"), &s.orientation, "by a mesh cloth");
@@ -206,6 +248,9 @@ pub(super) fn cloth(
         params,
         thickness,
         motion,
+        seams,
+        seam_time,
+        attachments,
     })
 }
 

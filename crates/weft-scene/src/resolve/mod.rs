@@ -2,17 +2,20 @@
 //! solver types, reporting every bad value with its key and line. The [`Checker`] holds the
 //! shared checks; a cloth, a collider each have their own file.
 
+mod character;
 mod checker;
 mod cloth;
 mod collider;
+mod garment;
 
 use weft_collide::SelfCollisionParams;
 use weft_solver::{Aero, Forces, Settings, Wind};
 
 use crate::ranges;
-use crate::scene::{ClothSpec, ColliderSpec, SelfCollisionSpec};
+use crate::scene::{CharacterSpec, ClothSpec, ColliderSpec, SelfCollisionSpec};
 use crate::schema::SceneFile;
 
+use character::character;
 pub(crate) use checker::Checker;
 use cloth::cloth;
 use collider::collider;
@@ -82,10 +85,20 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
     if file.cloth.is_empty() {
         c.bad("cloth", "a scene needs at least one [cloth.<name>] table");
     }
+    let character = file.character.as_ref().and_then(|s| character(c, s));
     let cloths: Vec<ClothSpec> = file
         .cloth
         .iter()
-        .filter_map(|(name, section)| cloth(c, name, section, &settings))
+        .filter_map(|(name, section)| {
+            cloth(
+                c,
+                name,
+                section,
+                &settings,
+                character.as_ref(),
+                file.character.is_some(),
+            )
+        })
         .collect();
     let colliders: Vec<ColliderSpec> = file
         .collider
@@ -140,6 +153,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
         cloths,
         colliders,
         self_collision,
+        character,
     })
 }
 
@@ -150,6 +164,7 @@ pub(crate) struct ResolvedParts {
     pub cloths: Vec<ClothSpec>,
     pub colliders: Vec<ColliderSpec>,
     pub self_collision: Option<SelfCollisionSpec>,
+    pub character: Option<CharacterSpec>,
 }
 
 pub(super) fn valid_name(name: &str) -> bool {

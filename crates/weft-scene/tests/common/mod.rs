@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 #[path = "../../../weft-collide/tests/common/watch.rs"]
-mod watch;
+pub mod watch;
 
 use std::path::{Path, PathBuf};
 

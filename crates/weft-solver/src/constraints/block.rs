@@ -46,6 +46,8 @@ pub(crate) struct Block<const N: usize, S> {
     pub lambda: Vec<f64>,
     /// Contiguous range of each colour.
     pub colors: Vec<Range<usize>>,
+    /// Insertion index of each constraint (before sorting by colour).
+    pub order: Vec<u32>,
     /// Scratch corrections for the parallel path (one colour at a time).
     deltas: Vec<[DVec3; N]>,
 }
@@ -58,6 +60,7 @@ impl<const N: usize, S> Default for Block<N, S> {
             shapes: Vec::new(),
             lambda: Vec::new(),
             colors: Vec::new(),
+            order: Vec::new(),
             deltas: Vec::new(),
         }
     }
@@ -108,6 +111,7 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
             shapes: order.iter().map(|&i| self.shapes[i]).collect(),
             lambda: vec![0.0; order.len()],
             colors: ranges,
+            order: order.iter().map(|&i| i as u32).collect(),
             deltas: vec![[DVec3::ZERO; N]; largest],
         }
     }
@@ -250,6 +254,39 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
                         x[idx[k][j] as usize] += *dj;
                     }
                 }
+            }
+        }
+    }
+
+    /// One sequential Gauss–Seidel sweep, in colour order, over the constraints for which
+    /// `keep(shape, positions)` holds.
+    pub fn project_where(
+        &mut self,
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        w: &[f64],
+        params: &[FamilyParams],
+        rule: Rule,
+        keep: impl Fn(&S, &[DVec3; N]) -> bool,
+    ) {
+        for k in 0..self.len() {
+            let idx = self.particles[k];
+            if !keep(&self.shapes[k], &idx.map(|i| x[i as usize])) {
+                continue;
+            }
+            let d = correction(
+                &self.shapes[k],
+                &idx,
+                self.group[k],
+                &mut self.lambda[k],
+                x,
+                prev,
+                w,
+                params,
+                rule,
+            );
+            for (j, dj) in d.iter().enumerate() {
+                x[idx[j] as usize] += *dj;
             }
         }
     }

@@ -15,7 +15,7 @@
 
 use glam::DVec3;
 
-use super::{Block, ConstraintSet, Dihedral, Distance, Shape, Tether};
+use super::{Block, ConstraintSet, Dihedral, Distance, Seam, Shape, Tether};
 use crate::params::FamilyParams;
 
 /// One spring evaluated at the current state.
@@ -41,6 +41,7 @@ pub(crate) struct Springs {
     distance: Vec<Linear<2, Distance>>,
     dihedral: Vec<Linear<4, Dihedral>>,
     tethers: Vec<Linear<2, Tether>>,
+    seams: Vec<Linear<2, Seam>>,
 }
 
 fn linearize<const N: usize, S: Shape<N>>(
@@ -114,6 +115,7 @@ impl ConstraintSet {
         linearize(&self.distance, x, v, params, &mut out.distance);
         linearize(&self.dihedral, x, v, params, &mut out.dihedral);
         linearize(&self.tethers, x, v, params, &mut out.tethers);
+        linearize(&self.seams, x, v, &self.seam_params, &mut out.seams);
     }
 }
 
@@ -130,6 +132,7 @@ impl Springs {
         add(&self.distance, f);
         add(&self.dihedral, f);
         add(&self.tethers, f);
+        add(&self.seams, f);
     }
 
     /// Adds (a_k K + a_c D) p to `out`, with K = −∂f/∂x and D = −∂f/∂v as above, in a fixed order.
@@ -141,6 +144,9 @@ impl Springs {
             l.product(a_k, a_c, p, out);
         }
         for l in &self.tethers {
+            l.product(a_k, a_c, p, out);
+        }
+        for l in &self.seams {
             l.product(a_k, a_c, p, out);
         }
     }
@@ -155,6 +161,9 @@ impl Springs {
             l.diagonal(a_k, a_c, diag);
         }
         for l in &self.tethers {
+            l.diagonal(a_k, a_c, diag);
+        }
+        for l in &self.seams {
             l.diagonal(a_k, a_c, diag);
         }
     }

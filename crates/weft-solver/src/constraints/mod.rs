@@ -5,12 +5,14 @@ mod dihedral;
 mod distance;
 pub(crate) mod lanes;
 mod linear;
+mod seam;
 mod tether;
 
 pub(crate) use block::{Block, BlockBuilder, Rule};
 pub use dihedral::Dihedral;
 pub use distance::Distance;
 pub(crate) use linear::Springs;
+pub use seam::Seam;
 pub use tether::Tether;
 
 use glam::DVec3;
@@ -44,7 +46,7 @@ pub(crate) fn distance_curvature(p: &[DVec3; 2], dp: &[DVec3; 2]) -> [DVec3; 2] 
     [h, -h]
 }
 
-/// Every constraint of a solver: distance-like pairs, dihedral quadruples and tethers.
+/// Every constraint of a solver: distance-like pairs, dihedral quadruples, tethers and seams.
 #[derive(Clone, Debug, Default)]
 pub struct ConstraintSet {
     /// Stretch, shear and bend-distance constraints.
@@ -53,6 +55,10 @@ pub struct ConstraintSet {
     pub(crate) dihedral: Block<4, Dihedral>,
     /// Long-range attachments.
     pub(crate) tethers: Block<2, Tether>,
+    /// Seams being sewn or held closed; their group indexes `seam_params`.
+    pub(crate) seams: Block<2, Seam>,
+    /// Parameters of each set of seams (one per [`crate::SolverBuilder::add_seams`]).
+    pub(crate) seam_params: Vec<FamilyParams>,
 }
 
 /// Max and root-mean-square of |C| over a set of constraints.
@@ -69,7 +75,7 @@ pub struct Residual {
 impl ConstraintSet {
     /// Number of constraints of every shape.
     pub fn len(&self) -> usize {
-        self.distance.len() + self.dihedral.len() + self.tethers.len()
+        self.distance.len() + self.dihedral.len() + self.tethers.len() + self.seams.len()
     }
 
     /// Whether there is no constraint.
@@ -86,14 +92,41 @@ impl ConstraintSet {
         ]
     }
 
+    /// Number of seam constraints.
+    pub fn seam_count(&self) -> usize {
+        self.seams.len()
+    }
+
+    /// Sets every seam's rest length for time `t` (s).
+    pub(crate) fn set_seam_time(&mut self, t: f64) {
+        for s in &mut self.seams.shapes {
+            s.set_time(t);
+        }
+    }
+
+    /// The distance between the two vertices of every seam pair (m), in the order the pairs
+    /// were added.
+    pub fn seam_gaps(&self, x: &[DVec3]) -> Vec<f64> {
+        let mut out: Vec<(u32, f64)> = self
+            .seams
+            .particles
+            .iter()
+            .zip(&self.seams.order)
+            .map(|(p, &k)| (k, x[p[0] as usize].distance(x[p[1] as usize])))
+            .collect();
+        out.sort_unstable_by_key(|&(k, _)| k);
+        out.into_iter().map(|(_, d)| d).collect()
+    }
+
     /// Clears the XPBD multipliers (at the start of each substep).
     pub(crate) fn reset_multipliers(&mut self) {
         // The distance constraints' multipliers live in `Domains`, which clears its own.
         self.dihedral.reset_multipliers();
         self.tethers.reset_multipliers();
+        self.seams.reset_multipliers();
     }
 
-    /// One Gauss–Seidel sweep over the dihedral and tether constraints, colour by colour, the
+    /// One Gauss–Seidel sweep over the dihedral, tether and seam constraints, colour by colour, the
     /// dihedrals' symmetric (forward, then backward); the distance constraints are solved by
     /// [`crate::domains::Domains`].
     pub(crate) fn project_others(
@@ -106,6 +139,19 @@ impl ConstraintSet {
     ) {
         self.dihedral.project_symmetric(x, prev, w, params, rule);
         self.tethers.project(x, prev, w, params, rule);
+        self.seams.project(x, prev, w, &self.seam_params, rule);
+    }
+
+    /// One more sweep over the closed seams alone (rest length 0, at most
+    /// [`Seam::HOLD_GAP`] open), after the substep's last contact pass: friction by position
+    /// undoes any tangential motion smaller than μ times the contact depth, the seam's own
+    /// pull included, so a seam lying on a body would stay open by that much. A wider seam is
+    /// left to the contacts: it may be caught across a limb, and must not be pulled through.
+    pub(crate) fn hold_seams(&mut self, x: &mut [DVec3], prev: &[DVec3], w: &[f64], rule: Rule) {
+        self.seams
+            .project_where(x, prev, w, &self.seam_params, rule, |s, p| {
+                s.rest == 0.0 && p[0].distance(p[1]) <= Seam::HOLD_GAP
+            });
     }
 
     /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N).
@@ -119,6 +165,7 @@ impl ConstraintSet {
         self.distance.spring_forces(x, v, params, forces);
         self.dihedral.spring_forces(x, v, params, forces);
         self.tethers.spring_forces(x, v, params, forces);
+        self.seams.spring_forces(x, v, &self.seam_params, forces);
     }
 
     /// |C| over distance-like constraints (stretch, shear, bend-distance) and active tethers (m).

@@ -1,0 +1,67 @@
+//! The walker in its T-shirt (assets/scenes/character.toml: 10,172 particles, 10 substeps,
+//! body contact, self-collision), one frame at a time once the seams have closed, and the
+//! same frame without self-collision and without any contact, so that the differences split
+//! the cost into solve, body contact and self-collision; and the whole frame with
+//! bend-distance bending instead of the preset's dihedral bending.
+#![allow(clippy::unwrap_used)]
+
+use std::path::Path;
+use std::time::Duration;
+
+use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
+use weft_scene::{Override, SolverGroup};
+use weft_solver::{Particles, SubstepContext, SubstepHook};
+
+/// An active hook that does nothing: the general step loop with no contact at all.
+struct Nothing;
+
+impl SubstepHook for Nothing {
+    fn project(&mut self, _ctx: &SubstepContext, _p: &mut Particles) -> usize {
+        0
+    }
+}
+
+/// The T-shirt scene with `overrides`, stepped past its seam closing (0.1 s) and 0.1 s more.
+fn dressed(overrides: &[&str]) -> SolverGroup {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes/character.toml");
+    let ov: Vec<Override> = overrides.iter().map(|s| s.parse().unwrap()).collect();
+    let scene = weft_scene::load(&path, &ov).unwrap();
+    let mut g = scene.build().unwrap().remove(0);
+    for _ in 0..12 {
+        g.step().unwrap();
+    }
+    g
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("dressed walker frame");
+    group
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1));
+    let mut full = dressed(&[]);
+    assert!(full.delayed_self_collision.is_none());
+    group.bench_function("tshirt: solve + body + self-collision", |b| {
+        b.iter(|| full.step().unwrap())
+    });
+    let mut body = dressed(&["self_collision.enabled=false"]);
+    group.bench_function("tshirt: solve + body", |b| b.iter(|| body.step().unwrap()));
+    let mut solve = dressed(&["self_collision.enabled=false"]);
+    group.bench_function("tshirt: solve only", |b| {
+        b.iter(|| solve.solver.step_with(&mut Nothing).unwrap())
+    });
+    // The jersey preset bends through dihedral angles (an atan2 per constraint, two sweeps);
+    // the same shirt with the cheap bend-distance constraints instead.
+    let mut cheap = dressed(&[
+        "cloth.tshirt.bend_dihedral_enabled=false",
+        "cloth.tshirt.bend_distance_enabled=true",
+    ]);
+    group.bench_function(
+        "tshirt, bend-distance: solve + body + self-collision",
+        |b| b.iter(|| cheap.step().unwrap()),
+    );
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

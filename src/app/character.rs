@@ -1,0 +1,279 @@
+//! The viewer's character choices, free of any window: the clip the body plays, the garment
+//! scene and each cloth's fabric, each applied by reloading the scene with overrides (the
+//! scene file stays as written; the choice shows in the log's overrides when recording).
+
+use std::str::FromStr;
+
+use weft_scene::Override;
+
+use crate::app::session::{SceneSource, Session};
+
+/// A clip the character can play: the overrides of `[character]` that select it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Clip {
+    /// Shown in the panel.
+    pub label: &'static str,
+    /// `(key, value)` overrides (values as TOML).
+    pub keys: &'static [(&'static str, &'static str)],
+}
+
+/// The clips offered: the procedural walk cycle and the shipped CMU capture (with its body
+/// table and the CMU conversion's unit, `weft_character::CMU_SCALE`). Paths are relative to
+/// the shipped scenes in `assets/scenes`.
+pub const CLIPS: [Clip; 2] = [
+    Clip {
+        label: "walk cycle (walker)",
+        keys: &[
+            ("character.skeleton", "\"walker\""),
+            ("character.body", "\"walker\""),
+        ],
+    },
+    Clip {
+        label: "CMU 01_01: forward jumps",
+        keys: &[
+            ("character.skeleton", "\"../characters/cmu_01_01_4s.bvh\""),
+            ("character.scale", "0.056444444444444446"),
+            ("character.body", "\"cmu\""),
+        ],
+    },
+];
+
+/// `overrides` with `key` set to `value` (replacing an earlier value of that key).
+pub fn with_override(overrides: &[Override], key: &str, value: &str) -> Vec<Override> {
+    let mut out: Vec<Override> = overrides.iter().filter(|o| o.key != key).cloned().collect();
+    // Keys come from this module's lists and cloth names: always well-formed.
+    if let Ok(o) = Override::from_str(&format!("{key}={value}")) {
+        out.push(o);
+    }
+    out
+}
+
+/// The clip in `overrides` (the last one whose skeleton override matches), if any.
+pub fn current_clip(overrides: &[Override]) -> Option<usize> {
+    let skeleton = overrides
+        .iter()
+        .rev()
+        .find(|o| o.key == "character.skeleton")?;
+    CLIPS.iter().position(|c| {
+        c.keys
+            .iter()
+            .any(|(k, v)| *k == "character.skeleton" && *v == skeleton.value)
+    })
+}
+
+impl Session {
+    /// Reloads the scene from its source with its overrides changed by `change`, keeping
+    /// the old scene if the new one does not load.
+    fn reload_with(&mut self, change: impl Fn(&[Override]) -> Vec<Override>) -> anyhow::Result<()> {
+        let overrides = change(&self.sim.scene.overrides);
+        self.load(self.source.clone(), &overrides)
+    }
+
+    /// Plays clip `CLIPS[clip]` from its start (the scene reloaded with its overrides).
+    pub fn set_clip(&mut self, clip: usize) -> anyhow::Result<()> {
+        let chosen = CLIPS
+            .get(clip)
+            .ok_or_else(|| anyhow::anyhow!("no clip {clip}"))?;
+        // Every clip's keys go first (the walker refuses a BVH's `scale`).
+        let clip_key = |key: &str| CLIPS.iter().any(|c| c.keys.iter().any(|(k, _)| *k == key));
+        self.reload_with(|o| {
+            let rest: Vec<Override> = o.iter().filter(|o| !clip_key(&o.key)).cloned().collect();
+            chosen
+                .keys
+                .iter()
+                .fold(rest, |acc, (k, v)| with_override(&acc, k, v))
+        })
+    }
+
+    /// Dresses cloth `cloth` (a scene cloth name) in the fabric preset `preset` (the scene
+    /// reloaded with `cloth.<name>.material`).
+    pub fn set_fabric(&mut self, cloth: &str, preset: &str) -> anyhow::Result<()> {
+        let key = format!("cloth.{cloth}.material");
+        self.reload_with(|o| with_override(o, &key, &format!("\"{preset}\"")))
+    }
+
+    /// Switches to the garment scene `source`, keeping the chosen clip.
+    pub fn set_garment(&mut self, source: SceneSource) -> anyhow::Result<()> {
+        let keep: Vec<Override> = self
+            .sim
+            .scene
+            .overrides
+            .iter()
+            .filter(|o| o.key.starts_with("character."))
+            .cloned()
+            .collect();
+        self.load(source, &keep)
+    }
+}
+
+/// Whether the scene `source` has a character (its file holds a `[character]` table).
+pub fn has_character(source: &SceneSource) -> bool {
+    match source {
+        SceneSource::Default => false,
+        SceneSource::File(p) => std::fs::read_to_string(p)
+            .is_ok_and(|t| t.lines().any(|l| l.trim_start().starts_with("[character]"))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use weft_collide::{BodyPart, KinematicBody};
+
+    use super::*;
+    use crate::app::picking::Ray;
+    use crate::sim::Simulation;
+
+    fn skirt() -> Session {
+        let source = SceneSource::File(PathBuf::from("assets/scenes/skirt.toml"));
+        let scene = source.load(&[]).expect("the skirt scene");
+        Session::new(Simulation::new(scene).expect("solvers"), source, 4)
+    }
+
+    /// The parts the viewer draws now, and the character's own parts at time `t`.
+    fn drawn_and_at(
+        s: &Session,
+        t: f64,
+    ) -> (Vec<crate::body::PartPose>, Vec<crate::body::PartPose>) {
+        let drawn = crate::body::parts(&s.sim)
+            .into_iter()
+            .map(|(_, p)| p)
+            .collect();
+        let mut at: Vec<BodyPart> = Vec::new();
+        let c = &s
+            .sim
+            .scene
+            .character
+            .as_ref()
+            .expect("a character")
+            .character;
+        c.parts_at(t, &mut at);
+        (drawn, at.iter().map(crate::body::PartPose::of).collect())
+    }
+
+    #[test]
+    fn step_pause_and_reset_carry_the_animation() {
+        let mut s = skirt();
+        let dt = s.dt();
+        for _ in 0..3 {
+            s.step_once().expect("steps");
+        }
+        let (drawn, want) = drawn_and_at(&s, 3.0 * dt);
+        assert_eq!(drawn, want, "three steps: the body at 3 dt");
+        let (_, start) = drawn_and_at(&s, 0.0);
+        assert_ne!(drawn, start, "the body moved");
+        // Paused, real time does not move it.
+        s.clock.set_paused(true);
+        std::thread::sleep(std::time::Duration::from_millis(40));
+        s.advance(None).expect("advances");
+        assert_eq!(drawn_and_at(&s, 0.0).0, drawn);
+        // Reset: the clip starts again.
+        s.reset().expect("resets");
+        assert_eq!(drawn_and_at(&s, 0.0).0, start);
+    }
+
+    #[test]
+    fn the_grabbed_garment_follows_the_mouse_while_the_body_moves() {
+        use weft_solver::glam::DVec3;
+        let mut s = skirt();
+        for _ in 0..2 {
+            s.step_once().expect("steps");
+        }
+        // Aim horizontally at the skirt's lowest particle from outside it.
+        let x = s.sim.cloth_positions(0);
+        let centre = x.iter().copied().sum::<DVec3>() / x.len() as f64;
+        let p = x
+            .iter()
+            .copied()
+            .min_by(|a, b| a.y.total_cmp(&b.y))
+            .expect("particles");
+        let out = DVec3::new(p.x - centre.x, 0.0, p.z - centre.z).normalize();
+        let ray = Ray {
+            origin: p + 2.0 * out,
+            dir: -out,
+        };
+        assert!(s.grab(&ray, -out), "the hem is under the ray");
+        let start = s.grab.as_ref().map(|g| g.target).expect("held");
+        // The mouse moves 5 cm up.
+        let up = Ray {
+            origin: ray.origin + DVec3::new(0.0, 0.05, 0.0),
+            dir: ray.dir,
+        };
+        s.drag(&up);
+        let before = drawn_and_at(&s, 0.0).0;
+        for _ in 0..6 {
+            s.step_once().expect("steps");
+        }
+        assert_ne!(drawn_and_at(&s, 0.0).0, before, "the body moved meanwhile");
+        let g = s.grab.as_ref().expect("still held");
+        assert!((g.target - start - DVec3::new(0.0, 0.05, 0.0)).length() < 1e-9);
+        let now = s.sim.cloth_positions(g.cloth)[g.particle];
+        assert!(
+            (now - g.target).length() < 1e-3,
+            "held at {now}, target {}",
+            g.target
+        );
+    }
+
+    #[test]
+    fn clip_fabric_and_garment_reload_the_scene_with_overrides() {
+        let mut s = skirt();
+        s.step_once().expect("steps");
+        let walker_joints = |s: &Session| {
+            let c = &s
+                .sim
+                .scene
+                .character
+                .as_ref()
+                .expect("a character")
+                .character;
+            c.animation().skeleton().len()
+        };
+        let walker = walker_joints(&s);
+        s.set_clip(1).expect("the CMU clip loads");
+        assert_eq!(current_clip(&s.sim.scene.overrides), Some(1));
+        assert_ne!(walker_joints(&s), walker, "the CMU skeleton");
+        assert_eq!(s.sim.frame(), 0, "the clip starts at its beginning");
+        s.set_fabric("skirt", "denim").expect("denim");
+        let keys: Vec<String> = s
+            .sim
+            .scene
+            .overrides
+            .iter()
+            .map(|o| o.to_string())
+            .collect();
+        assert!(
+            keys.contains(&"cloth.skirt.material=\"denim\"".to_owned()),
+            "{keys:?}"
+        );
+        assert_eq!(
+            current_clip(&s.sim.scene.overrides),
+            Some(1),
+            "the clip stays"
+        );
+        let e = s
+            .set_fabric("skirt", "tinfoil")
+            .expect_err("no such preset");
+        assert!(format!("{e:#}").contains("tinfoil"), "{e:#}");
+        let cape = SceneSource::File(PathBuf::from("assets/scenes/cape.toml"));
+        assert!(has_character(&cape) && !has_character(&SceneSource::Default));
+        // The cape hangs from the walker's Chest bone, which the CMU skeleton lacks: refused,
+        // naming it, and the skirt stays.
+        let e = s
+            .set_garment(cape.clone())
+            .expect_err("no Chest bone in CMU");
+        assert!(format!("{e:#}").contains("Chest"), "{e:#}");
+        assert_eq!(s.source, skirt().source);
+        s.set_clip(0).expect("the walker again");
+        assert_eq!(current_clip(&s.sim.scene.overrides), Some(0));
+        s.set_garment(cape.clone()).expect("the cape on the walker");
+        assert_eq!(s.source, cape);
+        assert_eq!(
+            current_clip(&s.sim.scene.overrides),
+            Some(0),
+            "the clip stays"
+        );
+        assert_eq!(walker_joints(&s), walker);
+    }
+}
