@@ -232,6 +232,30 @@ def character(r):
     print()
 
 
+def dressed(r):
+    print("## A dressed character (`crates/weft-scene/benches/dressed.rs`, "
+          "`crates/weft-character/benches/dressed.rs`, XPBD, 10 substeps × 1 iteration)\n")
+    print("| the walker in its T-shirt (`assets/scenes/character.toml`, 10,172 particles, "
+          "jersey), one frame after the seams closed | ms/frame |")
+    print("|---|---|")
+    for f, label in [("tshirt: solve + body + self-collision", "solve + body contact + self-collision"),
+                     ("tshirt: solve + body", "solve + body contact"),
+                     ("tshirt: solve only", "solve only (general loop, no contact)"),
+                     ("tshirt, bend-distance: solve + body + self-collision",
+                      "whole frame, bend-distance instead of dihedral bending")]:
+        print(f"| {label} | {fmt(ms(r, f'dressed walker frame/{f}'))} |")
+    print()
+    print("| a 12,903-particle sheet draped on the walking walker | ms/frame |")
+    print("|---|---|")
+    for f, label in [("solve/fused", "solve, fused frame (no hook)"),
+                     ("solve/general", "solve, general loop (an inert hook)"),
+                     ("contact-only", "the body's own work (poses, broad phase, sweep, planes)"),
+                     ("body", "solve + body contact"),
+                     ("body+self", "solve + body contact + self-collision")]:
+        print(f"| {label} | {fmt(ms(r, f'dressed/{f}'))} |")
+    print()
+
+
 def not_benches():
     print("## Figures that are not from a bench\n")
     print("Two kinds of figure quoted in the README and the notes do not come from criterion and "
@@ -334,6 +358,7 @@ def write_page(r, root, note):
     self_vs_solve(r)
     mesh_contact(r)
     character(r)
+    dressed(r)
     logging(r)
     not_benches()
 

@@ -16,17 +16,7 @@ fn numbers(v: &serde_json::Value) -> Vec<f64> {
 #[test]
 fn every_frame_lists_every_collider_at_its_analytic_pose() {
     let dir = temp_dir("collider-state");
-    let scene = write(&dir, "moving.toml", MOVING);
-    let log = dir.join("m.mcap");
-    let out = run(&[
-        "run",
-        &scene,
-        "--frames",
-        "30",
-        "--out",
-        &log.to_string_lossy(),
-    ]);
-    assert!(out.status.success(), "{:?}", texts(&out));
+    let log = logged_run(&dir, "moving.toml", MOVING, 30, "m.mcap");
     let bytes = std::fs::read(&log).expect("log");
     let summary = mcap::Summary::read(&bytes)
         .expect("summary")

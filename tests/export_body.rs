@@ -50,17 +50,7 @@ fn objects(path: &Path) -> Vec<(String, Vec<DVec3>)> {
 #[test]
 fn the_body_is_exported_where_the_character_is_at_each_frame() {
     let dir = temp_dir("export-body");
-    let scene = write(&dir, "walker.toml", WALKER);
-    let log = dir.join("w.mcap");
-    let out = run(&[
-        "run",
-        &scene,
-        "--frames",
-        "30",
-        "--out",
-        &log.to_string_lossy(),
-    ]);
-    assert!(out.status.success(), "{:?}", texts(&out));
+    let log = logged_run(&dir, "walker.toml", WALKER, 30, "w.mcap");
     let objs = dir.join("obj");
     let out = run(&[
         "export",

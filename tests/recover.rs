@@ -127,17 +127,7 @@ fn a_killed_run_is_recovered_with_every_complete_chunk() {
 #[test]
 fn a_log_with_flipped_bytes_is_called_corrupt() {
     let dir = temp_dir("corrupt");
-    let scene = write(&dir, "s.toml", SMALL);
-    let log = dir.join("a.mcap");
-    let out = run(&[
-        "run",
-        &scene,
-        "--frames",
-        "30",
-        "--out",
-        &log.to_string_lossy(),
-    ]);
-    assert!(out.status.success(), "{:?}", texts(&out));
+    let log = logged_run(&dir, "s.toml", SMALL, 30, "a.mcap");
     let mut bytes = std::fs::read(&log).expect("log");
     // Flip 16 bytes in the middle of the data section (inside a chunk's compressed data).
     let mid = bytes.len() / 2;

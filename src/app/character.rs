@@ -132,6 +132,16 @@ mod tests {
     }
 
     /// The parts the viewer draws now, and the character's own parts at time `t`.
+    /// The scene's character (the test scenes all have one).
+    fn character_of(s: &Session) -> &weft_character::Character {
+        &s.sim
+            .scene
+            .character
+            .as_ref()
+            .expect("a character")
+            .character
+    }
+
     fn drawn_and_at(
         s: &Session,
         t: f64,
@@ -141,14 +151,7 @@ mod tests {
             .map(|(_, p)| p)
             .collect();
         let mut at: Vec<BodyPart> = Vec::new();
-        let c = &s
-            .sim
-            .scene
-            .character
-            .as_ref()
-            .expect("a character")
-            .character;
-        c.parts_at(t, &mut at);
+        character_of(s).parts_at(t, &mut at);
         (drawn, at.iter().map(crate::body::PartPose::of).collect())
     }
 
@@ -220,16 +223,7 @@ mod tests {
     fn clip_fabric_and_garment_reload_the_scene_with_overrides() {
         let mut s = skirt();
         s.step_once().expect("steps");
-        let walker_joints = |s: &Session| {
-            let c = &s
-                .sim
-                .scene
-                .character
-                .as_ref()
-                .expect("a character")
-                .character;
-            c.animation().skeleton().len()
-        };
+        let walker_joints = |s: &Session| character_of(s).animation().skeleton().len();
         let walker = walker_joints(&s);
         s.set_clip(1).expect("the CMU clip loads");
         assert_eq!(current_clip(&s.sim.scene.overrides), Some(1));

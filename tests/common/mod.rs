@@ -36,6 +36,23 @@ pub fn write(dir: &Path, name: &str, text: &str) -> String {
     p.to_string_lossy().into_owned()
 }
 
+/// Writes `scene` to `dir/name`, runs `weft run` on it for `frames` frames with `--out
+/// dir/<log>`, checks it succeeded, and returns the log's path.
+pub fn logged_run(dir: &Path, name: &str, scene: &str, frames: u32, log: &str) -> PathBuf {
+    let scene = write(dir, name, scene);
+    let path = dir.join(log);
+    let out = run(&[
+        "run",
+        &scene,
+        "--frames",
+        &frames.to_string(),
+        "--out",
+        &path.to_string_lossy(),
+    ]);
+    assert!(out.status.success(), "{:?}", texts(&out));
+    path
+}
+
 /// A small, quick scene: an 8×8 cloth hanging from two corners.
 pub const SMALL: &str = r#"[sim]
 method = "xpbd"

@@ -109,10 +109,10 @@ fn stride() -> usize {
     (WALK_PERIOD * 60.0).ceil() as usize
 }
 
-#[test]
-fn the_skirt_stays_on_and_outside_the_walker_over_a_stride_with_its_seams_closed() {
-    let (scene, _g, seen) = run("skirt", 2 * stride(), &[], "Hips", stride());
-    eprintln!("skirt: {seen:?}");
+/// The checks every dressed scene passes: no particle inside the body by more than the
+/// thickness, attached vertices on their bone, every seam closed below 1 mm,
+/// the centroid within `reach` (m) of its anchor `bone`.
+fn assert_dressed(scene: &Scene, seen: &Seen, reach: f64, bone: &str) {
     let t = scene.cloths[0].thickness;
     assert!(
         seen.nearest > -t,
@@ -130,59 +130,31 @@ fn the_skirt_stays_on_and_outside_the_walker_over_a_stride_with_its_seams_closed
         seen.seam_after_closing
     );
     assert!(
-        seen.centroid_reach < 0.25,
-        "centroid {} m from the hips",
+        seen.centroid_reach < reach,
+        "centroid {} m from the {bone}",
         seen.centroid_reach
     );
+}
+
+#[test]
+fn the_skirt_stays_on_and_outside_the_walker_over_a_stride_with_its_seams_closed() {
+    let (scene, _g, seen) = run("skirt", 2 * stride(), &[], "Hips", stride());
+    eprintln!("skirt: {seen:?}");
+    assert_dressed(&scene, &seen, 0.25, "hips");
 }
 
 #[test]
 fn the_tshirt_stays_on_and_outside_the_walker_over_a_stride_with_its_seams_closed() {
     let (scene, _g, seen) = run("character", stride() + 30, &[], "Chest", stride());
     eprintln!("tshirt: {seen:?}");
-    let t = scene.cloths[0].thickness;
-    assert!(
-        seen.nearest > -t,
-        "a particle {} m inside the body",
-        -seen.nearest
-    );
-    assert!(
-        seen.attach_error < 1e-9,
-        "attached vertices {} m off",
-        seen.attach_error
-    );
-    assert!(
-        seen.seam_after_closing < 1e-3,
-        "a seam {} m open",
-        seen.seam_after_closing
-    );
-    assert!(
-        seen.centroid_reach < 0.25,
-        "centroid {} m from the chest",
-        seen.centroid_reach
-    );
+    assert_dressed(&scene, &seen, 0.25, "chest");
 }
 
 #[test]
 fn the_cape_stays_on_and_outside_the_walker() {
     let (scene, _g, seen) = run("cape", stride(), &[], "Chest", 0);
     eprintln!("cape: {seen:?}");
-    let t = scene.cloths[0].thickness;
-    assert!(
-        seen.nearest > -t,
-        "a particle {} m inside the body",
-        -seen.nearest
-    );
-    assert!(
-        seen.attach_error < 1e-9,
-        "attached vertices {} m off",
-        seen.attach_error
-    );
-    assert!(
-        seen.centroid_reach < 0.3,
-        "centroid {} m from the chest",
-        seen.centroid_reach
-    );
+    assert_dressed(&scene, &seen, 0.3, "chest");
 }
 
 /// The skirt's particle positions, as bytes, after `frames` frames on `threads` threads

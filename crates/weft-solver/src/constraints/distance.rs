@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Shape, distance_curvature};
+use super::{Shape, distance_curvature, distance_evaluate};
 
 /// Keeps two particles at a rest distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -14,13 +14,7 @@ pub struct Distance {
 impl Shape<2> for Distance {
     #[inline]
     fn evaluate(&self, p: &[DVec3; 2]) -> Option<(f64, [DVec3; 2])> {
-        let d = p[0] - p[1];
-        let len = d.length();
-        if len < 1e-9 {
-            return None;
-        }
-        let n = d / len;
-        Some((len - self.rest, [n, -n]))
+        distance_evaluate(p, self.rest, 1e-9)
     }
 
     #[inline]

@@ -31,6 +31,23 @@ pub trait Shape<const N: usize>: Copy + Send + Sync {
     }
 }
 
+/// C = |p₀ − p₁| − `rest` and its gradient (n, −n), n = (p₀ − p₁)/|p₀ − p₁| (Müller et al.
+/// 2007, eq. 9); `None` below `min_len`, where the direction is undefined.
+#[inline]
+pub(crate) fn distance_evaluate(
+    p: &[DVec3; 2],
+    rest: f64,
+    min_len: f64,
+) -> Option<(f64, [DVec3; 2])> {
+    let d = p[0] - p[1];
+    let len = d.length();
+    if len < min_len {
+        return None;
+    }
+    let n = d / len;
+    Some((len - rest, [n, -n]))
+}
+
 /// (∇²C) dp of a distance C = |p₀ − p₁| − d: with n = (p₀ − p₁)/|p₀ − p₁|, the block
 /// ∂²C/∂p₀² = (I − n nᵀ)/|p₀ − p₁| and the others ± the same.
 #[inline]

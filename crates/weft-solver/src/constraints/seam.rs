@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 
-use super::{Shape, distance_curvature};
+use super::{Shape, distance_curvature, distance_evaluate};
 
 /// Pulls two seam vertices together: rest length `gap · max(0, 1 − t/T)` at time t.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,14 +53,8 @@ impl Seam {
 impl Shape<2> for Seam {
     #[inline]
     fn evaluate(&self, p: &[DVec3; 2]) -> Option<(f64, [DVec3; 2])> {
-        let d = p[0] - p[1];
-        let len = d.length();
         // Closed to rounding: C ≈ 0 and the direction undefined, nothing to do.
-        if len < 1e-12 {
-            return None;
-        }
-        let n = d / len;
-        Some((len - self.rest, [n, -n]))
+        distance_evaluate(p, self.rest, 1e-12)
     }
 
     #[inline]
