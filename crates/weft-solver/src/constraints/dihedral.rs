@@ -19,22 +19,30 @@ pub struct Dihedral {
 impl Dihedral {
     /// Signed dihedral angle θ at `p`, in (−π, π]; 0 when both triangles are coplanar.
     pub fn angle(p: &[DVec3; 4]) -> Option<f64> {
-        let [x1, x2, x3, x4] = *p;
-        let n1 = (x1 - x3).cross(x1 - x4);
-        let n2 = (x2 - x4).cross(x2 - x3);
-        let e = x4 - x3;
-        let (l1, l2, le) = (n1.length(), n2.length(), e.length());
-        if l1 < 1e-12 || l2 < 1e-12 || le < 1e-9 {
-            return None;
-        }
-        let (n1, n2) = (n1 / l1, n2 / l2);
-        Some(n1.cross(n2).dot(e / le).atan2(n1.dot(n2)))
+        Frame::new(p).map(|f| f.angle())
     }
 }
 
-impl Shape<4> for Dihedral {
-    #[inline]
-    fn evaluate(&self, p: &[DVec3; 4]) -> Option<(f64, [DVec3; 4])> {
+/// The unnormalised normals and hinge of one dihedral, computed once per evaluation.
+struct Frame {
+    /// N₁ = (x₁ − x₃) × (x₁ − x₄).
+    n1: DVec3,
+    /// N₂ = (x₂ − x₄) × (x₂ − x₃).
+    n2: DVec3,
+    /// |N₁|².
+    q1: f64,
+    /// |N₂|².
+    q2: f64,
+    /// E = x₄ − x₃.
+    e: DVec3,
+    /// |E|.
+    le: f64,
+}
+
+impl Frame {
+    /// The frame at `p`, or `None` when a triangle or the hinge is degenerate.
+    #[inline(always)]
+    fn new(p: &[DVec3; 4]) -> Option<Self> {
         let [x1, x2, x3, x4] = *p;
         let n1 = (x1 - x3).cross(x1 - x4);
         let n2 = (x2 - x4).cross(x2 - x3);
@@ -43,20 +51,49 @@ impl Shape<4> for Dihedral {
         if q1 < 1e-24 || q2 < 1e-24 || le < 1e-9 {
             return None;
         }
-        let theta = Self::angle(p)?;
-        let mut c = theta - self.rest;
+        Some(Self {
+            n1,
+            n2,
+            q1,
+            q2,
+            e,
+            le,
+        })
+    }
+
+    /// θ = atan2((n̂₁ × n̂₂)·ê, n̂₁·n̂₂) (Bridson et al. 2003, §4), on the unit normals and hinge
+    /// (the same operations, hence the same bits, as before the frame was shared with the
+    /// gradient).
+    #[inline(always)]
+    fn angle(&self) -> f64 {
+        let (n1, n2) = (self.n1 / self.q1.sqrt(), self.n2 / self.q2.sqrt());
+        n1.cross(n2).dot(self.e / self.le).atan2(n1.dot(n2))
+    }
+}
+
+impl Shape<4> for Dihedral {
+    // Inlined into the projection, so that C and ∇C stay in registers instead of being returned
+    // through memory (a measurable share of the dihedral block's time).
+    #[inline(always)]
+    fn evaluate(&self, p: &[DVec3; 4]) -> Option<(f64, [DVec3; 4])> {
+        let [x1, x2, x3, x4] = *p;
+        let f = Frame::new(p)?;
+        let mut c = f.angle() - self.rest;
         if c > PI {
             c -= 2.0 * PI;
         } else if c <= -PI {
             c += 2.0 * PI;
         }
-        // Bridson et al. 2003: u₁ = |E| N₁/|N₁|², u₂ = |E| N₂/|N₂|², and u₃, u₄ as below.
+        // Bridson et al. 2003: u₁ = |E| N₁/|N₁|², u₂ = |E| N₂/|N₂|²,
+        // u₃ = (x₁ − x₄)·E/|E| N₁/|N₁|² + (x₂ − x₄)·E/|E| N₂/|N₂|²,
+        // u₄ = −(x₁ − x₃)·E/|E| N₁/|N₁|² − (x₂ − x₃)·E/|E| N₂/|N₂|².
         // With θ measured as above, ∂θ/∂xᵢ = −uᵢ (checked against finite differences in tests).
-        let (m1, m2) = (n1 / q1, n2 / q2);
+        let (m1, m2) = (f.n1 / f.q1, f.n2 / f.q2);
+        let le = f.le;
         let u1 = le * m1;
         let u2 = le * m2;
-        let u3 = (x1 - x4).dot(e) / le * m1 + (x2 - x4).dot(e) / le * m2;
-        let u4 = -(x1 - x3).dot(e) / le * m1 - (x2 - x3).dot(e) / le * m2;
+        let u3 = (x1 - x4).dot(f.e) / le * m1 + (x2 - x4).dot(f.e) / le * m2;
+        let u4 = -(x1 - x3).dot(f.e) / le * m1 - (x2 - x3).dot(f.e) / le * m2;
         Some((c, [-u1, -u2, -u3, -u4]))
     }
 }
