@@ -3,6 +3,7 @@
 //! substep inside the body, the waistband follows the hips to 1e-9 m at every substep, and the
 //! run gives the same bits on 1 and 2 threads.
 
+mod common;
 #[path = "../../weft-collide/tests/common/watch.rs"]
 mod watch;
 
@@ -54,18 +55,7 @@ fn dressed(edge: f64, self_collision: bool) -> Dressed {
     b.add_cloth("skirt", &skirt.mesh, ClothParams::default(), THICKNESS)
         .expect("cloth");
     let mut solver = b.build();
-    let waist: Vec<u32> = skirt
-        .panels
-        .iter()
-        .flat_map(|panel| {
-            panel
-                .flat
-                .iter()
-                .enumerate()
-                .filter(|(_, q)| (q.y - 0.5).abs() < 1e-12)
-                .map(move |(k, _)| panel.vertices.start + k as u32)
-        })
-        .collect();
+    let waist = common::flat_row(&skirt, 0.5);
     assert!(waist.len() > 20);
     let hips = walker.animation().skeleton().find("Hips").expect("hips");
     let bind = walker.animation().world(solver.time())[hips];

@@ -32,18 +32,7 @@ fn a_skirt_starts_outside_the_walker_and_its_waistband_follows_the_hips() {
         assert!(d > 0.005, "skirt vertex {i} at {p} is {d} m from the body");
     }
     // The waistband: every vertex on the panels' top edges (flat y = 0.3).
-    let waist: Vec<u32> = skirt
-        .panels
-        .iter()
-        .flat_map(|panel| {
-            panel
-                .flat
-                .iter()
-                .enumerate()
-                .filter(|(_, q)| (q.y - 0.3).abs() < 1e-12)
-                .map(move |(k, _)| panel.vertices.start + k as u32)
-        })
-        .collect();
+    let waist = common::flat_row(&skirt, 0.3);
     let per_panel = (0.3_f64 / 0.03).ceil() as usize + 1;
     assert_eq!(waist.len(), 2 * per_panel);
     let hips = walker.animation().skeleton().find("Hips").expect("hips");

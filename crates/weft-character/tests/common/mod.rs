@@ -68,3 +68,20 @@ flip = true
         -z
     )
 }
+
+/// The vertices of `garment` (global indices) that lie at height `y` (m) in their flat panel:
+/// a panel edge such as a skirt's waistband.
+pub fn flat_row(garment: &weft_character::garment::Garment, y: f64) -> Vec<u32> {
+    garment
+        .panels
+        .iter()
+        .flat_map(|panel| {
+            panel
+                .flat
+                .iter()
+                .enumerate()
+                .filter(move |(_, q)| (q.y - y).abs() < 1e-12)
+                .map(move |(k, _)| panel.vertices.start + k as u32)
+        })
+        .collect()
+}
