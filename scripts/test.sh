@@ -7,4 +7,7 @@ scripts/install-test-deps.sh
 # One backend for every test that draws: Vulkan through Mesa's lavapipe (software), unless
 # the caller chose another (WGPU_BACKEND=gl uses OpenGL/EGL on llvmpipe).
 export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
+# A from-scratch test build without incremental state is gigabytes smaller on disk (CI
+# builds once and never again); a developer may set CARGO_INCREMENTAL=1 to keep it.
+export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 exec cargo test --workspace "$@"

@@ -23,7 +23,7 @@ use weft_collide::SelfCollisionParams;
 use weft_collide::scenarios;
 use weft_solver::{Method, Solver};
 
-#[path = "../tests/common/split.rs"]
+#[path = "../tests/integration/common/split.rs"]
 mod split;
 use split::Split;
 

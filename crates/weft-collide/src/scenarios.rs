@@ -21,7 +21,7 @@ use crate::world::CollisionWorld;
 /// Settings and cloth parameters under which `method` is stable for the scenarios' cloths.
 ///
 /// Bending uses the bend-distance family; the dihedral family (swept symmetrically, so it no
-/// longer gains energy) is exercised by `tests/dihedral_drape.rs`.
+/// longer gains energy) is exercised by `tests/integration/dihedral_drape.rs`.
 /// Mass-spring is explicit: its springs are softened and its substeps raised so that
 /// ω h < 2 holds for the stiffest spring (ω = √(k_eff/m) of the lightest particle).
 pub fn method_setup(method: Method) -> (Settings, ClothParams) {

@@ -2,7 +2,7 @@
 //! [`crate::Settings::simd`] or the `WEFT_SIMD` environment variable (read once).
 //!
 //! Every path runs the same IEEE operations in the same order on the same lanes, so the path
-//! changes the speed, never the result (`tests/determinism.rs` checks each path this CPU has).
+//! changes the speed, never the result (`tests/integration/determinism.rs` checks each path this CPU has).
 
 use std::fmt;
 use std::str::FromStr;

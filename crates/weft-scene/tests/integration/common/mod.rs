@@ -1,0 +1,53 @@
+//! Shared test helpers: the shipped scenes, loaded with overrides and switched to one method,
+//! and a hook that checks the particles after every substep.
+#![allow(dead_code)]
+
+#[path = "../../../../weft-collide/tests/integration/common/watch.rs"]
+pub mod watch;
+
+use std::path::{Path, PathBuf};
+
+use watch::Watch;
+use weft_scene::{Override, Scene, SolverGroup};
+use weft_solver::{Method, Particles, SubstepContext};
+
+/// `assets/scenes`, the scenes Weft ships.
+pub fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes")
+}
+
+/// The scene at `path` with `overrides` (`key=value`) applied.
+pub fn load(path: &Path, overrides: &[String]) -> Scene {
+    let ov: Vec<Override> = overrides
+        .iter()
+        .map(|s| s.parse().expect("valid override"))
+        .collect();
+    weft_scene::load(path, &ov).unwrap_or_else(|e| panic!("{}: {e:?}", path.display()))
+}
+
+/// The scene at `path` with every cloth switched to `method`.
+pub fn with_method(path: &Path, method: Method, extra: &[String]) -> Vec<SolverGroup> {
+    let probe = load(path, extra);
+    let mut ov: Vec<String> = extra.to_vec();
+    ov.push(format!("sim.method={}", method.name()));
+    for c in &probe.cloths {
+        ov.push(format!("cloth.{}.method={}", c.name, method.name()));
+    }
+    load(path, &ov).build().expect("scene builds")
+}
+
+/// Steps `group` (which must have a collision world) `frames` frames, calling `check` after
+/// every substep.
+pub fn run_watched(
+    group: &mut SolverGroup,
+    frames: usize,
+    check: impl FnMut(&SubstepContext, &Particles) + Send,
+) {
+    let world = group.world.as_mut().expect("the scene has colliders");
+    let mut hook = Watch { world, check };
+    for frame in 0..frames {
+        if let Err(e) = group.solver.step_with(&mut hook) {
+            panic!("frame {frame}: {e}");
+        }
+    }
+}

@@ -1,0 +1,14 @@
+//! weft-scene's integration tests, one module a subject, linked into one test binary.
+//!
+//! One binary instead of one per file keeps the test build small on disk and quick to link.
+
+mod common;
+
+mod character;
+mod dressed;
+mod fuzz;
+mod material_key;
+mod self_fold;
+mod shipped_scenes;
+mod sphere_drop;
+mod table_drape;

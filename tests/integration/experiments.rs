@@ -1,0 +1,94 @@
+//! The experiment recorder: sweeps expand, shards split the queue, and the report and plots
+//! are rebuilt from every result present.
+
+use crate::common;
+
+use common::*;
+
+#[test]
+fn shards_cover_the_queue_and_the_report_gathers_them() {
+    let dir = temp_dir("experiments");
+    write(&dir, "small.toml", SMALL);
+    let exp = write(
+        &dir,
+        "exp.toml",
+        r#"title = "tiny"
+scene = "small.toml"
+frames = 10
+metrics = ["sag", "cost", "stretch_error_max"]
+set = { "sim.damping" = 1.0 }
+
+[[series]]
+name = "xpbd"
+vary = { "sim.substeps" = [1, 4], "sim.dt" = ["1/60", "1/30"] }
+
+[[series]]
+name = "pbd"
+set = { "sim.method" = "pbd" }
+vary = { "sim.substeps" = [1, 4] }
+
+[[plot]]
+file = "sag.png"
+title = "sag"
+x = "sim.substeps"
+y = "sag"
+log_x = true
+"#,
+    );
+    let out_dir = dir.join("out");
+    let o = out_dir.to_string_lossy();
+    for shard in ["0/2", "1/2"] {
+        let out = run(&[
+            "experiments",
+            &exp,
+            "--out",
+            &o,
+            "--shard",
+            shard,
+            "--jobs",
+            "1",
+        ]);
+        assert!(out.status.success(), "{:?}", texts(&out));
+    }
+    let out = run(&["experiments", &exp, "--out", &o, "--report-only"]);
+    let (stdout, e) = texts(&out);
+    assert!(out.status.success(), "{stdout}{e}");
+    assert!(stdout.contains("6 of 6 runs have results"), "{stdout}");
+    let csv = std::fs::read_to_string(out_dir.join("summary.csv")).expect("csv");
+    assert_eq!(csv.lines().count(), 7, "{csv}");
+    assert!(csv.starts_with("index,series,swept,status,sag,cost,stretch_error_max"));
+    assert!(
+        csv.contains("\"xpbd\",\"sim.dt=1/30 sim.substeps=4\",complete,"),
+        "{csv}"
+    );
+    let png = std::fs::read(out_dir.join("sag.png")).expect("plot written");
+    assert_eq!(&png[1..4], b"PNG");
+    let runs = std::fs::read_dir(out_dir.join("runs"))
+        .expect("runs")
+        .count();
+    assert_eq!(runs, 6);
+    // A bad shard is refused.
+    let out = run(&["experiments", &exp, "--out", &o, "--shard", "2/2"]);
+    assert!(!out.status.success());
+}
+
+#[test]
+fn bad_experiment_runs_are_refused_before_any_simulation() {
+    let dir = temp_dir("experiments-bad");
+    write(&dir, "small.toml", SMALL);
+    let exp = write(
+        &dir,
+        "exp.toml",
+        "scene = \"small.toml\"\nframes = 5\nmetrics = [\"sag\"]\n[[series]]\nname = \"x\"\nvary = { \"sim.substeps\" = [2, -1] }\n",
+    );
+    let out = run(&[
+        "experiments",
+        &exp,
+        "--out",
+        &dir.join("out").to_string_lossy(),
+    ]);
+    let (_, e) = texts(&out);
+    assert!(!out.status.success());
+    assert!(e.contains("command line (--set sim.substeps)"), "{e}");
+    assert!(!dir.join("out/results/run-0.json").exists());
+}

@@ -1,0 +1,21 @@
+//! The `weft` binary's integration tests: one test binary (one link of wgpu, winit and egui) holding every module.
+//!
+//! One binary instead of one per file keeps the test build small on disk and quick to link.
+
+mod common;
+
+mod bad_input;
+mod collider_state;
+mod e2e_drag;
+mod experiments;
+mod export;
+mod export_body;
+mod limits;
+mod mcap_log;
+mod output_safety;
+mod recorder;
+mod recover;
+mod render_video;
+mod small_things;
+mod stops;
+mod viewer;

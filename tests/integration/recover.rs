@@ -1,0 +1,148 @@
+//! A run killed with SIGKILL leaves its log cut short; `weft recover` rebuilds a valid log
+//! (summary, indexes, CRCs) holding every message of the complete chunks, with the scene
+//! attachments and status `recovered`; replay says a cut or damaged log is truncated or corrupt
+//! and points to `weft recover`.
+
+use crate::common;
+
+use std::time::Duration;
+
+use common::*;
+
+/// Messages the mcap crate itself finds in the complete chunks of `bytes` (a chunk record
+/// read whole, its CRC checked by the chunk reader).
+fn messages_before_the_cut(bytes: &[u8]) -> usize {
+    let records = mcap::read::LinearReader::new_with_options(
+        bytes,
+        mcap::read::Options::IgnoreEndMagic.into(),
+    )
+    .expect("starts with the magic");
+    let mut n = 0;
+    for r in records {
+        let Ok(r) = r else { break };
+        if let mcap::records::Record::Chunk { header, data } = r {
+            let inner: Vec<_> = mcap::read::ChunkReader::new(header, &data)
+                .expect("chunk opens")
+                .collect::<Result<_, _>>()
+                .expect("a complete chunk reads whole");
+            n += inner
+                .iter()
+                .filter(|r| matches!(r, mcap::records::Record::Message { .. }))
+                .count();
+        }
+    }
+    n
+}
+
+/// Runs a big scene and kills it with SIGKILL once its partial log holds a few chunks.
+fn killed_log(dir: &std::path::Path) -> std::path::PathBuf {
+    let scene = write(dir, "s.toml", &big(48));
+    let target = dir.join("run.mcap");
+    let child = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
+    let part = partial(&target);
+    let grew = partial_grows_past(&target, 3 << 20, Duration::from_secs(60));
+    signal(child.id(), "KILL");
+    let (_, _) = exits_within(child, Duration::from_secs(10));
+    assert!(grew, "the log never grew past 3 MiB");
+    assert!(
+        !target.exists(),
+        "a killed run leaves nothing under the final name"
+    );
+    part
+}
+
+#[test]
+fn a_killed_run_is_recovered_with_every_complete_chunk() {
+    let dir = temp_dir("recover");
+    let part = killed_log(&dir);
+    let bytes = std::fs::read(&part).expect("partial log");
+    assert!(
+        mcap::Summary::read(&bytes).is_err(),
+        "a cut log has no footer"
+    );
+    let held = messages_before_the_cut(&bytes);
+    assert!(held > 0, "no complete chunk before the kill");
+
+    let fixed = dir.join("fixed.mcap");
+    let out = run(&[
+        "recover",
+        &part.to_string_lossy(),
+        "--out",
+        &fixed.to_string_lossy(),
+    ]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(o.contains("recovered"), "{o}");
+    // read_log checks the summary and reads every message (chunk CRCs checked).
+    let log = read_log(&fixed);
+    let total: usize = log.counts.values().sum();
+    assert_eq!(
+        total, held,
+        "every message of the complete chunks, and only those"
+    );
+    let status = &log.metadata["weft.status"];
+    assert_eq!(status["status"], "recovered");
+    let stats = log.counts["/stats"];
+    assert!(stats > 1);
+    assert_eq!(
+        status["frames"],
+        (stats - 1).to_string(),
+        "frames after frame 0"
+    );
+    assert_eq!(log.metadata["weft.run"]["frames"], "100000000");
+    assert!(log.attachments.contains(&"scene/source.toml".to_owned()));
+    let verified = mcap::read::LinearReader::new(&std::fs::read(&fixed).expect("fixed"))
+        .expect("magic")
+        .all(|r| r.is_ok());
+    assert!(verified, "every record of the recovered log reads");
+
+    // Replay of the cut log: truncated, and how to recover it.
+    let out = run(&[
+        "replay",
+        &part.to_string_lossy(),
+        "--out",
+        &dir.join("r.mcap").to_string_lossy(),
+    ]);
+    let (_, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("is truncated") && e.contains("weft recover"),
+        "{e}"
+    );
+    assert!(!e.contains("Bad magic"), "{e}");
+
+    // The recovered log replays exactly the frames it holds.
+    let out = run(&[
+        "replay",
+        &fixed.to_string_lossy(),
+        "--out",
+        &dir.join("r.mcap").to_string_lossy(),
+        "-q",
+    ]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(o.contains(&format!("{} frames,", stats - 1)), "{o}");
+}
+
+#[test]
+fn a_log_with_flipped_bytes_is_called_corrupt() {
+    let dir = temp_dir("corrupt");
+    let log = logged_run(&dir, "s.toml", SMALL, 30, "a.mcap");
+    let mut bytes = std::fs::read(&log).expect("log");
+    // Flip 16 bytes in the middle of the data section (inside a chunk's compressed data).
+    let mid = bytes.len() / 2;
+    for b in &mut bytes[mid..mid + 16] {
+        *b ^= 0xA5;
+    }
+    std::fs::write(&log, &bytes).expect("write");
+    let out = run(&[
+        "replay",
+        &log.to_string_lossy(),
+        "--out",
+        &dir.join("r.mcap").to_string_lossy(),
+    ]);
+    let (o, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{o}{e}");
+    assert!(e.contains("is corrupt"), "{e}");
+    assert!(!o.contains("replay differs"), "{o}");
+}

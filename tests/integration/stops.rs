@@ -1,0 +1,127 @@
+//! Every stop is honoured within a second or two: inside a long frame (the solver polls the
+//! flag per substep), while building a big cloth (`weft check`), and a FIFO is never opened as
+//! a mesh. Exit code 130 for SIGINT and SIGTERM alike, and a finished log when one was open.
+
+use crate::common;
+
+use std::process::Stdio;
+use std::time::Duration;
+
+use common::*;
+
+/// How long a stop may take (the tests run beside other builds on a small machine).
+const PROMPT: Duration = Duration::from_secs(3);
+
+fn stop_inside_a_long_frame(sig: &str) {
+    let dir = temp_dir(&format!("long-frame-{sig}"));
+    let scene = write(&dir, "s.toml", &big(64));
+    let target = dir.join("a.mcap");
+    // 20000 substeps x 50 iterations on 4096 particles: one frame takes minutes.
+    let child = spawn_logging(
+        &[
+            "run",
+            &scene,
+            "--frames",
+            "5",
+            "--set",
+            "sim.substeps=20000",
+            "--set",
+            "sim.iterations=50",
+        ],
+        &target,
+    );
+    let part = partial(&target);
+    // The log's frame 0 is written as soon as the run starts: from then on frames are long.
+    assert!(
+        wait_for(Duration::from_secs(60), || part.exists()),
+        "the run never started"
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    signal(child.id(), sig);
+    let (out, took) = exits_within(child, Duration::from_secs(60));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(took < PROMPT, "{sig}: took {took:?} to stop: {err}");
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    let log = read_log(&target);
+    assert_eq!(log.metadata["weft.status"]["status"], "interrupted");
+    assert_eq!(log.metadata["weft.status"]["frames"], "0");
+    assert_eq!(
+        log.counts["/stats"], 1,
+        "frame 0 only: the stop came inside frame 1"
+    );
+}
+
+#[test]
+fn sigint_inside_a_long_frame_stops_within_a_second() {
+    stop_inside_a_long_frame("INT");
+}
+
+#[test]
+fn sigterm_inside_a_long_frame_stops_within_a_second() {
+    stop_inside_a_long_frame("TERM");
+}
+
+#[test]
+fn check_of_a_big_cloth_stops_at_once() {
+    let dir = temp_dir("check-stop");
+    let scene = write(&dir, "s.toml", &big(2048));
+    for sig in ["INT", "TERM"] {
+        let child = weft()
+            .args(["check", &scene, "--max-memory", "64G"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("starts");
+        // Loading and building 4 million particles takes several seconds here.
+        std::thread::sleep(Duration::from_millis(700));
+        signal(child.id(), sig);
+        let (out, took) = exits_within(child, Duration::from_secs(60));
+        let (o, e) = texts(&out);
+        assert!(took < PROMPT, "{sig}: took {took:?}");
+        assert_eq!(out.status.code(), Some(130), "{sig}: {o}{e}");
+        assert!(
+            !o.contains("ok"),
+            "{sig}: a stopped check says nothing is ok: {o}"
+        );
+    }
+}
+
+#[test]
+fn a_fifo_is_never_opened_as_a_mesh() {
+    let dir = temp_dir("fifo");
+    let fifo = dir.join("pipe.obj");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let scene = write(
+        &dir,
+        "s.toml",
+        "[cloth.shirt]\nmesh = \"pipe.obj\"\nmass = 0.2\n",
+    );
+    let child = weft()
+        .args(["check", &scene])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starts");
+    let (out, _) = exits_within(child, Duration::from_secs(20));
+    let (_, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("cloth.shirt.mesh") && e.contains("not a regular file"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_scene_file_that_is_a_device_is_refused() {
+    let out = run(&["check", "/dev/zero"]);
+    let (_, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("/dev/zero") && e.contains("not a regular file"),
+        "{e}"
+    );
+}
