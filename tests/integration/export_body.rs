@@ -10,23 +10,8 @@ use common::*;
 use weft_character::{Character, Geometry};
 use weft_solver::glam::DVec3;
 
-/// The walker and a small cloth away from it.
-const WALKER: &str = r#"[sim]
-dt = "1/60"
-substeps = 4
-
-[character]
-skeleton = "walker"
-body = "walker"
-
-[cloth.sheet]
-resolution = [4, 4]
-size = [0.3, 0.3]
-orientation = "horizontal"
-center = [3.0, 1.0, 0.0]
-mass = 0.1
-pins = []
-"#;
+/// The walker and a small cloth away from it (the log test in `src/record/body.rs` runs it too).
+const WALKER: &str = include_str!("../fixtures/walker.toml");
 
 /// Objects of an OBJ file: name and vertices.
 fn objects(path: &Path) -> Vec<(String, Vec<DVec3>)> {

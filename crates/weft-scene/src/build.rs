@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use weft_character::{Attachment, AttachmentDriver};
+use weft_character::AttachmentDriver;
 use weft_collide::CollisionWorld;
 use weft_solver::{
     Family, FamilyParams, Method, Motion, Settings, Solver, SolverBuilder, SolverError, StepStats,
@@ -139,20 +139,7 @@ impl Scene {
                 key: format!("cloth.{}.attach", c.name),
                 message: e.to_string(),
             };
-            let bones = ch.character.animation().bones(solver.time());
-            let attachments = c
-                .attachments
-                .iter()
-                .map(|a| {
-                    Attachment::bind(
-                        a.bone,
-                        a.vertices.clone(),
-                        &c.mesh.positions,
-                        &bones[a.bone].transform,
-                    )
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| err(&e))?;
+            let attachments = ch.bind(c, solver.time()).map_err(|e| err(&e))?;
             let first = solver.cloths()[j].particles.start;
             let driver = AttachmentDriver::new(ch.character.clone(), first, attachments)
                 .map_err(|e| err(&e))?;

@@ -133,6 +133,30 @@ pub struct CharacterSpec {
     pub dynamic_friction: f64,
 }
 
+impl CharacterSpec {
+    /// Binds `cloth`'s attachments to their bones at `time`: each attached vertex keeps its
+    /// rest position's coordinates in its bone's frame at that time.
+    pub fn bind(
+        &self,
+        cloth: &ClothSpec,
+        time: f64,
+    ) -> Result<Vec<weft_character::Attachment>, weft_character::AttachError> {
+        let bones = self.character.animation().bones(time);
+        cloth
+            .attachments
+            .iter()
+            .map(|a| {
+                weft_character::Attachment::bind(
+                    a.bone,
+                    a.vertices.clone(),
+                    &cloth.mesh.positions,
+                    &bones[a.bone].transform,
+                )
+            })
+            .collect()
+    }
+}
+
 /// A collider ready for the collision world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColliderSpec {

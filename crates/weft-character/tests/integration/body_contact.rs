@@ -4,13 +4,11 @@
 //! run gives the same bits on 1 and 2 threads.
 
 use crate::common;
-#[path = "../../../weft-collide/tests/integration/common/watch.rs"]
-mod watch;
 
 use std::sync::Arc;
 
+use common::watch::Watch;
 use glam::DVec3;
-use watch::Watch;
 use weft_character::garment::{Garment, GarmentSpec, build_garment};
 use weft_character::{Attachment, AttachmentDriver, Character};
 use weft_collide::{CollisionWorld, Friction, SelfCollisionParams};
@@ -94,7 +92,9 @@ fn a_skirt_on_the_walking_walker_stays_outside_and_its_waistband_follows_the_hip
     let (mut deepest, mut band_off, mut substeps, mut touching) = (f64::INFINITY, 0.0f64, 0, 0);
     let mut hook = Watch {
         world: &mut world,
-        check: |ctx: &weft_solver::SubstepContext, p: &weft_solver::Particles| {
+        check: |ctx: &weft_solver::SubstepContext,
+                p: &weft_solver::Particles,
+                _: &CollisionWorld| {
             let state = walker.state(ctx.time);
             for x in &p.positions {
                 let d = state.signed_distance(*x);

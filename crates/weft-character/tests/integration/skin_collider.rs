@@ -6,13 +6,14 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use crate::common::watch::Watch;
 use glam::{DQuat, DVec3};
 use weft_character::files::read_skinned_gltf;
 use weft_character::skin::{ChannelValues, SkinCollider, SkinnedMesh};
 use weft_collide::{CollisionWorld, Friction};
 use weft_solver::{
     ClothMesh, ClothParams, Edge, Forces, GridDesc, Mass, Orientation, Particles, Pin, Settings,
-    Solver, SolverBuilder, SubstepContext, SubstepHook,
+    Solver, SolverBuilder, SubstepContext,
 };
 
 const THICKNESS: f64 = 0.01;
@@ -156,61 +157,38 @@ fn winding(p: DVec3, v: &[DVec3], tris: &[[u32; 3]]) -> f64 {
 
 /// Runs the world and, after every substep, checks the collider's vertices against
 /// `SkinnedMesh::skin` at the substep's end and hands the particles and those vertices to
-/// `check`.
-struct Skinned<'a, F: FnMut(&SubstepContext, &Particles, &[DVec3]) + Send> {
-    world: &'a mut CollisionWorld,
-    mesh: &'a SkinnedMesh,
-    check: F,
-    substeps: usize,
-}
-
-impl<F: FnMut(&SubstepContext, &Particles, &[DVec3]) + Send> SubstepHook for Skinned<'_, F> {
-    fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
-        self.world.begin_substep(ctx, particles);
-    }
-
-    fn project(&mut self, ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        self.world.project(ctx, particles)
-    }
-
-    fn end_substep(&mut self, ctx: &SubstepContext, particles: &mut Particles) {
-        self.world.end_substep(ctx, particles);
-        let got = self.world.colliders()[0]
-            .mesh_vertices()
-            .expect("a mesh collider");
-        let want = self.mesh.skin(ctx.time);
-        assert_eq!(got.len(), want.len());
-        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
-            assert!(
-                g == w,
-                "t = {}: collider vertex {k} at {g}, skinned at {w}",
-                ctx.time
-            );
-        }
-        self.substeps += 1;
-        (self.check)(ctx, particles, got);
-    }
-}
-
+/// `check`; returns the number of substeps.
 fn run(
     solver: &mut Solver,
     world: &mut CollisionWorld,
     mesh: &SkinnedMesh,
     frames: usize,
-    check: impl FnMut(&SubstepContext, &Particles, &[DVec3]) + Send,
+    mut check: impl FnMut(&SubstepContext, &Particles, &[DVec3]) + Send,
 ) -> usize {
-    let mut hook = Skinned {
+    let mut substeps = 0;
+    let mut hook = Watch {
         world,
-        mesh,
-        check,
-        substeps: 0,
+        check: |ctx: &SubstepContext, p: &Particles, w: &CollisionWorld| {
+            let got = w.colliders()[0].mesh_vertices().expect("a mesh collider");
+            let want = mesh.skin(ctx.time);
+            assert_eq!(got.len(), want.len());
+            for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+                assert!(
+                    g == w,
+                    "t = {}: collider vertex {k} at {g}, skinned at {w}",
+                    ctx.time
+                );
+            }
+            substeps += 1;
+            check(ctx, p, got);
+        },
     };
     for frame in 0..frames {
         if let Err(e) = solver.step_with(&mut hook) {
             panic!("frame {frame}: {e}");
         }
     }
-    hook.substeps
+    substeps
 }
 
 fn world_with(solver: &Solver, skinned: &SkinnedMesh) -> CollisionWorld {

@@ -85,7 +85,7 @@ fn fast_cloth_does_not_tunnel_through_thin_mesh() {
     let mut swept = 0;
     let mut hook = common::Watch {
         world: &mut world,
-        check: |_: &weft_solver::SubstepContext, p: &weft_solver::Particles| {
+        check: |_: &weft_solver::SubstepContext, p: &weft_solver::Particles, _: &CollisionWorld| {
             for x in &p.positions {
                 lowest = lowest.min(x.y);
             }

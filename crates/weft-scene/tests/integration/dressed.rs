@@ -51,20 +51,7 @@ fn run(
         .skeleton()
         .find(anchor)
         .expect("anchor bone");
-    let bones = ch.character.animation().bones(0.0);
-    let bound: Vec<Attachment> = cloth
-        .attachments
-        .iter()
-        .map(|a| {
-            Attachment::bind(
-                a.bone,
-                a.vertices.clone(),
-                &cloth.mesh.positions,
-                &bones[a.bone].transform,
-            )
-            .expect("bind")
-        })
-        .collect();
+    let bound: Vec<Attachment> = ch.bind(cloth, 0.0).expect("bind");
     let mut seen = Seen {
         nearest: f64::INFINITY,
         ..Seen::default()
@@ -72,7 +59,9 @@ fn run(
     for frame in 0..frames {
         let world = g.world.as_mut().expect("a world");
         let s = &mut seen;
-        let check = |ctx: &weft_solver::SubstepContext, p: &weft_solver::Particles| {
+        let check = |ctx: &weft_solver::SubstepContext,
+                     p: &weft_solver::Particles,
+                     _: &weft_collide::CollisionWorld| {
             let state = ch.character.state(ctx.time);
             for x in &p.positions[first.clone()] {
                 s.nearest = s.nearest.min(state.signed_distance(*x));

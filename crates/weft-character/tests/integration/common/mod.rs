@@ -1,5 +1,9 @@
-//! Fixtures shared by the character tests.
+//! Fixtures shared by the character tests, and (`watch`) weft-collide's test hook that checks
+//! every substep.
 #![allow(dead_code)]
+
+#[path = "../../../../weft-collide/tests/integration/common/watch.rs"]
+pub mod watch;
 
 /// Root (6 channels, Z X Y rotation order), Mid (Y X Z), Tip (2 channels: X Z), End Site.
 /// Centimetres; frame 0 is the rest pose, frame 1 turns Mid 90° about y (and more, worked out

@@ -33,8 +33,9 @@ pub fn run(
     solver: &mut Solver,
     world: &mut CollisionWorld,
     frames: usize,
-    check: impl FnMut(&SubstepContext, &Particles) + Send,
+    mut check: impl FnMut(&SubstepContext, &Particles) + Send,
 ) {
+    let check = |ctx: &SubstepContext, p: &Particles, _: &CollisionWorld| check(ctx, p);
     let mut hook = Watch { world, check };
     for frame in 0..frames {
         if let Err(e) = solver.step_with(&mut hook) {

@@ -4,15 +4,16 @@
 use weft_collide::CollisionWorld;
 use weft_solver::{Particles, SubstepContext, SubstepHook};
 
-/// Runs the world, then calls `check` after every substep with the final positions.
-pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles) + Send> {
+/// Runs the world, then calls `check` after every substep with the final positions and the
+/// world (whose colliders are then at the substep's end pose).
+pub struct Watch<'a, F: FnMut(&SubstepContext, &Particles, &CollisionWorld) + Send> {
     /// The wrapped world.
     pub world: &'a mut CollisionWorld,
     /// Called at the end of every substep.
     pub check: F,
 }
 
-impl<F: FnMut(&SubstepContext, &Particles) + Send> SubstepHook for Watch<'_, F> {
+impl<F: FnMut(&SubstepContext, &Particles, &CollisionWorld) + Send> SubstepHook for Watch<'_, F> {
     fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
         self.world.begin_substep(ctx, particles);
     }
@@ -23,6 +24,6 @@ impl<F: FnMut(&SubstepContext, &Particles) + Send> SubstepHook for Watch<'_, F> 
 
     fn end_substep(&mut self, ctx: &SubstepContext, particles: &mut Particles) {
         self.world.end_substep(ctx, particles);
-        (self.check)(ctx, particles);
+        (self.check)(ctx, particles, self.world);
     }
 }

@@ -41,9 +41,11 @@ pub fn with_method(path: &Path, method: Method, extra: &[String]) -> Vec<SolverG
 pub fn run_watched(
     group: &mut SolverGroup,
     frames: usize,
-    check: impl FnMut(&SubstepContext, &Particles) + Send,
+    mut check: impl FnMut(&SubstepContext, &Particles) + Send,
 ) {
     let world = group.world.as_mut().expect("the scene has colliders");
+    let check =
+        |ctx: &SubstepContext, p: &Particles, _: &weft_collide::CollisionWorld| check(ctx, p);
     let mut hook = Watch { world, check };
     for frame in 0..frames {
         if let Err(e) = group.solver.step_with(&mut hook) {
