@@ -19,8 +19,6 @@ mod record;
 #[path = "../src/sim.rs"]
 mod sim;
 
-mod common;
-
 use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -35,10 +33,11 @@ use sim::Simulation;
 const N: usize = 128;
 
 fn simulation() -> Simulation {
-    let scene = common::load(
-        "hanging.toml",
-        &[format!("cloth.cloth.resolution=[{N}, {N}]")],
-    );
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/hanging.toml");
+    let resolution: weft_scene::Override = format!("cloth.cloth.resolution=[{N}, {N}]")
+        .parse()
+        .expect("well-formed override");
+    let scene = weft_scene::load(&path, &[resolution]).expect("hanging.toml loads");
     Simulation::new(scene).expect("scene builds")
 }
 

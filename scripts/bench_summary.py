@@ -2,7 +2,7 @@
 """Summarise Weft's `cargo bench` results as docs/benchmarks.md.
 
 Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.8) and
-`<criterion>/substeps_error.json` (written by benches/substeps.rs), and prints:
+`<criterion>/substeps_error.json` (written by crates/weft-scene/benches/substeps.rs), and prints:
 
 - step time per frame of XPBD / PBD / mass-spring at 32²…256² particles, projections per
   second, and the scaling exponent p of cost ∝ particles^p (least-squares fit in log-log);
@@ -128,7 +128,7 @@ def methods(r):
         p = exponent([n * n for n, x in zip(SIZES, t) if x], [x for x in t if x])
         print(f"| {m} | " + " | ".join(fmt(x) for x in t) + f" | {rate} | {fmt_p(p)} |")
     if not any_row:
-        print("(no results: run `cargo bench --bench methods`)")
+        print("(no results: run `cargo bench -p weft-scene --bench methods`)")
     print()
 
 
@@ -149,7 +149,7 @@ def substeps(r, root):
     path = root / "substeps_error.json"
     rows = json.loads(path.read_text()) if path.exists() else []
     if not rows:
-        print(f"(no {path}: run `cargo bench --bench substeps`)\n")
+        print(f"(no {path}: run `cargo bench -p weft-scene --bench substeps`)\n")
         return
     print("| substeps × iterations | ms/frame (criterion) | RMS C at 1 s (m) | max abs C at 1 s (m) "
           "| mean RMS C, 0.5–1 s (m) |")

@@ -1,4 +1,4 @@
-//! What the root benches share: scenes loaded from `assets/scenes/` with `--set`-style
+//! What weft-scene's method benches share: scenes loaded from `assets/scenes/` with `--set`-style
 //! overrides (the same path `weft run` takes), the reference workload's sizes, and where
 //! criterion writes its reports.
 #![allow(dead_code)]
@@ -14,7 +14,7 @@ pub const SIZES: [usize; 4] = [32, 64, 128, 256];
 /// `assets/scenes/<name>` in this checkout.
 pub fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/scenes")
+        .join("../../assets/scenes")
         .join(name)
 }
 
