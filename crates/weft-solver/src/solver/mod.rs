@@ -1,19 +1,20 @@
-//! The solver: one step loop shared by every method.
+//! The solver: one step loop shared by every method (the loop itself, fused and general, is
+//! in `frame.rs`).
+
+mod frame;
 
 use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::DVec3;
-use rayon::prelude::*;
 
-use crate::chunk::CHUNK;
-use crate::constraints::{ConstraintSet, Residual, Rule};
-use crate::domains::{DomainStats, Domains, Finish, Integration, SimdPath};
+use crate::constraints::{ConstraintSet, Residual};
+use crate::domains::{DomainStats, Domains, SimdPath};
 use crate::driver::PinDriver;
 use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
-use crate::hook::{SubstepContext, SubstepHook};
+use crate::hook::SubstepHook;
 use crate::motion::KinematicPin;
 use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
@@ -438,229 +439,6 @@ impl Solver {
             && self.constraints.dihedral.len() == 0
             && self.constraints.tethers.len() == 0
             && self.constraints.seams.len() == 0
-    }
-
-    /// Time at the end of substep `k`, and the pin and grab targets there, into `self.targets`.
-    fn substep_targets(&mut self, k: u32) -> f64 {
-        let s = self.settings;
-        let time = self.time + s.dt * f64::from(k + 1) / f64::from(s.substeps);
-        self.targets.clear();
-        for pin in &self.pins {
-            self.targets
-                .push((pin.particle as usize, pin.motion.position(pin.rest, time)));
-        }
-        self.driven_velocities.clear();
-        let (x, v) = &mut self.driven;
-        for driver in &self.drivers {
-            let ids = driver.particles();
-            x.resize(ids.len(), DVec3::ZERO);
-            v.resize(ids.len(), DVec3::ZERO);
-            driver.drive(time, x, v);
-            for (k, &i) in ids.iter().enumerate() {
-                self.targets.push((i as usize, x[k]));
-                self.driven_velocities.push((i as usize, v[k]));
-            }
-        }
-        if let Some(g) = &self.grab {
-            let f = (k + 1) as f64 / s.substeps as f64;
-            self.targets.push((g.particle, g.from.lerp(g.target, f)));
-        }
-        time
-    }
-
-    /// One frame with every substep phase inside the domains' parallel regions, with the hook's
-    /// per-particle contacts when it is active; false when the stop flag cut it short.
-    fn frame_fused(&mut self, rule: Rule, hook: &mut dyn SubstepHook) -> (StepStats, bool) {
-        let s = self.settings;
-        let h = s.h();
-        let inv_h = 1.0 / h;
-        let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
-        let active = hook.is_active();
-        let mut stats = StepStats::default();
-        self.domains.prepare(&self.params, rule);
-        let lambda = self.domains.mode().lambda;
-        let mut whole = true;
-        for k in 0..s.substeps {
-            if self.stopping() {
-                if k == 0 {
-                    // Nothing loaded into the domains yet: the store is as it was.
-                    return (stats, false);
-                }
-                whole = false;
-                break;
-            }
-            let time = self.substep_targets(k);
-            if active {
-                let ctx = SubstepContext {
-                    method: s.method,
-                    time,
-                    h,
-                    substep: k,
-                };
-                hook.begin_substep(&ctx, &self.particles);
-            }
-            let step = Integration {
-                h,
-                forces: &self.forces,
-                pins: &self.targets,
-            };
-            let p = &self.particles;
-            self.domains.reset_link_multipliers();
-            self.domains
-                .project_after(&p.positions, &p.velocities, &p.inv_masses, |d, aos| {
-                    let finish = if k == 0 {
-                        d.load(aos);
-                        None
-                    } else {
-                        Some(Finish { inv_h, keep })
-                    };
-                    d.integrate(&step, finish, lambda);
-                });
-            for it in 0..s.iterations {
-                if it > 0 {
-                    self.domains.project();
-                }
-                if active && let Some(contacts) = hook.particle_contacts() {
-                    let totals = self.domains.collide(contacts, it == 0);
-                    stats.contacts = hook.fused_pass(it == 0, totals);
-                }
-            }
-        }
-        let p = &mut self.particles;
-        self.domains.finish(
-            inv_h,
-            keep,
-            &mut p.positions,
-            &mut p.prev_positions,
-            &mut p.velocities,
-        );
-        // The last substep's driven velocities, as the general loop leaves them.
-        for &(i, v) in &self.driven_velocities {
-            p.velocities[i] = v;
-        }
-        (stats, whole)
-    }
-
-    /// One frame of the general loop: every phase on the particle store, the hook in between;
-    /// false when the stop flag cut it short.
-    fn frame_general(&mut self, hook: &mut dyn SubstepHook) -> (StepStats, bool) {
-        let s = self.settings;
-        let h = s.h();
-        let strategy = s.method.strategy();
-        let mut stats = StepStats::default();
-        let rule = strategy.rule(h);
-        if let Some(rule) = rule {
-            self.domains.prepare(&self.params, rule);
-        }
-        let mut whole = true;
-        for k in 0..s.substeps {
-            if self.stopping() {
-                whole = false;
-                break;
-            }
-            let time = self.substep_targets(k);
-            // Seams pull towards the rest length of the substep's end.
-            self.constraints.set_seam_time(time);
-            let ctx = SubstepContext {
-                method: s.method,
-                time,
-                h,
-                substep: k,
-            };
-            // External and (mass-spring) internal accelerations at the start of the substep.
-            self.forces
-                .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
-            strategy.add_internal_forces(
-                &self.constraints,
-                &self.particles,
-                &self.params,
-                h,
-                &mut self.force,
-                &mut self.accel,
-            );
-            // Semi-implicit Euler: v ← v + h a, x ← x + h v (for PBD/XPBD, the prediction).
-            let p = &mut self.particles;
-            p.positions
-                .par_chunks_mut(CHUNK)
-                .zip(p.prev_positions.par_chunks_mut(CHUNK))
-                .zip(p.velocities.par_chunks_mut(CHUNK))
-                .zip(p.inv_masses.par_chunks(CHUNK))
-                .zip(self.accel.par_chunks(CHUNK))
-                .for_each(|((((x, prev), v), w), a)| {
-                    for j in 0..x.len() {
-                        prev[j] = x[j];
-                        if w[j] > 0.0 {
-                            v[j] += a[j] * h;
-                            x[j] += v[j] * h;
-                        }
-                    }
-                });
-            for &(i, x) in &self.targets {
-                p.positions[i] = x;
-            }
-            hook.begin_substep(&ctx, p);
-            strategy.begin_substep(&mut self.constraints);
-            match rule {
-                Some(rule) => {
-                    for it in 0..s.iterations {
-                        self.domains.project_global(
-                            &mut p.positions,
-                            &p.prev_positions,
-                            &p.inv_masses,
-                            it == 0,
-                        );
-                        self.constraints.project_others(
-                            &mut p.positions,
-                            &p.prev_positions,
-                            &p.inv_masses,
-                            &self.params,
-                            rule,
-                        );
-                        stats.contacts = hook.project(&ctx, p);
-                    }
-                    if self.constraints.seam_count() > 0 {
-                        self.constraints.hold_seams(
-                            &mut p.positions,
-                            &p.prev_positions,
-                            &p.inv_masses,
-                            rule,
-                        );
-                    }
-                }
-                None => stats.contacts = hook.project(&ctx, p),
-            }
-            // Velocities from positions (the PBD update; for mass-spring it equals v unless
-            // a contact moved the particle).
-            let inv_h = 1.0 / h;
-            p.velocities
-                .par_chunks_mut(CHUNK)
-                .zip(p.positions.par_chunks(CHUNK))
-                .zip(p.prev_positions.par_chunks(CHUNK))
-                .for_each(|((v, x), prev)| {
-                    for j in 0..v.len() {
-                        v[j] = (x[j] - prev[j]) * inv_h;
-                    }
-                });
-            // Driven pins report the velocity of what carries them, not the chord.
-            for &(i, v) in &self.driven_velocities {
-                p.velocities[i] = v;
-            }
-            hook.end_substep(&ctx, p);
-            if self.forces.damping > 0.0 {
-                let keep = (-self.forces.damping * h).exp();
-                p.velocities
-                    .par_chunks_mut(CHUNK)
-                    .zip(p.inv_masses.par_chunks(CHUNK))
-                    .for_each(|(v, w)| {
-                        for (v, w) in v.iter_mut().zip(w) {
-                            if *w > 0.0 {
-                                *v *= keep;
-                            }
-                        }
-                    });
-            }
-        }
-        (stats, whole)
     }
 
     fn check_divergence(&self, frame: u64) -> Result<(), SolverError> {
