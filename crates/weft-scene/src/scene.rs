@@ -133,6 +133,19 @@ pub struct CharacterSpec {
     pub dynamic_friction: f64,
 }
 
+/// The scene's skinned glTF character (`[character] model = …`): a deforming mesh collider.
+#[derive(Clone, Debug)]
+pub struct ModelSpec {
+    /// The model file, as written in the scene.
+    pub path: String,
+    /// The skinned mesh, placed and played as the scene says; its clock is the solvers'.
+    pub skin: std::sync::Arc<weft_character::skin::SkinCollider>,
+    /// Static friction between the body and cloth.
+    pub static_friction: f64,
+    /// Dynamic friction between the body and cloth.
+    pub dynamic_friction: f64,
+}
+
 /// A collider ready for the collision world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColliderSpec {
@@ -192,8 +205,10 @@ pub struct Scene {
     pub colliders: Vec<ColliderSpec>,
     /// Self-collision, when on.
     pub self_collision: Option<SelfCollisionSpec>,
-    /// The animated character, when the scene has one.
+    /// The animated character, when the scene has one (a skeleton and its body).
     pub character: Option<CharacterSpec>,
+    /// The skinned glTF character, when the scene's `[character]` names a `model`.
+    pub model: Option<ModelSpec>,
     /// Files the scene read (OBJ meshes), by the path written in the scene.
     pub files: BTreeMap<String, Vec<u8>>,
 }

@@ -7,18 +7,20 @@ mod checker;
 mod cloth;
 mod collider;
 mod garment;
+mod model;
 
 use weft_collide::SelfCollisionParams;
 use weft_solver::{Aero, Forces, Settings, Wind};
 
 use crate::ranges;
-use crate::scene::{CharacterSpec, ClothSpec, ColliderSpec, SelfCollisionSpec};
+use crate::scene::{CharacterSpec, ClothSpec, ColliderSpec, ModelSpec, SelfCollisionSpec};
 use crate::schema::SceneFile;
 
 use character::character;
 pub(crate) use checker::Checker;
 use cloth::cloth;
 use collider::collider;
+use model::model;
 
 /// Checks every value of `file` and resolves it into solver types.
 pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedParts> {
@@ -85,7 +87,22 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
     if file.cloth.is_empty() {
         c.bad("cloth", "a scene needs at least one [cloth.<name>] table");
     }
-    let character = file.character.as_ref().and_then(|s| character(c, s));
+    let (character, model) = match &file.character {
+        Some(s) if s.model.is_some() => (None, model(c, s)),
+        Some(s) => (character(c, s), None),
+        None => (None, None),
+    };
+    if file.character.as_ref().is_some_and(|s| s.model.is_some()) {
+        for (name, s) in &file.cloth {
+            if s.attach.as_ref().is_some_and(|a| !a.is_empty()) {
+                c.bad(
+                    &format!("cloth.{name}.attach"),
+                    "attachments to the joints of a glTF `model` character are not supported \
+                     yet (attach garments to a `skeleton` character's bones)",
+                );
+            }
+        }
+    }
     let cloths: Vec<ClothSpec> = file
         .cloth
         .iter()
@@ -154,6 +171,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
         colliders,
         self_collision,
         character,
+        model,
     })
 }
 
@@ -165,6 +183,7 @@ pub(crate) struct ResolvedParts {
     pub colliders: Vec<ColliderSpec>,
     pub self_collision: Option<SelfCollisionSpec>,
     pub character: Option<CharacterSpec>,
+    pub model: Option<ModelSpec>,
 }
 
 pub(super) fn valid_name(name: &str) -> bool {
