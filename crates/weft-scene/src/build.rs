@@ -2,6 +2,7 @@
 
 use std::sync::Arc;
 
+use weft_character::skin::{JointAttachment, SkinAttachmentDriver};
 use weft_character::{Attachment, AttachmentDriver};
 use weft_collide::CollisionWorld;
 use weft_solver::{
@@ -123,6 +124,9 @@ impl Scene {
     /// Drives each garment's attached vertices with its bones (one driver per cloth), bound
     /// at the solver's present time.
     fn attach(&self, solver: &mut Solver, members: &[usize]) -> Result<(), SceneError> {
+        if self.model.is_some() {
+            return self.attach_to_model(solver, members);
+        }
         let Some(ch) = &self.character else {
             return Ok(());
         };
@@ -155,6 +159,49 @@ impl Scene {
                 .map_err(|e| err(&e))?;
             let first = solver.cloths()[j].particles.start;
             let driver = AttachmentDriver::new(ch.character.clone(), first, attachments)
+                .map_err(|e| err(&e))?;
+            solver
+                .add_pin_driver(Arc::new(driver))
+                .map_err(|e| err(&e))?;
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// [`Scene::attach`] for a glTF model: each attachment follows its joint node's placed
+    /// world transform.
+    fn attach_to_model(&self, solver: &mut Solver, members: &[usize]) -> Result<(), SceneError> {
+        let Some(m) = &self.model else {
+            return Ok(());
+        };
+        let world = m.skin.node_world(solver.time());
+        for (j, &i) in members.iter().enumerate() {
+            let c = &self.cloths[i];
+            if c.attachments.is_empty() {
+                continue;
+            }
+            let err = |e: &dyn std::fmt::Display| SceneError {
+                origin: Origin::File {
+                    path: self.name.clone(),
+                    line: None,
+                },
+                key: format!("cloth.{}.attach", c.name),
+                message: e.to_string(),
+            };
+            let attachments = c
+                .attachments
+                .iter()
+                .map(|a| {
+                    let bind = world.get(a.bone).ok_or_else(|| {
+                        err(&format!("joint node {} is not in the model", a.bone))
+                    })?;
+                    JointAttachment::bind(a.bone, a.vertices.clone(), &c.mesh.positions, bind)
+                        .map_err(|e| err(&e))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let first = solver.cloths()[j].particles.start;
+            let driver = SkinAttachmentDriver::new(m.skin.clone(), first, attachments)
                 .map_err(|e| err(&e))?;
             solver
                 .add_pin_driver(Arc::new(driver))

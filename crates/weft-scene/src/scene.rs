@@ -113,7 +113,7 @@ pub struct ClothSpec {
 /// Garment vertices pinned to a bone of the scene's character.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AttachSpec {
-    /// The bone's index in the skeleton.
+    /// The bone's index in the skeleton (for a glTF `model`: the joint's node index).
     pub bone: usize,
     /// The bone's name.
     pub bone_name: String,

@@ -57,6 +57,16 @@ impl SkinCollider {
         }
     }
 
+    /// Every glTF node's placed world transform at solver time `t` (s):
+    /// `placement · G(clip_time(t))`.
+    pub fn node_world(&self, t: f64) -> Vec<DMat4> {
+        let mut g = self.mesh.node_globals(self.clip_time(t));
+        for m in &mut g {
+            *m = self.placement * *m;
+        }
+        g
+    }
+
     /// The placed, skinned vertices at solver time `t` (s).
     pub fn vertices(&self, t: f64) -> Vec<DVec3> {
         let mut out = vec![DVec3::ZERO; self.mesh.positions.len()];

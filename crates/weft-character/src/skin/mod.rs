@@ -9,6 +9,7 @@
 //! files (and external buffers) is [`crate::files`]'s job.
 
 mod animation;
+mod attach;
 mod collider;
 mod load;
 
@@ -16,6 +17,7 @@ use glam::{DMat4, DQuat, DVec3};
 use thiserror::Error;
 
 pub use animation::{Channel, ChannelValues, Interpolation};
+pub use attach::{JointAttachment, SkinAttachmentDriver};
 pub use collider::SkinCollider;
 pub use load::{AnimationChoice, BufferSource, decode_data_uri, parse_gltf_slice};
 

@@ -20,6 +20,7 @@ use character::character;
 pub(crate) use checker::Checker;
 use cloth::cloth;
 use collider::collider;
+use garment::Rig;
 use model::model;
 
 /// Checks every value of `file` and resolves it into solver types.
@@ -92,30 +93,15 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
         Some(s) => (character(c, s), None),
         None => (None, None),
     };
-    if file.character.as_ref().is_some_and(|s| s.model.is_some()) {
-        for (name, s) in &file.cloth {
-            if s.attach.as_ref().is_some_and(|a| !a.is_empty()) {
-                c.bad(
-                    &format!("cloth.{name}.attach"),
-                    "attachments to the joints of a glTF `model` character are not supported \
-                     yet (attach garments to a `skeleton` character's bones)",
-                );
-            }
-        }
-    }
+    let rig = Rig {
+        character: character.as_ref(),
+        model: model.as_ref(),
+        present: file.character.is_some(),
+    };
     let cloths: Vec<ClothSpec> = file
         .cloth
         .iter()
-        .filter_map(|(name, section)| {
-            cloth(
-                c,
-                name,
-                section,
-                &settings,
-                character.as_ref(),
-                file.character.is_some(),
-            )
-        })
+        .filter_map(|(name, section)| cloth(c, name, section, &settings, rig))
         .collect();
     let colliders: Vec<ColliderSpec> = file
         .collider
