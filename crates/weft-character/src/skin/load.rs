@@ -152,6 +152,11 @@ impl SkinnedMesh {
                 .collect(),
             None => vec![DMat4::IDENTITY; joints.len()],
         };
+        if !inverse_bind.iter().all(|m| m.is_finite()) {
+            return Err(SkinError::Invalid(
+                "an inverse bind matrix is not finite".into(),
+            ));
+        }
         if inverse_bind.len() != joints.len() {
             return Err(SkinError::Invalid(format!(
                 "{} inverse bind matrices for {} joints",
@@ -226,6 +231,11 @@ impl SkinnedMesh {
             .into_f32()
             .collect();
         let n = positions.len();
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(SkinError::Invalid(format!(
+                "mesh {mesh}, primitive {primitive}: vertex {k} is not finite"
+            )));
+        }
         if joints.len() != n || weights.len() != n {
             return Err(SkinError::Invalid(format!(
                 "mesh {mesh}, primitive {primitive}: {n} positions, {} joints, {} weights",
@@ -349,6 +359,16 @@ where
         ChannelValues::Translation(v) | ChannelValues::Scale(v) => v.len(),
         ChannelValues::Rotation(v) => v.len(),
     };
+    let finite = match &values {
+        ChannelValues::Translation(v) | ChannelValues::Scale(v) => v.iter().all(|x| x.is_finite()),
+        ChannelValues::Rotation(v) => v.iter().all(|q| q.is_finite()),
+    };
+    if !finite {
+        return Err(SkinError::Invalid(format!(
+            "channel {}: a key value is not finite",
+            ch.index()
+        )));
+    }
     let bad_times = times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] <= w[0]);
     if count != times.len() || bad_times {
         return Err(SkinError::Invalid(format!(
