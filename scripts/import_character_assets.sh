@@ -12,6 +12,13 @@
 #   assets/characters/CMU-mocap-README.txt          the .source.txt beside the BVH files
 #   assets/characters/simple_skin.gltf              models/glTF2/simple_skin (2 joints, 10
 #                                                   vertices, a bending animation; BSD-3)
+#   assets/characters/bcn_epileptic.glb             models/X/BCN_Epileptic.X (a skinned human in
+#                                                   three meshes on one 54-joint skin, a 3.3 s
+#                                                   jump; BSD-3) converted to GLB by
+#                                                   `assimp export`
+#
+# Needs: apt-get (or DEB=…), dpkg, awk, and `assimp` from Debian's assimp-utils
+# (`apt-get install -y assimp-utils`) for the GLB conversion.
 #
 # Usage: scripts/import_character_assets.sh   (env: DEB=path/to/assimp-testmodels_*.deb to use
 #        a downloaded package; START=120 FRAMES=240 STRIDE=2, i.e. 1 s to 5 s at 60 fps)
@@ -35,6 +42,15 @@ mkdir -p "$out"
 cp "$work/x/usr/share/doc/assimp-testmodels/copyright" "$out/LICENSE-assimp-testmodels.txt"
 cp "$models/BVH/01_nn.bvh.source.txt" "$out/CMU-mocap-README.txt"
 cp "$models/glTF2/simple_skin/simple_skin.gltf" "$out/simple_skin.gltf"
+
+# The skinned human: DirectX .X to binary glTF. Already y-up and in metres (feet at
+# y = -1.02 m): scenes place it with [character] position, not by editing the data.
+if ! command -v assimp >/dev/null; then
+  echo "assimp not found: apt-get install -y assimp-utils" >&2; exit 1
+fi
+(cd "$work" && assimp export "$models/X/BCN_Epileptic.X" bcn_epileptic.glb >/dev/null)
+cp "$work/bcn_epileptic.glb" "$out/bcn_epileptic.glb"
+echo "# wrote $out/bcn_epileptic.glb" >&2
 
 # Hierarchy verbatim; MOTION header rewritten for the kept frames; frames START,
 # START + STRIDE, … (0-based), FRAMES of them. Fails if the source has too few frames.

@@ -179,6 +179,7 @@ impl<'g> VideoRecorder<'g> {
             .map(|i| sim.cloth_positions(i))
             .collect();
         let poses = view::frame_poses(sim);
+        view::refresh_deformed(&mut self.renderer, sim);
         self.renderer.update(
             &self.gpu.queue,
             &FrameData {

@@ -63,6 +63,30 @@ pub fn scene_meshes(sim: &Simulation) -> SceneView {
     }
 }
 
+/// The deforming mesh colliders of `sim` (a skinned glTF character's body) at the solvers'
+/// time, each with its index among the renderer's collider meshes: vertices in the
+/// collider's frame (posed by [`frame_poses`]), triangles as in [`scene_meshes`].
+pub fn deformed_meshes(sim: &Simulation) -> Vec<(usize, TriMesh)> {
+    colliders(sim)
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.is_deforming())
+        .filter_map(|(i, c)| {
+            let vertices = c.mesh_vertices()?;
+            let (_, indices) = c.tessellate();
+            let positions = vertices.iter().map(|v| v.as_vec3()).collect();
+            Some((i, TriMesh { positions, indices }))
+        })
+        .collect()
+}
+
+/// Gives `renderer` this frame's shape of every deforming collider of `sim`.
+pub fn refresh_deformed(renderer: &mut Renderer, sim: &Simulation) {
+    for (i, mesh) in deformed_meshes(sim) {
+        renderer.set_collider_mesh(i, &mesh);
+    }
+}
+
 /// The current world pose of each collider of `sim`, then of each body part (in the order of
 /// [`scene_meshes`]).
 pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
@@ -181,5 +205,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A skinned glTF character is drawn as it moves: its mesh for the renderer is the
+    /// collider's vertices at the solvers' time, which is the skinning at that time.
+    #[test]
+    fn a_skinned_characters_body_is_drawn_as_skinned_at_the_solvers_time() {
+        let source = std::path::Path::new("assets/scenes/glb_character.toml");
+        let scene = weft_scene::load(source, &[]).expect("the glb scene");
+        let mut sim = Simulation::new(scene).expect("solvers");
+        let skin = sim.scene.model.clone().expect("a model").skin;
+        let first = scene_meshes(&sim).meshes.colliders;
+        for _ in 0..6 {
+            sim.step().expect("a step");
+        }
+        let deformed = deformed_meshes(&sim);
+        assert_eq!(deformed.len(), 1);
+        let (i, mesh) = &deformed[0];
+        assert_eq!(mesh.indices, first[*i].indices);
+        let want = skin.vertices(sim.groups[0].solver.time());
+        assert_eq!(mesh.positions.len(), want.len());
+        let mut moved = 0.0f32;
+        for ((p, w), p0) in mesh.positions.iter().zip(&want).zip(&first[*i].positions) {
+            assert!((p.as_dvec3() - *w).length() < 1e-6, "{p} vs {w}");
+            moved = moved.max((*p - *p0).length());
+        }
+        assert!(moved > 1e-3, "the drawn body did not move ({moved} m)");
     }
 }

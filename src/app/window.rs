@@ -330,6 +330,7 @@ impl App {
             .map(|i| sim.cloth_positions(i))
             .collect();
         let poses = view::frame_poses(sim);
+        view::refresh_deformed(&mut g.renderer, sim);
         let grab = self.session.grab;
         g.renderer.update(
             &g.gpu.queue,

@@ -98,6 +98,20 @@ pub fn parts(sim: &Simulation) -> Vec<(String, PartPose)> {
         .collect()
 }
 
+/// The name the skinned glTF character's body is logged under.
+pub const MODEL_NAME: &str = "body/model";
+
+/// The scene's skinned glTF character (`[character] model`) as the collision world meets it
+/// now: its vertices skinned and placed at the solvers' time, and its triangles. `None` for a
+/// scene without one.
+pub fn model_mesh(sim: &Simulation) -> Option<(Vec<DVec3>, &[[u32; 3]])> {
+    let (m, group) = (sim.scene.model.as_ref()?, sim.groups.first()?);
+    Some((
+        m.skin.vertices(group.solver.time()),
+        &m.skin.mesh().triangles,
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,8 +1,11 @@
 //! The character's body on `/colliders`: each part an entity `collider/<part name>` drawn, in
 //! its own frame, as Foxglove primitives that make its surface exactly: its two end spheres and
-//! the cone tangent to both (a cylinder with scaled ends; a sphere alone for a sphere).
+//! the cone tangent to both (a cylinder with scaled ends; a sphere alone for a sphere); a
+//! skinned glTF character's body as the triangle list `collider/body/model`.
 
-use foxglove::messages::{CylinderPrimitive, SceneEntity, SpherePrimitive};
+use foxglove::messages::{
+    CylinderPrimitive, Point3, SceneEntity, SpherePrimitive, TriangleListPrimitive,
+};
 use weft_solver::glam::{DQuat, DVec3};
 
 use crate::body::PartPose;
@@ -52,6 +55,31 @@ pub fn entities(time: f64, parts: &[(String, PartPose)]) -> Vec<SceneEntity> {
             e
         })
         .collect()
+}
+
+/// The skinned glTF character's body at time `time` (s) as the entity
+/// `collider/body/model`: its triangles at `vertices` (world, m), in grey.
+pub fn model_entity(time: f64, vertices: &[DVec3], triangles: &[[u32; 3]]) -> SceneEntity {
+    SceneEntity {
+        timestamp: Some(timestamp(time)),
+        frame_id: FRAME_ID.into(),
+        id: format!("collider/{}", crate::body::MODEL_NAME),
+        triangles: vec![TriangleListPrimitive {
+            pose: Some(pose(DVec3::ZERO, DQuat::IDENTITY)),
+            points: vertices
+                .iter()
+                .map(|p| Point3 {
+                    x: p.x,
+                    y: p.y,
+                    z: p.z,
+                })
+                .collect(),
+            color: Some(GREY),
+            colors: vec![],
+            indices: triangles.iter().flatten().copied().collect(),
+        }],
+        ..SceneEntity::default()
+    }
 }
 
 #[cfg(test)]

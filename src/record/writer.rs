@@ -85,7 +85,7 @@ impl Recorder {
         let none = BTreeMap::new();
         let scene = &sim.scene;
         // A character's body is logged with the colliders, and moves every frame.
-        let has_body = !crate::body::parts(sim).is_empty();
+        let has_body = !crate::body::parts(sim).is_empty() || scene.model.is_some();
         let no_colliders = scene.colliders.is_empty() && !has_body;
         let mut particles = Vec::new();
         let mut meshes = Vec::new();
@@ -234,6 +234,14 @@ impl Recorder {
         {
             let mut m = messages::colliders(time, &sim.scene.colliders);
             m.entities.extend(body::entities(time, &parts));
+            // A skinned body is as large as a cloth mesh: logged when the cloth meshes are.
+            let every = self.options.mesh_every;
+            if (stats.frame == 0 || (every > 0 && stats.frame % every == 0))
+                && let Some((vertices, triangles)) = crate::body::model_mesh(sim)
+            {
+                m.entities
+                    .push(body::model_entity(time, &vertices, triangles));
+            }
             self.put(ch, time, &m)?;
         }
         if let Some(ch) = self.collider_state {

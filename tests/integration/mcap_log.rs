@@ -233,3 +233,61 @@ fn colliders_are_logged_and_collide() {
         .fold(f32::INFINITY, f32::min);
     assert!(centre > 0.85 && centre < 1.0, "centre at y = {centre}");
 }
+
+/// A skinned glTF character's body is on `/colliders` as the triangle list
+/// `collider/body/model`, at the skinning of each logged frame's time (the scene's own
+/// `SkinCollider`, placed), whenever the cloth meshes are logged.
+#[test]
+fn a_skinned_characters_body_is_logged_as_it_moves() {
+    use foxglove::Decode;
+    use foxglove::messages::SceneUpdate;
+    let dir = temp_dir("glb-body");
+    let mcap = dir.join("g.mcap");
+    let scene = Path::new("assets/scenes/glb_character.toml");
+    let out = run(&[
+        "run",
+        &scene.to_string_lossy(),
+        "--frames",
+        "6",
+        "--mesh-every",
+        "3",
+        "--out",
+        &mcap.to_string_lossy(),
+    ]);
+    assert!(out.status.success(), "{:?}", texts(&out));
+    let skin = weft_scene::load(scene, &[])
+        .expect("the scene")
+        .model
+        .expect("a model")
+        .skin;
+    let bytes = std::fs::read(&mcap).expect("log");
+    let mut seen = Vec::new();
+    for m in mcap::MessageStream::new(&bytes).expect("readable") {
+        let m = m.expect("message");
+        if m.channel.topic != "/colliders" {
+            continue;
+        }
+        let update = SceneUpdate::decode(&m.data[..]).expect("a SceneUpdate");
+        let Some(e) = update
+            .entities
+            .iter()
+            .find(|e| e.id == "collider/body/model")
+        else {
+            continue;
+        };
+        let t = m.log_time as f64 * 1e-9;
+        let want = skin.vertices(t);
+        let points = &e.triangles[0].points;
+        assert_eq!(points.len(), want.len());
+        for (p, w) in points.iter().zip(&want) {
+            let d = (weft_solver::glam::DVec3::new(p.x, p.y, p.z) - *w).length();
+            assert!(d < 1e-6, "t = {t}: logged vertex {d} m from the skinning");
+        }
+        assert_eq!(
+            e.triangles[0].indices.len(),
+            3 * skin.mesh().triangles.len()
+        );
+        seen.push((t * 60.0).round() as u32);
+    }
+    assert_eq!(seen, vec![0, 3, 6], "frames logging the body");
+}

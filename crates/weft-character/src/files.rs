@@ -9,7 +9,7 @@ use crate::body_table::BodyTable;
 use crate::bvh::{Bvh, BvhOptions, parse_bvh};
 use crate::error::{BodyError, BvhError};
 use crate::garment::{GarmentError, GarmentSpec};
-use crate::skin::{BufferSource, SkinError, SkinnedMesh, parse_gltf_slice};
+use crate::skin::{AnimationChoice, BufferSource, SkinError, SkinnedMesh, parse_gltf_slice};
 
 /// A character file that cannot be read or parsed.
 #[derive(Debug, Error)]
@@ -91,8 +91,16 @@ pub fn read_garment(path: &Path) -> Result<GarmentSpec, LoadError> {
 }
 
 /// Reads a skinned, animated mesh from a `.gltf` or `.glb` file; external buffers are read
-/// from paths relative to the file.
+/// from paths relative to the file; the first animation plays.
 pub fn read_skinned_gltf(path: &Path) -> Result<SkinnedMesh, LoadError> {
+    read_skinned_gltf_with(path, &AnimationChoice::First)
+}
+
+/// [`read_skinned_gltf`] playing the animation `animation` chooses.
+pub fn read_skinned_gltf_with(
+    path: &Path,
+    animation: &AnimationChoice,
+) -> Result<SkinnedMesh, LoadError> {
     let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
         path: path.to_owned(),
         source,
@@ -113,5 +121,5 @@ pub fn read_skinned_gltf(path: &Path) -> Result<SkinnedMesh, LoadError> {
             }
         })
         .collect::<Result<Vec<_>, _>>()?;
-    SkinnedMesh::from_document(&doc, &buffers).map_err(skin_error)
+    SkinnedMesh::from_document_with(&doc, &buffers, animation).map_err(skin_error)
 }

@@ -3,9 +3,11 @@
 use std::sync::Arc;
 
 use weft_character::AttachmentDriver;
+use weft_character::skin::SkinAttachmentDriver;
 use weft_collide::CollisionWorld;
 use weft_solver::{
-    Family, FamilyParams, Method, Motion, Settings, Solver, SolverBuilder, SolverError, StepStats,
+    Family, FamilyParams, Method, Motion, PinDriver, Settings, Solver, SolverBuilder, SolverError,
+    StepStats,
 };
 
 use crate::collide::DelayedSelfCollision;
@@ -120,12 +122,9 @@ impl Scene {
 }
 
 impl Scene {
-    /// Drives each garment's attached vertices with its bones (one driver per cloth), bound
-    /// at the solver's present time.
+    /// Drives each garment's attached vertices with its bones, or with the joints of a glTF
+    /// model (one driver per cloth), bound at the solver's present time.
     fn attach(&self, solver: &mut Solver, members: &[usize]) -> Result<(), SceneError> {
-        let Some(ch) = &self.character else {
-            return Ok(());
-        };
         for (j, &i) in members.iter().enumerate() {
             let c = &self.cloths[i];
             if c.attachments.is_empty() {
@@ -139,13 +138,24 @@ impl Scene {
                 key: format!("cloth.{}.attach", c.name),
                 message: e.to_string(),
             };
-            let attachments = ch.bind(c, solver.time()).map_err(|e| err(&e))?;
             let first = solver.cloths()[j].particles.start;
-            let driver = AttachmentDriver::new(ch.character.clone(), first, attachments)
-                .map_err(|e| err(&e))?;
-            solver
-                .add_pin_driver(Arc::new(driver))
-                .map_err(|e| err(&e))?;
+            let time = solver.time();
+            let driver: Arc<dyn PinDriver> = if let Some(m) = &self.model {
+                let attachments = m.bind(c, time).map_err(|e| err(&e))?;
+                Arc::new(
+                    SkinAttachmentDriver::new(m.skin.clone(), first, attachments)
+                        .map_err(|e| err(&e))?,
+                )
+            } else if let Some(ch) = &self.character {
+                let attachments = ch.bind(c, time).map_err(|e| err(&e))?;
+                Arc::new(
+                    AttachmentDriver::new(ch.character.clone(), first, attachments)
+                        .map_err(|e| err(&e))?,
+                )
+            } else {
+                continue;
+            };
+            solver.add_pin_driver(driver).map_err(|e| err(&e))?;
         }
         Ok(())
     }

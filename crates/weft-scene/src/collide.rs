@@ -3,7 +3,9 @@
 
 use std::sync::Arc;
 
-use weft_collide::{ColliderDesc, CollisionWorld, Friction, KinematicBody, SelfCollisionParams};
+use weft_collide::{
+    ColliderDesc, CollisionWorld, Friction, KinematicBody, MeshAnimation, SelfCollisionParams,
+};
 use weft_solver::Solver;
 
 use crate::error::{Origin, SceneError};
@@ -42,7 +44,8 @@ impl Scene {
     }
 
     /// The collision world for `solver`, whose cloths are scene cloths `members`; `None`
-    /// when the scene has no collider, no character and no self-collision among these cloths.
+    /// when the scene has no collider, no character (skeleton or model) and no self-collision
+    /// among these cloths.
     ///
     /// When one of the self-colliding cloths is a garment whose seams are still closing,
     /// self-collision is not turned on here: it is returned, to be turned on once the seams
@@ -62,7 +65,11 @@ impl Scene {
                 .collect(),
             None => Vec::new(),
         };
-        if self.colliders.is_empty() && self_cloths.is_empty() && self.character.is_none() {
+        if self.colliders.is_empty()
+            && self_cloths.is_empty()
+            && self.character.is_none()
+            && self.model.is_none()
+        {
             return Ok((None, None));
         }
         let mut world = CollisionWorld::new(solver);
@@ -107,13 +114,28 @@ impl Scene {
 }
 
 impl Scene {
-    /// Adds the scene's character (its body, moving with the clip) to `world`.
+    /// Adds the scene's character to `world`: a skeleton's body moving with the clip, or a
+    /// glTF model's skinned mesh as a deforming mesh collider.
     fn add_character(&self, world: &mut CollisionWorld) -> Result<(), SceneError> {
         if let Some(ch) = &self.character {
             let body: Arc<dyn KinematicBody> = ch.character.clone();
             world
                 .add_body(body, Friction::new(ch.static_friction, ch.dynamic_friction))
                 .map_err(|e| self.collide_error("character".into(), e.to_string()))?;
+        }
+        if let Some(m) = &self.model {
+            let err = |e: &dyn std::fmt::Display| {
+                self.collide_error("character.model".into(), format!("`{}`: {e}", m.path))
+            };
+            let desc = m
+                .skin
+                .desc()
+                .map_err(|e| err(&e))?
+                .with_friction(Friction::new(m.static_friction, m.dynamic_friction));
+            let animation: Arc<dyn MeshAnimation> = m.skin.clone();
+            world
+                .add_deforming_mesh(&desc, animation)
+                .map_err(|e| err(&e))?;
         }
         Ok(())
     }

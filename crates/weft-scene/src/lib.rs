@@ -25,5 +25,5 @@ pub use load::{from_text, from_text_with, load, load_with};
 pub use overrides::{Override, parse_value};
 pub use scene::{
     AttachSpec, CappedDirFiles, CharacterSpec, ClothSpec, ColliderSpec, DEFAULT_MAX_FILE_BYTES,
-    DirFiles, Files, MapFiles, Scene, SelfCollisionSpec, read_regular,
+    DirFiles, Files, MapFiles, ModelSpec, Scene, SelfCollisionSpec, read_regular,
 };

@@ -160,6 +160,7 @@ pub fn from_text_with(
         colliders: parts.colliders,
         self_collision: parts.self_collision,
         character: parts.character,
+        model: parts.model,
         files: checker.read,
     })
 }

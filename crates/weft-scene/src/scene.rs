@@ -113,7 +113,7 @@ pub struct ClothSpec {
 /// Garment vertices pinned to a bone of the scene's character.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AttachSpec {
-    /// The bone's index in the skeleton.
+    /// The bone's index in the skeleton (for a glTF `model`: the joint's node index).
     pub bone: usize,
     /// The bone's name.
     pub bone_name: String,
@@ -152,6 +152,47 @@ impl CharacterSpec {
                     &cloth.mesh.positions,
                     &bones[a.bone].transform,
                 )
+            })
+            .collect()
+    }
+}
+
+/// The scene's skinned glTF character (`[character] model = …`): a deforming mesh collider.
+#[derive(Clone, Debug)]
+pub struct ModelSpec {
+    /// The model file, as written in the scene.
+    pub path: String,
+    /// The skinned mesh, placed and played as the scene says; its clock is the solvers'.
+    pub skin: std::sync::Arc<weft_character::skin::SkinCollider>,
+    /// Static friction between the body and cloth.
+    pub static_friction: f64,
+    /// Dynamic friction between the body and cloth.
+    pub dynamic_friction: f64,
+}
+
+impl ModelSpec {
+    /// Binds `cloth`'s attachments to the model's joint nodes at `time`: each attached vertex
+    /// keeps its rest position's coordinates in its joint's placed world frame at that time.
+    pub fn bind(
+        &self,
+        cloth: &ClothSpec,
+        time: f64,
+    ) -> Result<Vec<weft_character::skin::JointAttachment>, String> {
+        let world = self.skin.node_world(time);
+        cloth
+            .attachments
+            .iter()
+            .map(|a| {
+                let bind = world
+                    .get(a.bone)
+                    .ok_or_else(|| format!("joint node {} is not in the model", a.bone))?;
+                weft_character::skin::JointAttachment::bind(
+                    a.bone,
+                    a.vertices.clone(),
+                    &cloth.mesh.positions,
+                    bind,
+                )
+                .map_err(|e| e.to_string())
             })
             .collect()
     }
@@ -216,8 +257,10 @@ pub struct Scene {
     pub colliders: Vec<ColliderSpec>,
     /// Self-collision, when on.
     pub self_collision: Option<SelfCollisionSpec>,
-    /// The animated character, when the scene has one.
+    /// The animated character, when the scene has one (a skeleton and its body).
     pub character: Option<CharacterSpec>,
+    /// The skinned glTF character, when the scene's `[character]` names a `model`.
+    pub model: Option<ModelSpec>,
     /// Files the scene read (OBJ meshes), by the path written in the scene.
     pub files: BTreeMap<String, Vec<u8>>,
 }

@@ -48,16 +48,31 @@ pub enum WrapName {
 }
 
 /// `[character]`: the skeleton and clip (the built-in `walker` or a BVH file), the body table
-/// (built-in `walker` or `cmu`, or a file) and how the clip plays.
+/// (built-in `walker` or `cmu`, or a file) and how the clip plays; or, with `model`, a skinned
+/// glTF/GLB character whose deforming mesh is the body.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CharacterSection {
     /// `walker` (the procedural walk cycle) or a BVH file, relative to the scene.
     #[serde(default = "default_walker")]
     pub skeleton: String,
-    /// BVH length unit in metres (BVH files only; e.g. 0.01 for centimetres).
+    /// The file's length unit in metres (a BVH file or a `model`; e.g. 0.01 for centimetres).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<f64>,
+    /// A skinned glTF (`.gltf`) or GLB (`.glb`) file, relative to the scene: its skinned mesh
+    /// is the body (instead of `skeleton` and `body`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+    /// The `model`'s animation to play: its name or index (default: the first).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub animation: Option<AnimationKey>,
+    /// Where the `model`'s origin goes (m, after `scale` and `rotation_deg`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f64; 3]>,
+    /// The `model`'s rotation as XYZ Euler angles in degrees (e.g. `[-90, 0, 0]` for a z-up
+    /// file), applied after `scale`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation_deg: Option<[f64; 3]>,
     /// `walker`, `cmu` (built-in body tables) or a body-table TOML file.
     #[serde(default = "default_walker")]
     pub body: String,
@@ -70,6 +85,19 @@ pub struct CharacterSection {
     /// Dynamic friction between the body and cloth.
     #[serde(default = "default_dynamic_friction")]
     pub dynamic_friction: f64,
+}
+
+/// A glTF animation, by name or by index.
+#[derive(Clone, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(
+    untagged,
+    expecting = "an animation name (a string) or index (an integer)"
+)]
+pub enum AnimationKey {
+    /// The animation's index in the file.
+    Index(i64),
+    /// The animation's name.
+    Name(String),
 }
 
 fn default_walker() -> String {

@@ -17,6 +17,52 @@ pub enum BufferSource {
     External(String),
 }
 
+/// Which of a document's animations a skinned mesh plays.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum AnimationChoice {
+    /// The first, if there is one (none: the rest pose).
+    #[default]
+    First,
+    /// The one at this index.
+    Index(usize),
+    /// The one with this name.
+    Name(String),
+}
+
+impl AnimationChoice {
+    /// The chosen animation of `doc`; an index or name it does not have is an error that
+    /// lists the animations it has.
+    pub fn pick<'a>(
+        &self,
+        doc: &'a gltf::Document,
+    ) -> Result<Option<gltf::Animation<'a>>, SkinError> {
+        let found = match self {
+            Self::First => return Ok(doc.animations().next()),
+            Self::Index(i) => doc.animations().nth(*i),
+            Self::Name(n) => doc.animations().find(|a| a.name() == Some(n.as_str())),
+        };
+        found.map(Some).ok_or_else(|| {
+            let names: Vec<String> = doc
+                .animations()
+                .map(|a| format!("{} `{}`", a.index(), a.name().unwrap_or_default()))
+                .collect();
+            let what = match self {
+                Self::Index(i) => format!("no animation {i}"),
+                Self::Name(n) => format!("no animation named `{n}`"),
+                Self::First => "no animation".to_owned(),
+            };
+            SkinError::NoSuchAnimation(format!(
+                "{what} (the file's animations: {})",
+                if names.is_empty() {
+                    "none".to_owned()
+                } else {
+                    names.join(", ")
+                }
+            ))
+        })
+    }
+}
+
 /// Parses `.gltf` (JSON) or `.glb` bytes; embedded buffers are decoded, external ones named.
 pub fn parse_gltf_slice(bytes: &[u8]) -> Result<(gltf::Document, Vec<BufferSource>), SkinError> {
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| SkinError::Gltf(e.to_string()))?;
@@ -67,9 +113,20 @@ fn quat(v: [f32; 4]) -> DQuat {
 }
 
 impl SkinnedMesh {
-    /// Reads the first node that has both a mesh and a skin, every node's rest transform, and
-    /// the first animation; `buffers` holds the document's buffers in order.
+    /// Reads every node's rest transform and name, the skin of the first node that has both
+    /// a mesh and a skin, the meshes of every node skinned by that skin (their primitives
+    /// joined into one mesh, as one character split into body, head and legs is), and the
+    /// first animation; `buffers` holds the document's buffers in order.
     pub fn from_document(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<Self, SkinError> {
+        Self::from_document_with(doc, buffers, &AnimationChoice::First)
+    }
+
+    /// [`Self::from_document`] playing the animation `animation` chooses.
+    pub fn from_document_with(
+        doc: &gltf::Document,
+        buffers: &[Vec<u8>],
+        animation: &AnimationChoice,
+    ) -> Result<Self, SkinError> {
         if buffers.len() < doc.buffers().count() {
             return Err(SkinError::Invalid(format!(
                 "{} buffers given for {}",
@@ -79,13 +136,15 @@ impl SkinnedMesh {
         }
         let get = |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice);
         let (nodes, order) = node_tree(doc)?;
-        let node = doc
+        let skin = doc
             .nodes()
-            .find(|n| n.mesh().is_some() && n.skin().is_some())
+            .find_map(|n| n.mesh().and(n.skin()))
             .ok_or(SkinError::NoSkinnedMesh)?;
-        let (Some(skin), Some(mesh)) = (node.skin(), node.mesh()) else {
-            return Err(SkinError::NoSkinnedMesh);
-        };
+        let meshes: Vec<gltf::Mesh> = doc
+            .nodes()
+            .filter(|n| n.skin().is_some_and(|s| s.index() == skin.index()))
+            .filter_map(|n| n.mesh())
+            .collect();
         let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
         let inverse_bind: Vec<DMat4> = match skin.reader(get).read_inverse_bind_matrices() {
             Some(m) => m
@@ -93,6 +152,11 @@ impl SkinnedMesh {
                 .collect(),
             None => vec![DMat4::IDENTITY; joints.len()],
         };
+        if !inverse_bind.iter().all(|m| m.is_finite()) {
+            return Err(SkinError::Invalid(
+                "an inverse bind matrix is not finite".into(),
+            ));
+        }
         if inverse_bind.len() != joints.len() {
             return Err(SkinError::Invalid(format!(
                 "{} inverse bind matrices for {} joints",
@@ -103,6 +167,10 @@ impl SkinnedMesh {
         let mut out = SkinnedMesh {
             nodes,
             order,
+            names: doc
+                .nodes()
+                .map(|n| n.name().unwrap_or_default().to_owned())
+                .collect(),
             joints,
             inverse_bind,
             positions: Vec::new(),
@@ -110,10 +178,12 @@ impl SkinnedMesh {
             influences: Vec::new(),
             channels: Vec::new(),
         };
-        for prim in mesh.primitives() {
-            out.add_primitive(mesh.index(), &prim, get)?;
+        for mesh in &meshes {
+            for prim in mesh.primitives() {
+                out.add_primitive(mesh.index(), &prim, get)?;
+            }
         }
-        if let Some(anim) = doc.animations().next() {
+        if let Some(anim) = animation.pick(doc)? {
             for ch in anim.channels() {
                 if let Some(c) = read_channel(&ch, get)? {
                     out.channels.push(c);
@@ -161,6 +231,11 @@ impl SkinnedMesh {
             .into_f32()
             .collect();
         let n = positions.len();
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(SkinError::Invalid(format!(
+                "mesh {mesh}, primitive {primitive}: vertex {k} is not finite"
+            )));
+        }
         if joints.len() != n || weights.len() != n {
             return Err(SkinError::Invalid(format!(
                 "mesh {mesh}, primitive {primitive}: {n} positions, {} joints, {} weights",
@@ -284,6 +359,16 @@ where
         ChannelValues::Translation(v) | ChannelValues::Scale(v) => v.len(),
         ChannelValues::Rotation(v) => v.len(),
     };
+    let finite = match &values {
+        ChannelValues::Translation(v) | ChannelValues::Scale(v) => v.iter().all(|x| x.is_finite()),
+        ChannelValues::Rotation(v) => v.iter().all(|q| q.is_finite()),
+    };
+    if !finite {
+        return Err(SkinError::Invalid(format!(
+            "channel {}: a key value is not finite",
+            ch.index()
+        )));
+    }
     let bad_times = times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] <= w[0]);
     if count != times.len() || bad_times {
         return Err(SkinError::Invalid(format!(

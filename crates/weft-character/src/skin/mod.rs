@@ -9,6 +9,7 @@
 //! files (and external buffers) is [`crate::files`]'s job.
 
 mod animation;
+mod attach;
 mod collider;
 mod load;
 
@@ -16,8 +17,9 @@ use glam::{DMat4, DQuat, DVec3};
 use thiserror::Error;
 
 pub use animation::{Channel, ChannelValues, Interpolation};
+pub use attach::{JointAttachment, SkinAttachmentDriver};
 pub use collider::SkinCollider;
-pub use load::{BufferSource, decode_data_uri, parse_gltf_slice};
+pub use load::{AnimationChoice, BufferSource, decode_data_uri, parse_gltf_slice};
 
 /// A glTF that cannot be turned into a skinned mesh.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -52,6 +54,9 @@ pub enum SkinError {
     /// Data that is present but inconsistent (named).
     #[error("invalid: {0}")]
     Invalid(String),
+    /// The chosen animation is not in the file (the message lists those that are).
+    #[error("{0}")]
+    NoSuchAnimation(String),
 }
 
 /// A node's rest transform (translation, rotation, scale) and parent.
@@ -74,6 +79,8 @@ pub struct SkinnedMesh {
     pub nodes: Vec<NodeRest>,
     /// Nodes ordered parents first.
     pub order: Vec<usize>,
+    /// Every node's name, in document order (empty for an unnamed node).
+    pub names: Vec<String>,
     /// Node index of each skin joint.
     pub joints: Vec<usize>,
     /// Inverse bind matrix of each skin joint.

@@ -17,4 +17,5 @@ mod sampling;
 mod sew;
 mod skin;
 mod skin_collider;
+mod skin_glb;
 mod walk;

@@ -107,3 +107,65 @@ fn broken_gltf_files_are_errors_not_panics() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The fixture with the f32 at byte `at` of buffer `buffer` set to NaN, read.
+fn with_nan(buffer: usize, at: usize) -> Result<SkinnedMesh, SkinError> {
+    use base64::Engine;
+    let text = std::fs::read_to_string(fixture()).expect("fixture");
+    let engine = base64::engine::general_purpose::STANDARD;
+    let mut start = 0;
+    for _ in 0..=buffer {
+        start += text[start..].find("base64,").expect("a data uri") + "base64,".len();
+    }
+    let end = start + text[start..].find('"').expect("end of uri");
+    let mut bytes = engine.decode(&text[start..end]).expect("base64");
+    bytes[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let broken = format!(
+        "{}{}{}",
+        &text[..start],
+        engine.encode(&bytes),
+        &text[end..]
+    );
+    let (doc, buffers) = parse_gltf_slice(broken.as_bytes()).expect("still glTF");
+    let data: Vec<Vec<u8>> = buffers
+        .into_iter()
+        .map(|b| match b {
+            weft_character::skin::BufferSource::Data(d) => d,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    SkinnedMesh::from_document(&doc, &data)
+}
+
+/// A NaN among the bind positions or an animation's key values is an error naming where it
+/// is, not a body that turns into NaN.
+#[test]
+fn non_finite_positions_and_animation_keys_are_errors() {
+    let text = std::fs::read_to_string(fixture()).expect("fixture");
+    let (doc, _) = parse_gltf_slice(text.as_bytes()).expect("glTF");
+    let place = |a: gltf::Accessor| {
+        let view = a.view().expect("a buffer view");
+        (view.buffer().index(), view.offset() + a.offset())
+    };
+    let prim = doc.meshes().next().and_then(|m| m.primitives().next());
+    let position = prim
+        .and_then(|p| p.get(&gltf::Semantic::Positions))
+        .expect("positions");
+    let (b, at) = place(position);
+    assert_eq!(
+        with_nan(b, at + 12).expect_err("a NaN position"),
+        SkinError::Invalid("mesh 0, primitive 0: vertex 1 is not finite".into())
+    );
+    let output = doc
+        .animations()
+        .next()
+        .and_then(|a| a.channels().next())
+        .expect("a channel")
+        .sampler()
+        .output();
+    let (b, at) = place(output);
+    assert_eq!(
+        with_nan(b, at).expect_err("a NaN key"),
+        SkinError::Invalid("channel 0: a key value is not finite".into())
+    );
+}

@@ -10,7 +10,7 @@ mod staging;
 use resources::Resources;
 use staging::Staging;
 
-use crate::scene::{FrameData, SceneMeshes};
+use crate::scene::{FrameData, SceneMeshes, TriMesh};
 
 /// Draws one scene; create it once, then [`update`](Self::update) and
 /// [`render`](Self::render) every frame.
@@ -46,6 +46,14 @@ impl Renderer {
         if y.is_finite() {
             self.ground_height = y;
         }
+    }
+
+    /// Replaces collider `i`'s mesh (in its own frame) with `mesh`, e.g. a deforming mesh's
+    /// vertices at this frame; it must have the same triangles as the mesh it replaces, else
+    /// nothing changes. Returns whether it was replaced; takes effect at the next
+    /// [`update`](Self::update).
+    pub fn set_collider_mesh(&mut self, i: usize, mesh: &TriMesh) -> bool {
+        self.staging.set_collider_mesh(i, mesh)
     }
 
     /// Uploads the frame's positions, per-vertex normals and collider poses. Cloths whose

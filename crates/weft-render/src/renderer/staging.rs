@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 use super::focus;
 use crate::geometry::{self, Bounds, SplitMesh};
 use crate::pipelines::{LineVertex, LitVertex, PointInstance};
-use crate::scene::{ClothTopology, FrameData, SceneMeshes};
+use crate::scene::{ClothTopology, FrameData, SceneMeshes, TriMesh};
 use crate::uniforms::{CLOTH_MATERIALS, COLLIDER_MATERIAL};
 
 /// Linear RGBA of wireframe edges.
@@ -149,6 +149,22 @@ impl Staging {
             scratch_pos: Vec::new(),
             scratch_normal: Vec::new(),
         }
+    }
+
+    /// Replaces collider `i`'s local mesh (a deforming mesh's vertices at this frame, drawn
+    /// at the frame's pose from the next [`Self::stage`] on). The mesh must split into as
+    /// many vertices as the one it replaces (the same triangles); otherwise, or for an
+    /// index past the colliders, nothing changes. Returns whether it was replaced.
+    pub(super) fn set_collider_mesh(&mut self, i: usize, mesh: &TriMesh) -> bool {
+        let Some(slot) = self.colliders.get_mut(i) else {
+            return false;
+        };
+        let split = SplitMesh::new(mesh);
+        if split.len() != slot.mesh.len() {
+            return false;
+        }
+        slot.mesh = split;
+        true
     }
 
     /// Wireframe edges of every cloth.
@@ -297,7 +313,6 @@ mod tests {
     use glam::DVec3;
 
     use super::*;
-    use crate::scene::TriMesh;
 
     /// Two cloths (a unit square of two triangles, and a second one with a triangle naming a
     /// missing particle) and a unit cube collider.
@@ -406,5 +421,37 @@ mod tests {
         assert!(s.overlay_lines.is_empty() && s.markers.is_empty());
         assert_ne!(focus::grid_spacing(s.focus), spacing);
         assert_eq!(s.grid_spacing, Some(spacing), "chosen once");
+    }
+
+    /// A deforming collider's new vertices replace its mesh and are drawn at the frame's
+    /// pose; a mesh of another size leaves the old one in place.
+    #[test]
+    fn a_deforming_colliders_new_vertices_are_drawn_at_its_pose() {
+        let mut s = Staging::new(&scene());
+        let mut cube = scene().colliders.remove(0);
+        for p in &mut cube.positions {
+            *p *= 2.0;
+        }
+        assert!(s.set_collider_mesh(0, &cube));
+        let pose = Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0));
+        let frame = |s: &mut Staging| {
+            s.stage(&FrameData {
+                cloths: &[],
+                collider_poses: &[pose],
+                highlight: None,
+                drag_target: None,
+            })
+        };
+        frame(&mut s);
+        for v in &s.vertices[7..] {
+            assert_eq!((v.pos[2] + 1.0).abs(), 1.0, "{:?}", v.pos);
+            assert_eq!(v.pos[0].abs(), 1.0, "{:?}", v.pos);
+        }
+        let mut fewer = cube.clone();
+        fewer.indices.pop();
+        assert!(!s.set_collider_mesh(0, &fewer));
+        assert!(!s.set_collider_mesh(1, &cube));
+        frame(&mut s);
+        assert!(s.vertices[7..].iter().all(|v| v.pos[0].abs() == 1.0));
     }
 }

@@ -11,6 +11,10 @@ use crate::schema::{CharacterSection, WrapName};
 
 pub(super) fn character(c: &mut Checker<'_>, s: &CharacterSection) -> Option<CharacterSpec> {
     let before = c.errors.len();
+    let model_only = "without `model` (it places a glTF model)";
+    c.unused("character.animation", &s.animation, model_only);
+    c.unused("character.position", &s.position, model_only);
+    c.unused("character.rotation_deg", &s.rotation_deg, model_only);
     let wrap = match s.wrap {
         WrapName::Loop => Wrap::Loop,
         WrapName::Clamp => Wrap::Clamp,

@@ -132,6 +132,20 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// Reads `path` as bytes (a glTF model or buffer); names `what` in errors.
+    pub(super) fn read_bytes(&mut self, key: &str, path: &str, what: &str) -> Option<Vec<u8>> {
+        match self.files.read(path) {
+            Ok(bytes) => {
+                self.read.insert(path.to_owned(), bytes.clone());
+                Some(bytes)
+            }
+            Err(e) => {
+                self.bad(key, format!("cannot read {what} file `{path}`: {e}"));
+                None
+            }
+        }
+    }
+
     /// Reads `path` as text (a garment, BVH or body-table file); names `what` in errors.
     pub(super) fn read_text(&mut self, key: &str, path: &str, what: &str) -> Option<String> {
         match self.files.read(path) {

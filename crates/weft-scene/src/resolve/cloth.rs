@@ -6,11 +6,11 @@ use weft_solver::{
     Settings,
 };
 
-use super::garment::{DEFAULT_SEAM_TIME, garment};
+use super::garment::{DEFAULT_SEAM_TIME, Rig, garment};
 use super::{Checker, valid_name};
 use crate::family::{self, Field, Setting};
 use crate::ranges;
-use crate::scene::{CharacterSpec, ClothSpec};
+use crate::scene::ClothSpec;
 use crate::schema::{ClothSection, OrientationName, PinSpec};
 
 fn named_pin(name: &str) -> Option<Pin> {
@@ -32,8 +32,7 @@ pub(super) fn cloth(
     name: &str,
     s: &ClothSection,
     settings: &Settings,
-    character: Option<&CharacterSpec>,
-    has_character: bool,
+    rig: Rig<'_>,
 ) -> Option<ClothSpec> {
     let k = |field: &str| format!("cloth.{name}.{field}");
     let before = c.errors.len();
@@ -123,15 +122,7 @@ pub(super) fn cloth(
         );
         c.non_negative(&k("seam_time"), seam_time);
         let explicit = s.mass.is_some() || s.density.is_some() || material.is_some();
-        let g = garment(
-            c,
-            name,
-            s,
-            explicit.then_some(mass),
-            center,
-            character,
-            has_character,
-        )?;
+        let g = garment(c, name, s, explicit.then_some(mass), center, rig)?;
         if c.errors.len() > before {
             return None;
         }

@@ -6,11 +6,55 @@ use weft_solver::glam::DVec3;
 use weft_solver::{ClothMesh, Mass};
 
 use super::Checker;
-use crate::scene::{AttachSpec, CharacterSpec};
+use crate::scene::{AttachSpec, CharacterSpec, ModelSpec};
 use crate::schema::ClothSection;
 
 /// Default time over which a garment's seams close (s).
 pub(crate) const DEFAULT_SEAM_TIME: f64 = 0.5;
+
+/// Where a garment's attachments find their bones: the scene's skeleton character or its
+/// glTF model (whichever resolved), and whether the scene has a `[character]` table at all.
+#[derive(Clone, Copy)]
+pub(super) struct Rig<'a> {
+    pub character: Option<&'a CharacterSpec>,
+    pub model: Option<&'a ModelSpec>,
+    pub present: bool,
+}
+
+impl Rig<'_> {
+    /// The bone (skeleton joint index) or glTF joint (node index) named `name`, or why not.
+    fn find(&self, name: &str) -> Option<Result<usize, String>> {
+        if let Some(m) = self.model {
+            let mesh = m.skin.mesh();
+            let found = mesh
+                .joints
+                .iter()
+                .copied()
+                .find(|&j| mesh.names.get(j).is_some_and(|n| n == name));
+            return Some(found.ok_or_else(|| {
+                let some: Vec<&str> = mesh
+                    .joints
+                    .iter()
+                    .filter_map(|&j| mesh.names.get(j).map(String::as_str))
+                    .take(8)
+                    .collect();
+                format!(
+                    "no joint named `{name}` in the skin of `{}` (its joints include {})",
+                    m.path,
+                    some.join(", ")
+                )
+            }));
+        }
+        let ch = self.character?;
+        Some(
+            ch.character
+                .animation()
+                .skeleton()
+                .find(name)
+                .ok_or_else(|| format!("no bone named `{name}` in the character's skeleton")),
+        )
+    }
+}
 
 /// What a garment file gives a cloth.
 pub(super) struct GarmentCloth {
@@ -20,16 +64,14 @@ pub(super) struct GarmentCloth {
 }
 
 /// Reads and builds the garment of cloth `name` (its `garment` key); `mass` overrides the file's area density
-/// when given. `character` is the scene's, if it has one and it resolved; `has_character`
-/// whether the scene has a `[character]` table at all.
+/// when given. `rig` holds the scene's character, if it has one and it resolved.
 pub(super) fn garment(
     c: &mut Checker<'_>,
     name: &str,
     s: &ClothSection,
     mass: Option<Mass>,
     center: DVec3,
-    character: Option<&CharacterSpec>,
-    has_character: bool,
+    rig: Rig<'_>,
 ) -> Option<GarmentCloth> {
     let k = |field: &str| format!("cloth.{name}.{field}");
     let path = s.garment.as_deref()?;
@@ -44,7 +86,7 @@ pub(super) fn garment(
     };
     let mut attachments = Vec::new();
     let list = s.attach.as_deref().unwrap_or_default();
-    if !list.is_empty() && !has_character {
+    if !list.is_empty() && !rig.present {
         c.bad(
             &k("attach"),
             "attachments need a [character] table whose bones they follow",
@@ -52,17 +94,14 @@ pub(super) fn garment(
     }
     for (i, a) in list.iter().enumerate() {
         let ak = |field: &str| format!("cloth.{name}.attach[{i}].{field}");
-        let bone = character.and_then(|ch| {
-            let skeleton = ch.character.animation().skeleton();
-            let found = skeleton.find(&a.bone);
-            if found.is_none() {
-                c.bad(
-                    &ak("bone"),
-                    format!("no bone named `{}` in the character's skeleton", a.bone),
-                );
+        let bone = match rig.find(&a.bone) {
+            Some(Ok(b)) => Some(b),
+            Some(Err(message)) => {
+                c.bad(&ak("bone"), message);
+                None
             }
-            found
-        });
+            None => None,
+        };
         let Some(panel) = g.panel(&a.panel) else {
             let names: Vec<&str> = g.panels.iter().map(|p| p.name.as_str()).collect();
             c.bad(

@@ -7,18 +7,21 @@ mod checker;
 mod cloth;
 mod collider;
 mod garment;
+mod model;
 
 use weft_collide::SelfCollisionParams;
 use weft_solver::{Aero, Forces, Settings, Wind};
 
 use crate::ranges;
-use crate::scene::{CharacterSpec, ClothSpec, ColliderSpec, SelfCollisionSpec};
+use crate::scene::{CharacterSpec, ClothSpec, ColliderSpec, ModelSpec, SelfCollisionSpec};
 use crate::schema::SceneFile;
 
 use character::character;
 pub(crate) use checker::Checker;
 use cloth::cloth;
 use collider::collider;
+use garment::Rig;
+use model::model;
 
 /// Checks every value of `file` and resolves it into solver types.
 pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedParts> {
@@ -85,20 +88,20 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
     if file.cloth.is_empty() {
         c.bad("cloth", "a scene needs at least one [cloth.<name>] table");
     }
-    let character = file.character.as_ref().and_then(|s| character(c, s));
+    let (character, model) = match &file.character {
+        Some(s) if s.model.is_some() => (None, model(c, s)),
+        Some(s) => (character(c, s), None),
+        None => (None, None),
+    };
+    let rig = Rig {
+        character: character.as_ref(),
+        model: model.as_ref(),
+        present: file.character.is_some(),
+    };
     let cloths: Vec<ClothSpec> = file
         .cloth
         .iter()
-        .filter_map(|(name, section)| {
-            cloth(
-                c,
-                name,
-                section,
-                &settings,
-                character.as_ref(),
-                file.character.is_some(),
-            )
-        })
+        .filter_map(|(name, section)| cloth(c, name, section, &settings, rig))
         .collect();
     let colliders: Vec<ColliderSpec> = file
         .collider
@@ -154,6 +157,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
         colliders,
         self_collision,
         character,
+        model,
     })
 }
 
@@ -165,6 +169,7 @@ pub(crate) struct ResolvedParts {
     pub colliders: Vec<ColliderSpec>,
     pub self_collision: Option<SelfCollisionSpec>,
     pub character: Option<CharacterSpec>,
+    pub model: Option<ModelSpec>,
 }
 
 pub(super) fn valid_name(name: &str) -> bool {

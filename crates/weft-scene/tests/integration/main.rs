@@ -7,6 +7,7 @@ mod common;
 mod character;
 mod dressed;
 mod fuzz;
+mod glb_character;
 mod material_key;
 mod self_fold;
 mod shipped_scenes;

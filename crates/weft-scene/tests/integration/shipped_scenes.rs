@@ -24,6 +24,11 @@ const BUILT_TO_EXPLODE: &[&str] = &["explode.toml"];
 /// their fabrics (their `weft check` says so).
 const DRESSED: &[&str] = &["cape.toml", "character.toml", "skirt.toml"];
 
+/// The skinned glTF character's scene, checked by tests/glb_character.rs (contact every
+/// substep over 0.5 s, every method over a few frames): 300 frames of a 5,126-triangle
+/// deforming body under four methods would hold CI up for minutes.
+const SKINNED: &[&str] = &["glb_character.toml"];
+
 #[test]
 fn every_shipped_scene_runs_300_frames_under_every_method() {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(scenes_dir())
@@ -32,7 +37,9 @@ fn every_shipped_scene_runs_300_frames_under_every_method() {
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .filter(|p| {
             let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            !BUILT_TO_EXPLODE.contains(&name) && !DRESSED.contains(&name)
+            !BUILT_TO_EXPLODE.contains(&name)
+                && !DRESSED.contains(&name)
+                && !SKINNED.contains(&name)
         })
         .collect();
     paths.sort();
