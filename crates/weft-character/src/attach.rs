@@ -7,6 +7,59 @@ use crate::animation::BoneState;
 use crate::error::AttachError;
 use crate::transform::Transform;
 
+/// `vertices`' positions (indices into `positions`, world m) carried into a frame by
+/// `to_local`; an index past `positions` or a non-finite position is an error.
+pub(crate) fn local_coordinates(
+    vertices: &[u32],
+    positions: &[DVec3],
+    to_local: impl Fn(DVec3) -> DVec3,
+) -> Result<Vec<DVec3>, AttachError> {
+    vertices
+        .iter()
+        .map(|&v| {
+            let p = positions
+                .get(v as usize)
+                .ok_or(AttachError::VertexOutOfRange {
+                    vertex: v,
+                    len: positions.len(),
+                })?;
+            if !p.is_finite() {
+                return Err(AttachError::NonFinite { vertex: v });
+            }
+            Ok(to_local(*p))
+        })
+        .collect()
+}
+
+/// The solver particles a pin driver moves: for each `(frame, vertices)` set, in order, the
+/// cloth's vertices offset by `first_particle`; a frame index of `frames` or more (a bone or
+/// node the character lacks) is an error.
+pub(crate) fn driven_particles<'a>(
+    first_particle: usize,
+    sets: impl IntoIterator<Item = (usize, &'a [u32])>,
+    frames: usize,
+) -> Result<Vec<u32>, AttachError> {
+    let mut particles = Vec::new();
+    for (frame, vertices) in sets {
+        if frame >= frames {
+            return Err(AttachError::BoneOutOfRange {
+                bone: frame,
+                len: frames,
+            });
+        }
+        for &v in vertices {
+            let i = u32::try_from(first_particle + v as usize).map_err(|_| {
+                AttachError::VertexOutOfRange {
+                    vertex: v,
+                    len: u32::MAX as usize,
+                }
+            })?;
+            particles.push(i);
+        }
+    }
+    Ok(particles)
+}
+
 /// A set of vertices held at fixed coordinates in one bone's frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Attachment {
@@ -25,21 +78,7 @@ impl Attachment {
         bind: &Transform,
     ) -> Result<Self, AttachError> {
         let inverse = bind.inverse();
-        let local = vertices
-            .iter()
-            .map(|&v| {
-                let p = positions
-                    .get(v as usize)
-                    .ok_or(AttachError::VertexOutOfRange {
-                        vertex: v,
-                        len: positions.len(),
-                    })?;
-                if !p.is_finite() {
-                    return Err(AttachError::NonFinite { vertex: v });
-                }
-                Ok(inverse.transform_point(*p))
-            })
-            .collect::<Result<_, _>>()?;
+        let local = local_coordinates(&vertices, positions, |p| inverse.transform_point(p))?;
         Ok(Self {
             bone,
             vertices,

@@ -8,7 +8,7 @@ use glam::DVec3;
 use weft_collide::body::{BodyPart, KinematicBody, RoundCone};
 use weft_solver::PinDriver;
 
-use crate::attach::Attachment;
+use crate::attach::{Attachment, driven_particles};
 use crate::character::Character;
 use crate::error::AttachError;
 use crate::shape::Geometry;
@@ -57,20 +57,11 @@ impl AttachmentDriver {
         first_particle: usize,
         attachments: Vec<Attachment>,
     ) -> Result<Self, AttachError> {
-        let bones = character.animation().skeleton().len();
-        let mut particles = Vec::new();
-        for a in &attachments {
-            a.check_bone(bones)?;
-            for &v in a.vertices() {
-                let i = u32::try_from(first_particle + v as usize).map_err(|_| {
-                    AttachError::VertexOutOfRange {
-                        vertex: v,
-                        len: u32::MAX as usize,
-                    }
-                })?;
-                particles.push(i);
-            }
-        }
+        let particles = driven_particles(
+            first_particle,
+            attachments.iter().map(|a| (a.bone(), a.vertices())),
+            character.animation().skeleton().len(),
+        )?;
         Ok(Self {
             character,
             attachments,

@@ -9,6 +9,7 @@ use weft_solver::PinDriver;
 
 use super::SkinCollider;
 use crate::animation::VELOCITY_STEP;
+use crate::attach::{driven_particles, local_coordinates};
 use crate::error::AttachError;
 
 /// A set of vertices held at fixed coordinates in one glTF node's frame.
@@ -29,21 +30,7 @@ impl JointAttachment {
         bind: &DMat4,
     ) -> Result<Self, AttachError> {
         let inverse = bind.inverse();
-        let local = vertices
-            .iter()
-            .map(|&v| {
-                let p = positions
-                    .get(v as usize)
-                    .ok_or(AttachError::VertexOutOfRange {
-                        vertex: v,
-                        len: positions.len(),
-                    })?;
-                if !p.is_finite() {
-                    return Err(AttachError::NonFinite { vertex: v });
-                }
-                Ok(inverse.transform_point3(*p))
-            })
-            .collect::<Result<_, _>>()?;
+        let local = local_coordinates(&vertices, positions, |p| inverse.transform_point3(p))?;
         Ok(Self {
             node,
             vertices,
@@ -88,25 +75,11 @@ impl SkinAttachmentDriver {
         first_particle: usize,
         attachments: Vec<JointAttachment>,
     ) -> Result<Self, AttachError> {
-        let nodes = skin.mesh().nodes.len();
-        let mut particles = Vec::new();
-        for a in &attachments {
-            if a.node >= nodes {
-                return Err(AttachError::BoneOutOfRange {
-                    bone: a.node,
-                    len: nodes,
-                });
-            }
-            for &v in &a.vertices {
-                let i = u32::try_from(first_particle + v as usize).map_err(|_| {
-                    AttachError::VertexOutOfRange {
-                        vertex: v,
-                        len: u32::MAX as usize,
-                    }
-                })?;
-                particles.push(i);
-            }
-        }
+        let particles = driven_particles(
+            first_particle,
+            attachments.iter().map(|a| (a.node, a.vertices.as_slice())),
+            skin.mesh().nodes.len(),
+        )?;
         Ok(Self {
             skin,
             attachments,
