@@ -2,6 +2,8 @@
 //! every substep.
 #![allow(dead_code)]
 
+#[path = "../../../../weft-collide/tests/integration/common/triangle.rs"]
+pub mod triangle;
 #[path = "../../../../weft-collide/tests/integration/common/watch.rs"]
 pub mod watch;
 

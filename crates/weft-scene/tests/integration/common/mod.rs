@@ -1,7 +1,10 @@
 //! Shared test helpers: the shipped scenes, loaded with overrides and switched to one method,
-//! and a hook that checks the particles after every substep.
+//! a hook that checks the particles after every substep, and a reference closest point on a
+//! triangle.
 #![allow(dead_code)]
 
+#[path = "../../../../weft-collide/tests/integration/common/triangle.rs"]
+pub mod triangle;
 #[path = "../../../../weft-collide/tests/integration/common/watch.rs"]
 pub mod watch;
 
