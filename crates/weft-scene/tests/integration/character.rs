@@ -24,26 +24,6 @@ fn the_character_scenes_load() {
     }
 }
 
-/// The errors (as `line: key: message` lines, sorted) of a character scene `text` whose
-/// files are read from assets/scenes.
-fn errors(text: &str) -> Vec<(Option<usize>, String, String)> {
-    let files = weft_scene::DirFiles(scenes_dir());
-    match weft_scene::from_text("bad.toml", text, &[], &files) {
-        Ok(_) => panic!("accepted:\n{text}"),
-        Err(e) => {
-            e.0.iter()
-                .map(|e| {
-                    let line = match &e.origin {
-                        weft_scene::Origin::File { line, .. } => *line,
-                        weft_scene::Origin::CommandLine => None,
-                    };
-                    (line, e.key.clone(), e.message.clone())
-                })
-                .collect()
-        }
-    }
-}
-
 const GOOD: &str = r#"[character]
 skeleton = "walker"
 
@@ -128,14 +108,7 @@ fn bad_character_and_garment_keys_are_errors_with_file_line_and_key() {
             "attachments need a [character] table",
         ),
     ];
-    for (text, line, key, message) in cases {
-        let errs = errors(&text);
-        assert!(
-            errs.iter()
-                .any(|(l, k, m)| *l == Some(line) && k == key && m.contains(message)),
-            "expected line {line}, key {key}: {message}\ngot {errs:?}\nfor\n{text}"
-        );
-    }
+    common::assert_errors(&cases);
 }
 
 #[test]

@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use crate::common;
 
 use common::triangle::closest;
-use common::{load, run_watched, scenes_dir};
+use common::{errors, load, run_watched, scenes_dir};
 use weft_scene::{Origin, Scene};
 use weft_solver::glam::DVec3;
 
@@ -241,25 +241,6 @@ fn the_glb_scene_gives_the_same_bytes_on_one_and_two_threads() {
     assert_eq!(run(1), run(2));
 }
 
-/// The errors (line, key, message) of a scene `text` read from assets/scenes.
-fn errors(text: &str) -> Vec<(Option<usize>, String, String)> {
-    let files = weft_scene::DirFiles(scenes_dir());
-    match weft_scene::from_text("bad.toml", text, &[], &files) {
-        Ok(_) => panic!("accepted:\n{text}"),
-        Err(e) => {
-            e.0.iter()
-                .map(|e| {
-                    let line = match &e.origin {
-                        Origin::File { line, .. } => *line,
-                        Origin::CommandLine => None,
-                    };
-                    (line, e.key.clone(), e.message.clone())
-                })
-                .collect()
-        }
-    }
-}
-
 const GOOD: &str = r#"[character]
 model = "../characters/bcn_epileptic.glb"
 position = [0.0, 1.025, 0.0]
@@ -351,14 +332,7 @@ fn bad_model_keys_are_errors_with_file_line_and_key() {
             "not used without `model`",
         ),
     ];
-    for (text, line, key, message) in cases {
-        let errs = errors(&text);
-        assert!(
-            errs.iter()
-                .any(|(l, k, m)| *l == Some(line) && k == key && m.contains(message)),
-            "expected line {line}, key {key}: {message}\ngot {errs:?}\nfor\n{text}"
-        );
-    }
+    common::assert_errors(&cases);
 }
 
 /// A skinned glTF without a skin, and an animation the file does not have, name the file.

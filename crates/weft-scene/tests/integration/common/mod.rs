@@ -56,3 +56,36 @@ pub fn run_watched(
         }
     }
 }
+
+/// The errors (line, key, message) of `text` loaded as `bad.toml` beside the shipped scenes;
+/// panics when it loads.
+pub fn errors(text: &str) -> Vec<(Option<usize>, String, String)> {
+    let files = weft_scene::DirFiles(scenes_dir());
+    match weft_scene::from_text("bad.toml", text, &[], &files) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => {
+            e.0.iter()
+                .map(|e| {
+                    let line = match &e.origin {
+                        weft_scene::Origin::File { line, .. } => *line,
+                        weft_scene::Origin::CommandLine => None,
+                    };
+                    (line, e.key.clone(), e.message.clone())
+                })
+                .collect()
+        }
+    }
+}
+
+/// Each case's text fails to load with an error at its line and key whose message holds its
+/// text.
+pub fn assert_errors(cases: &[(String, usize, &str, &str)]) {
+    for (text, line, key, message) in cases {
+        let errs = errors(text);
+        assert!(
+            errs.iter()
+                .any(|(l, k, m)| *l == Some(*line) && k == key && m.contains(message)),
+            "expected line {line}, key {key}: {message}\ngot {errs:?}\nfor\n{text}"
+        );
+    }
+}
