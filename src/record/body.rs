@@ -3,14 +3,12 @@
 //! the cone tangent to both (a cylinder with scaled ends; a sphere alone for a sphere); a
 //! skinned glTF character's body as the triangle list `collider/body/model`.
 
-use foxglove::messages::{
-    CylinderPrimitive, Point3, SceneEntity, SpherePrimitive, TriangleListPrimitive,
-};
+use foxglove::messages::{CylinderPrimitive, SceneEntity, SpherePrimitive};
 use weft_solver::glam::{DQuat, DVec3};
 
 use crate::body::PartPose;
 use crate::body::mesh::tangent_angle;
-use crate::record::messages::{FRAME_ID, GREY, pose, timestamp, vec3};
+use crate::record::messages::{FRAME_ID, GREY, pose, timestamp, triangle_list, vec3};
 
 /// The entities of the body parts `parts` at time `time` (s).
 pub fn entities(time: f64, parts: &[(String, PartPose)]) -> Vec<SceneEntity> {
@@ -64,20 +62,12 @@ pub fn model_entity(time: f64, vertices: &[DVec3], triangles: &[[u32; 3]]) -> Sc
         timestamp: Some(timestamp(time)),
         frame_id: FRAME_ID.into(),
         id: format!("collider/{}", crate::body::MODEL_NAME),
-        triangles: vec![TriangleListPrimitive {
-            pose: Some(pose(DVec3::ZERO, DQuat::IDENTITY)),
-            points: vertices
-                .iter()
-                .map(|p| Point3 {
-                    x: p.x,
-                    y: p.y,
-                    z: p.z,
-                })
-                .collect(),
-            color: Some(GREY),
-            colors: vec![],
-            indices: triangles.iter().flatten().copied().collect(),
-        }],
+        triangles: vec![triangle_list(
+            pose(DVec3::ZERO, DQuat::IDENTITY),
+            vertices,
+            triangles,
+            Some(GREY),
+        )],
         ..SceneEntity::default()
     }
 }

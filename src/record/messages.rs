@@ -68,6 +68,29 @@ pub fn point_cloud(time: f64, positions: &[DVec3]) -> PointCloud {
     }
 }
 
+/// `triangles` (indices into `vertices`, m) as a Foxglove indexed triangle list at `pose`.
+pub fn triangle_list(
+    pose: Pose,
+    vertices: &[DVec3],
+    triangles: &[[u32; 3]],
+    color: Option<Color>,
+) -> TriangleListPrimitive {
+    TriangleListPrimitive {
+        pose: Some(pose),
+        points: vertices
+            .iter()
+            .map(|p| Point3 {
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            })
+            .collect(),
+        color,
+        colors: vec![],
+        indices: triangles.iter().flatten().copied().collect(),
+    }
+}
+
 /// The cloth surface as an indexed triangle list.
 pub fn cloth_mesh(
     time: f64,
@@ -76,20 +99,12 @@ pub fn cloth_mesh(
     triangles: &[[u32; 3]],
     color: Color,
 ) -> SceneUpdate {
-    let tri = TriangleListPrimitive {
-        pose: Some(pose(DVec3::ZERO, DQuat::IDENTITY)),
-        points: positions
-            .iter()
-            .map(|p| Point3 {
-                x: p.x,
-                y: p.y,
-                z: p.z,
-            })
-            .collect(),
-        color: Some(color),
-        colors: vec![],
-        indices: triangles.iter().flatten().copied().collect(),
-    };
+    let tri = triangle_list(
+        pose(DVec3::ZERO, DQuat::IDENTITY),
+        positions,
+        triangles,
+        Some(color),
+    );
     SceneUpdate {
         deletions: vec![],
         entities: vec![SceneEntity {
@@ -176,21 +191,10 @@ fn add_shape(e: &mut SceneEntity, shape: &ShapeDesc, position: DVec3, rotation: 
                 color,
             });
         }
-        ShapeDesc::TriMesh(mesh) => e.triangles.push(TriangleListPrimitive {
-            pose: Some(p),
-            points: mesh
-                .vertices
-                .iter()
-                .map(|v| Point3 {
-                    x: v.x,
-                    y: v.y,
-                    z: v.z,
-                })
-                .collect(),
-            color,
-            colors: vec![],
-            indices: mesh.triangles.iter().flatten().copied().collect(),
-        }),
+        ShapeDesc::TriMesh(mesh) => {
+            e.triangles
+                .push(triangle_list(p, &mesh.vertices, &mesh.triangles, color))
+        }
         ShapeDesc::Compound(parts) => {
             for part in parts {
                 add_shape(
