@@ -196,14 +196,17 @@ impl Domain {
     }
 }
 
-/// Which optional terms a sweep evaluates; both off gives the same bits as both on with
-/// γ = 0 and α̃ = 0.
+/// Which optional terms a sweep evaluates; each setting gives the same bits as the general
+/// form (damped, multipliers, any k) with the coefficients it was derived from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Mode {
     /// Some group has XPBD damping (γ > 0): read previous positions.
     pub damped: bool,
     /// Some group has compliance (α̃ > 0): keep multipliers.
     pub lambda: bool,
+    /// Every group has k = 1 (XPBD with none disabled): the kernel negates C instead of
+    /// multiplying it by −k.
+    pub unit_k: bool,
 }
 
 /// How a fused substep ends the previous one: 1/h and the damping factor, if any.
