@@ -77,9 +77,19 @@ pub(crate) struct Ends<const L: usize> {
 /// Every step is a straight loop over lanes with selects instead of branches, so that it
 /// compiles to vector instructions; without damping the two divisions (by |p − q| and by the
 /// denominator) are folded into one, s = num / (denom |p − q|), Δp = w_p s (p − q).
+///
+/// Two terms can be left out where they cannot change a bit: without `LAMBDA` the caller
+/// passes λ = +0 in every lane and every α̃ is finite, so α̃ λ = +0 and −k C − (+0) = −k C for
+/// every value; with `UNIT_K` every lane has k = 1 (XPBD), and −1 · C = −C exactly. The
+/// general form (`LAMBDA`, not `UNIT_K`) is right for any coefficients.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn project<const L: usize, const DAMPED: bool>(
+pub(crate) fn project<
+    const L: usize,
+    const DAMPED: bool,
+    const LAMBDA: bool,
+    const UNIT_K: bool,
+>(
     x: &mut Ends<L>,
     prev: &Ends<L>,
     wp: &[f64; L],
@@ -111,8 +121,8 @@ pub(crate) fn project<const L: usize, const DAMPED: bool>(
             let inv = 1.0 / len[l];
             let c = len[l] - rest[l];
             let denom = (1.0 + coef.gamma[l]) * (wp[l] + wq[l]) + coef.alpha[l];
-            let num =
-                -coef.k[l] * c - coef.alpha[l] * lambda[l] - coef.gamma[l] * (grad_dx[l] * inv);
+            let num = stiffness_term::<LAMBDA, UNIT_K>(c, coef.k[l], coef.alpha[l], lambda[l])
+                - coef.gamma[l] * (grad_dx[l] * inv);
             let ok = (len[l] >= 1e-9) & (denom > f64::MIN_POSITIVE);
             let dl = if ok { num / denom } else { 0.0 };
             lambda[l] += dl;
@@ -122,7 +132,7 @@ pub(crate) fn project<const L: usize, const DAMPED: bool>(
         for l in 0..L {
             let c = len[l] - rest[l];
             let denom = (wp[l] + wq[l]) + coef.alpha[l];
-            let num = -coef.k[l] * c - coef.alpha[l] * lambda[l];
+            let num = stiffness_term::<LAMBDA, UNIT_K>(c, coef.k[l], coef.alpha[l], lambda[l]);
             let ok = (len[l] >= 1e-9) & (denom > f64::MIN_POSITIVE);
             let s = num / (denom * len[l]);
             scale[l] = if ok { s } else { 0.0 };
@@ -135,6 +145,19 @@ pub(crate) fn project<const L: usize, const DAMPED: bool>(
             x.q[a][l] -= d[a][l] * (wq[l] * scale[l]);
         }
     }
+}
+
+/// −k C − α̃ λ, the numerator of Δλ before damping, with the terms [`project`]'s `LAMBDA`
+/// and `UNIT_K` leave out.
+#[inline(always)]
+fn stiffness_term<const LAMBDA: bool, const UNIT_K: bool>(
+    c: f64,
+    k: f64,
+    alpha: f64,
+    lambda: f64,
+) -> f64 {
+    let kc = if UNIT_K { -c } else { -k * c };
+    if LAMBDA { kc - alpha * lambda } else { kc }
 }
 
 #[cfg(test)]
@@ -158,7 +181,7 @@ mod tests {
             gamma: 0.0,
         });
         let mut lambda = [0.0];
-        project::<1, false>(&mut x, &prev, &[1.0], &[1.0], &[1.0], &coef, &mut lambda);
+        project::<1, false, true, false>(&mut x, &prev, &[1.0], &[1.0], &[1.0], &coef, &mut lambda);
         assert!((x.p[0][0] - 0.5).abs() < 1e-15);
         assert!((x.q[0][0] - 1.5).abs() < 1e-15);
         // λ = −C/(w_p + w_q) = −1/2.
@@ -176,7 +199,7 @@ mod tests {
             gamma: 0.0,
         });
         let mut lambda = [0.0];
-        project::<1, false>(&mut x, &prev, &[1.0], &[0.0], &[1.0], &coef, &mut lambda);
+        project::<1, false, true, false>(&mut x, &prev, &[1.0], &[0.0], &[1.0], &coef, &mut lambda);
         assert!((x.p[1][0] - 0.5).abs() < 1e-15);
         assert_eq!(x.q[1][0], 2.0);
     }
@@ -205,12 +228,12 @@ mod tests {
         let mut wide = ends(p, q);
         let mut lambda: [f64; LANES] = std::array::from_fn(|_| rnd());
         let lambda0 = lambda;
-        project::<LANES, true>(&mut wide, &prev, &wp, &wq, &rest, &coefs, &mut lambda);
+        project::<LANES, true, true, false>(&mut wide, &prev, &wp, &wq, &rest, &coefs, &mut lambda);
         for l in 0..LANES {
             let mut one = ends([p[l]], [q[l]]);
             let prev1 = ends([q[l]], [p[l]]);
             let mut lam = [lambda0[l]];
-            project::<1, true>(
+            project::<1, true, true, false>(
                 &mut one,
                 &prev1,
                 &[wp[l]],
@@ -224,6 +247,79 @@ mod tests {
                 assert_eq!(one.q[a][0].to_bits(), wide.q[a][l].to_bits());
             }
             assert_eq!(lam[0].to_bits(), lambda[l].to_bits());
+        }
+    }
+
+    /// A [`project`] instance over [`LANES`] lanes.
+    type Kernel = fn(
+        &mut Ends<LANES>,
+        &Ends<LANES>,
+        &[f64; LANES],
+        &[f64; LANES],
+        &[f64; LANES],
+        &Coefs<LANES>,
+        &mut [f64; LANES],
+    );
+
+    /// Runs every specialised form on the same random lanes as the general one, with λ = +0
+    /// (what a sweep without multipliers passes) and k = 1 (XPBD), and compares bits.
+    #[test]
+    fn the_forms_without_lambda_or_k_give_the_general_bits() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for round in 0..64 {
+            let p: [[f64; 3]; LANES] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
+            let q: [[f64; 3]; LANES] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
+            let prev = ends(q, p);
+            let wp: [f64; LANES] = std::array::from_fn(|l| if l == 2 { 0.0 } else { rnd() + 0.5 });
+            let wq: [f64; LANES] = std::array::from_fn(|l| if l == 5 { 0.0 } else { rnd() + 0.5 });
+            let rest: [f64; LANES] = std::array::from_fn(|_| rnd() + 0.5);
+            // Half the rounds stiff (α̃ = 0, as a sweep without multipliers has), half not.
+            let coef: [Coef; LANES] = std::array::from_fn(|l| Coef {
+                k: 1.0,
+                alpha: if round % 2 == 0 {
+                    0.0
+                } else {
+                    (rnd() + 0.5) * l as f64
+                },
+                gamma: if round % 4 < 2 { 0.0 } else { rnd().abs() },
+            });
+            let coefs = Coefs::from_fn(|l| coef[l]);
+            let run = |f: Kernel| {
+                let mut x = ends(p, q);
+                let mut lambda = [0.0; LANES];
+                f(&mut x, &prev, &wp, &wq, &rest, &coefs, &mut lambda);
+                let bits = |v: &[[f64; LANES]; 3]| v.map(|a| a.map(f64::to_bits));
+                (bits(&x.p), bits(&x.q), lambda.map(f64::to_bits))
+            };
+            let general = run(project::<LANES, true, true, false>);
+            assert_eq!(
+                run(project::<LANES, true, false, false>),
+                general,
+                "round {round}"
+            );
+            assert_eq!(
+                run(project::<LANES, true, true, true>),
+                general,
+                "round {round}"
+            );
+            assert_eq!(
+                run(project::<LANES, true, false, true>),
+                general,
+                "round {round}"
+            );
+            if round % 4 < 2 {
+                // γ = 0: the undamped forms too.
+                let undamped = run(project::<LANES, false, true, false>);
+                assert_eq!(run(project::<LANES, false, false, false>), undamped);
+                assert_eq!(run(project::<LANES, false, true, true>), undamped);
+                assert_eq!(run(project::<LANES, false, false, true>), undamped);
+            }
         }
     }
 }

@@ -196,14 +196,17 @@ impl Domain {
     }
 }
 
-/// Which optional terms a sweep evaluates; both off gives the same bits as both on with
-/// γ = 0 and α̃ = 0.
+/// Which optional terms a sweep evaluates; each setting gives the same bits as the general
+/// form (damped, multipliers, any k) with the coefficients it was derived from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Mode {
     /// Some group has XPBD damping (γ > 0): read previous positions.
     pub damped: bool,
     /// Some group has compliance (α̃ > 0): keep multipliers.
     pub lambda: bool,
+    /// Every group has k = 1 (XPBD with none disabled): the kernel negates C instead of
+    /// multiplying it by −k.
+    pub unit_k: bool,
 }
 
 /// How a fused substep ends the previous one: 1/h and the damping factor, if any.
@@ -224,8 +227,10 @@ fn end_velocities(x: &[f64], prev: &[f64], v: &mut [f64], w: &[f64], finish: Fin
         v[i] = (x[i] - prev[i]) * finish.inv_h;
     }
     if let Some(keep) = finish.keep {
+        // v · 1 = v exactly: a factor chosen per particle keeps the store unconditional, where
+        // a kept value became a masked store (microcoded on AMD).
         for i in 0..w.len() {
-            v[i] = if w[i] > 0.0 { v[i] * keep } else { v[i] };
+            v[i] *= if w[i] > 0.0 { keep } else { 1.0 };
         }
     }
 }
@@ -276,14 +281,17 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
         if let Some(finish) = finish {
             end_velocities(x, prev, v, w, finish);
         }
+        // Each value read once into a local: reading `v[i]` again in the selects made the
+        // compiler load it with a masked load.
         for i in 0..w.len() {
-            prev[i] = x[i];
-            let acc = g + drag * (wv - v[i]);
-            let vi = v[i] + acc * h;
-            let xi = x[i] + vi * h;
+            let (x0, v0) = (x[i], v[i]);
+            prev[i] = x0;
+            let acc = g + drag * (wv - v0);
+            let vi = v0 + acc * h;
+            let xi = x0 + vi * h;
             let free = w[i] > 0.0;
-            v[i] = if free { vi } else { v[i] };
-            x[i] = if free { xi } else { x[i] };
+            v[i] = if free { vi } else { v0 };
+            x[i] = if free { xi } else { x0 };
         }
     }
 }

@@ -80,6 +80,8 @@ pub(crate) struct Domains {
     coef: Vec<Coef>,
     /// Which optional terms the coefficients need.
     mode: Mode,
+    /// Whether each parameter group has a constraint here.
+    used: Vec<bool>,
 }
 
 impl Domains {
@@ -121,12 +123,21 @@ impl Domains {
         for (dom, cons) in list.iter_mut().zip(interior) {
             dom.order(cons);
         }
+        let mut used = Vec::new();
+        for &g in &block.group {
+            let g = g as usize;
+            if used.len() <= g {
+                used.resize(g + 1, false);
+            }
+            used[g] = true;
+        }
         Self {
             size,
             list,
             links,
             coef: Vec::new(),
             mode: Mode::default(),
+            used,
         }
     }
 
@@ -204,6 +215,8 @@ impl Domains {
             }
             self.coef.push(c);
         }
+        let used = |g: usize| self.used.get(g).copied().unwrap_or(false);
+        self.mode.unit_k = (self.coef.iter().enumerate()).all(|(g, c)| c.k == 1.0 || !used(g));
     }
 
     /// Projects every domain and link once; coefficients from [`Self::prepare`].

@@ -50,16 +50,20 @@ fn sweep_scalar(dom: &mut Domain, coef: &[Coef], mode: Mode) {
 /// The sweep with its optional terms chosen at compile time.
 #[inline(always)]
 fn sweep_modes<const W: usize>(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    match (mode.damped, mode.lambda) {
-        (false, false) => sweep_with::<false, false, W>(dom, coef),
-        (false, true) => sweep_with::<false, true, W>(dom, coef),
-        (true, false) => sweep_with::<true, false, W>(dom, coef),
-        (true, true) => sweep_with::<true, true, W>(dom, coef),
+    match (mode.damped, mode.lambda, mode.unit_k) {
+        (false, false, false) => sweep_with::<false, false, false, W>(dom, coef),
+        (false, false, true) => sweep_with::<false, false, true, W>(dom, coef),
+        (false, true, false) => sweep_with::<false, true, false, W>(dom, coef),
+        (false, true, true) => sweep_with::<false, true, true, W>(dom, coef),
+        (true, false, false) => sweep_with::<true, false, false, W>(dom, coef),
+        (true, false, true) => sweep_with::<true, false, true, W>(dom, coef),
+        (true, true, false) => sweep_with::<true, true, false, W>(dom, coef),
+        (true, true, true) => sweep_with::<true, true, true, W>(dom, coef),
     }
 }
 
 #[inline(always)]
-fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
+fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const W: usize>(
     dom: &mut Domain,
     coef: &[Coef],
 ) {
@@ -75,7 +79,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
     } = dom;
     for (c, (chunk_range, tail)) in plan.iter().enumerate() {
         for chunk in &chunks[chunk_range.clone()] {
-            project_chunk::<DAMPED, LAMBDA, W>(chunk, pairs, x, prev, w, coef);
+            project_chunk::<DAMPED, LAMBDA, UNIT_K, W>(chunk, pairs, x, prev, w, coef);
         }
         for k in *tail..colours[c].end {
             let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
@@ -99,7 +103,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
 }
 
 #[inline(always)]
-fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
+fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const W: usize>(
     chunk: &Chunk,
     pairs: &mut Pairs,
     x: &mut [Vec<f64>; 3],
@@ -112,14 +116,22 @@ fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
     // masked loads, which cannot forward from the stores).
     match chunk.layout {
         Layout::Contiguous => {
-            project_laid_out::<DAMPED, LAMBDA, 0, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 0, W>(chunk, pairs, x, prev, w, coef)
         }
-        Layout::Paired => project_laid_out::<DAMPED, LAMBDA, 1, W>(chunk, pairs, x, prev, w, coef),
-        Layout::Quad => project_laid_out::<DAMPED, LAMBDA, 2, W>(chunk, pairs, x, prev, w, coef),
-        Layout::Strided => project_laid_out::<DAMPED, LAMBDA, 3, W>(chunk, pairs, x, prev, w, coef),
-        Layout::Spaced => project_laid_out::<DAMPED, LAMBDA, 4, W>(chunk, pairs, x, prev, w, coef),
+        Layout::Paired => {
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 1, W>(chunk, pairs, x, prev, w, coef)
+        }
+        Layout::Quad => {
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 2, W>(chunk, pairs, x, prev, w, coef)
+        }
+        Layout::Strided => {
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 3, W>(chunk, pairs, x, prev, w, coef)
+        }
+        Layout::Spaced => {
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 4, W>(chunk, pairs, x, prev, w, coef)
+        }
         Layout::Gathered => {
-            project_laid_out::<DAMPED, LAMBDA, 5, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 5, W>(chunk, pairs, x, prev, w, coef)
         }
     }
 }
@@ -128,7 +140,13 @@ fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const W: usize>(
 /// straight from the layout, projected and stored before the next: the lanes of a chunk share
 /// no particle, so the parts' order changes no bit.
 #[inline(always)]
-fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8, const W: usize>(
+fn project_laid_out<
+    const DAMPED: bool,
+    const LAMBDA: bool,
+    const UNIT_K: bool,
+    const LAYOUT: u8,
+    const W: usize,
+>(
     chunk: &Chunk,
     pairs: &mut Pairs,
     x: &mut [Vec<f64>; 3],
@@ -178,7 +196,7 @@ fn project_laid_out<const DAMPED: bool, const LAMBDA: bool, const LAYOUT: u8, co
         if LAMBDA {
             lambda.copy_from_slice(&pairs.lambda[r.clone()]);
         }
-        lanes::project::<W, DAMPED>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
+        lanes::project::<W, DAMPED, LAMBDA, UNIT_K>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
         if LAMBDA {
             pairs.lambda[r].copy_from_slice(&lambda);
         }
@@ -227,7 +245,7 @@ pub(super) fn project_one<const DAMPED: bool>(
         q: q.prev.map(|v| [v]),
     };
     let mut l = [*lambda];
-    lanes::project::<1, DAMPED>(
+    lanes::project::<1, DAMPED, true, false>(
         &mut e,
         &pr,
         &[p.w],

@@ -156,3 +156,51 @@ fn chunk_layouts_match_their_lanes_and_grids_mostly_load_with_unit_stride() {
         block.len()
     );
 }
+
+#[test]
+fn the_unit_k_form_runs_only_when_every_constrained_group_has_k_one() {
+    let (block, n) = block(12, false);
+    let mut domains = Domains::new(&block, n, 64, SimdPath::Scalar);
+    let params = |edit: &dyn Fn(Family, &mut FamilyParams)| -> Vec<FamilyParams> {
+        Family::ALL
+            .map(|f| {
+                let mut p = FamilyParams::default_for(f);
+                p.enabled |= f == Family::BendDistance;
+                edit(f, &mut p);
+                p
+            })
+            .to_vec()
+    };
+    let xpbd = Rule::Xpbd { h: 1.0 / 600.0 };
+    let cases: [(&str, Vec<FamilyParams>, Rule, bool); 5] = [
+        ("XPBD", params(&|_, _| {}), xpbd, true),
+        (
+            "PBD, every k = 1",
+            params(&|_, p| p.pbd_stiffness = 1.0),
+            Rule::Pbd,
+            true,
+        ),
+        (
+            "PBD, bending k = 0.5",
+            params(&|f, p| p.pbd_stiffness = if f == Family::BendDistance { 0.5 } else { 1.0 }),
+            Rule::Pbd,
+            false,
+        ),
+        (
+            "PBD, k = 0.5 for tethers, which have no constraint here",
+            params(&|f, p| p.pbd_stiffness = if f == Family::Tether { 0.5 } else { 1.0 }),
+            Rule::Pbd,
+            true,
+        ),
+        (
+            "XPBD with bending disabled (k = 0) over its constraints",
+            params(&|f, p| p.enabled &= f != Family::BendDistance),
+            xpbd,
+            false,
+        ),
+    ];
+    for (what, params, rule, unit_k) in cases {
+        domains.prepare(&params, rule);
+        assert_eq!(domains.mode().unit_k, unit_k, "{what}");
+    }
+}
