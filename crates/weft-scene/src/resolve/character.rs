@@ -2,12 +2,12 @@
 //! table (built-in or a file), checked and built into a [`CharacterSpec`].
 
 use weft_character::{
-    Animation, BodyTable, BvhOptions, Character, Wrap, parse_bvh, walk::walk_clip, walker_skeleton,
+    Animation, BodyTable, BvhOptions, Character, parse_bvh, walk::walk_clip, walker_skeleton,
 };
 
 use super::Checker;
 use crate::scene::CharacterSpec;
-use crate::schema::{CharacterSection, WrapName};
+use crate::schema::CharacterSection;
 
 pub(super) fn character(c: &mut Checker<'_>, s: &CharacterSection) -> Option<CharacterSpec> {
     let before = c.errors.len();
@@ -15,18 +15,8 @@ pub(super) fn character(c: &mut Checker<'_>, s: &CharacterSection) -> Option<Cha
     c.unused("character.animation", &s.animation, model_only);
     c.unused("character.position", &s.position, model_only);
     c.unused("character.rotation_deg", &s.rotation_deg, model_only);
-    let wrap = match s.wrap {
-        WrapName::Loop => Wrap::Loop,
-        WrapName::Clamp => Wrap::Clamp,
-    };
-    c.non_negative("character.static_friction", s.static_friction);
-    c.non_negative("character.dynamic_friction", s.dynamic_friction);
-    if s.dynamic_friction > s.static_friction {
-        c.bad(
-            "character.dynamic_friction",
-            "must not exceed static_friction",
-        );
-    }
+    let wrap = s.wrap.into();
+    c.friction("character", s.static_friction, s.dynamic_friction);
     let animation = if s.skeleton == "walker" {
         c.unused("character.scale", &s.scale, "by the built-in walker");
         let skeleton = walker_skeleton();

@@ -93,6 +93,19 @@ impl<'a> Checker<'a> {
         self.check(key, v, v >= 0.0, "finite and >= 0")
     }
 
+    /// Coulomb friction of `table` (`<table>.static_friction`, `.dynamic_friction`): both
+    /// finite and >= 0, dynamic no more than static.
+    pub(super) fn friction(&mut self, table: &str, static_friction: f64, dynamic_friction: f64) {
+        self.non_negative(&format!("{table}.static_friction"), static_friction);
+        self.non_negative(&format!("{table}.dynamic_friction"), dynamic_friction);
+        if dynamic_friction > static_friction {
+            self.bad(
+                &format!("{table}.dynamic_friction"),
+                "must not exceed static_friction",
+            );
+        }
+    }
+
     pub(super) fn positive(&mut self, key: &str, v: f64) -> bool {
         self.check(key, v, v > 0.0, "finite and > 0")
     }

@@ -178,11 +178,7 @@ pub(super) fn collider(c: &mut Checker<'_>, i: usize, s: &ColliderSection) -> Op
     };
     let position = c.vector(&k("position"), s.position);
     let rotation = c.rotation(&k("rotation_deg"), s.rotation_deg);
-    c.non_negative(&k("static_friction"), s.static_friction);
-    c.non_negative(&k("dynamic_friction"), s.dynamic_friction);
-    if s.dynamic_friction > s.static_friction {
-        c.bad(&k("dynamic_friction"), "must not exceed static_friction");
-    }
+    c.friction(&key, s.static_friction, s.dynamic_friction);
     let motion = c.motion(&k("motion"), &s.motion);
     let shape = spec?;
     (c.errors.len() == before).then_some(ColliderSpec {

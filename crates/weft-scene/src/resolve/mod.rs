@@ -122,14 +122,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
                 );
             }
         }
-        c.non_negative("self_collision.static_friction", s.static_friction);
-        c.non_negative("self_collision.dynamic_friction", s.dynamic_friction);
-        if s.dynamic_friction > s.static_friction {
-            c.bad(
-                "self_collision.dynamic_friction",
-                "must not exceed static_friction",
-            );
-        }
+        c.friction("self_collision", s.static_friction, s.dynamic_friction);
         // The ranges are weft-collide's, the one authority on them.
         c.rule(
             "self_collision.max_displacement",

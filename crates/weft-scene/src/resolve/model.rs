@@ -5,7 +5,6 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use weft_character::Wrap;
 use weft_character::skin::{
     AnimationChoice, BufferSource, SkinCollider, SkinnedMesh, parse_gltf_slice,
 };
@@ -15,7 +14,7 @@ use super::Checker;
 use super::checker::show;
 use crate::ranges;
 use crate::scene::ModelSpec;
-use crate::schema::{AnimationKey, CharacterSection, WrapName};
+use crate::schema::{AnimationKey, CharacterSection};
 
 /// Checks the model keys of `s` (which has a `model`) and reads the model.
 pub(super) fn model(c: &mut Checker<'_>, s: &CharacterSection) -> Option<ModelSpec> {
@@ -33,14 +32,7 @@ pub(super) fn model(c: &mut Checker<'_>, s: &CharacterSection) -> Option<ModelSp
             "not used with `model` (the model's mesh is the body)",
         );
     }
-    c.non_negative("character.static_friction", s.static_friction);
-    c.non_negative("character.dynamic_friction", s.dynamic_friction);
-    if s.dynamic_friction > s.static_friction {
-        c.bad(
-            "character.dynamic_friction",
-            "must not exceed static_friction",
-        );
-    }
+    c.friction("character", s.static_friction, s.dynamic_friction);
     let scale = s.scale.unwrap_or(1.0);
     c.positive("character.scale", scale);
     let rotation = c.rotation("character.rotation_deg", s.rotation_deg.unwrap_or_default());
@@ -62,11 +54,7 @@ pub(super) fn model(c: &mut Checker<'_>, s: &CharacterSection) -> Option<ModelSp
         return None;
     }
     let placement = DMat4::from_scale_rotation_translation(DVec3::splat(scale), rotation, position);
-    let wrap = match s.wrap {
-        WrapName::Loop => Wrap::Loop,
-        WrapName::Clamp => Wrap::Clamp,
-    };
-    let skin = SkinCollider::placed(mesh, placement, wrap);
+    let skin = SkinCollider::placed(mesh, placement, s.wrap.into());
     // The placed body at the first and a few later instants must lie in the world's range
     // (a wrong `scale` would put it kilometres away).
     let duration = skin.mesh().duration();

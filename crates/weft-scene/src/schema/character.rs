@@ -15,6 +15,15 @@ pub enum WrapName {
     Clamp,
 }
 
+impl From<WrapName> for weft_character::Wrap {
+    fn from(w: WrapName) -> Self {
+        match w {
+            WrapName::Loop => weft_character::Wrap::Loop,
+            WrapName::Clamp => weft_character::Wrap::Clamp,
+        }
+    }
+}
+
 /// `[character]`: the skeleton and clip (the built-in `walker` or a BVH file), the body table
 /// (built-in `walker` or `cmu`, or a file) and how the clip plays; or, with `model`, a skinned
 /// glTF/GLB character whose deforming mesh is the body.

@@ -6,6 +6,7 @@ mod common;
 
 mod character;
 mod dressed;
+mod friction;
 mod fuzz;
 mod glb_character;
 mod material_key;
