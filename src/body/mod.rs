@@ -102,14 +102,13 @@ pub fn parts(sim: &Simulation) -> Vec<(String, PartPose)> {
 pub const MODEL_NAME: &str = "body/model";
 
 /// The scene's skinned glTF character (`[character] model`) as the collision world meets it
-/// now: its vertices skinned and placed at the solvers' time, and its triangles. `None` for a
-/// scene without one.
-pub fn model_mesh(sim: &Simulation) -> Option<(Vec<DVec3>, &[[u32; 3]])> {
-    let (m, group) = (sim.scene.model.as_ref()?, sim.groups.first()?);
-    Some((
-        m.skin.vertices(group.solver.time()),
-        &m.skin.mesh().triangles,
-    ))
+/// now: the deforming collider's vertices (skinned and placed at the end of the last substep,
+/// the solvers' time), and its triangles. `None` for a scene without one.
+pub fn model_mesh(sim: &Simulation) -> Option<(&[DVec3], &[[u32; 3]])> {
+    let m = sim.scene.model.as_ref()?;
+    let world = sim.groups.first()?.world.as_ref()?;
+    let body = world.colliders().iter().find(|c| c.is_deforming())?;
+    Some((body.mesh_vertices()?, &m.skin.mesh().triangles))
 }
 
 #[cfg(test)]

@@ -240,7 +240,7 @@ impl Recorder {
                 && let Some((vertices, triangles)) = crate::body::model_mesh(sim)
             {
                 m.entities
-                    .push(body::model_entity(time, &vertices, triangles));
+                    .push(body::model_entity(time, vertices, triangles));
             }
             self.put(ch, time, &m)?;
         }
