@@ -13,8 +13,8 @@ Usage: read_collider_state.py LOG.mcap
   motion prescribes: static, linear x0 + v t, or oscillating x0 + A sin(2 pi f t) (t is the
   message's log time), to 1e-9 m. Colliders whose motion is a rotation are checked for their
   unit quaternion only.
-* a scene with a `[character]` also lists its body parts (`body/<i>`, after the colliders), the
-  same ones every frame; each part's pose agrees with its own parameters as documented:
+* a scene with a skeleton `[character]` also lists its body parts (`body/<i>`, after the
+  colliders), the same ones every frame (a glTF `model` body is a mesh, not listed); each part's pose agrees with its own parameters as documented:
   `position` is halfway between the end points `a` and `b` of a round cone, `rotation` turns
   (0, +-half_height, 0) onto `b` and `a`, and `half_height` is half their distance (1e-9 m).
 """
@@ -102,6 +102,9 @@ def main(log_path: str) -> int:
     colliders = scene.get("collider", [])
     character = "character" in scene
     assert colliders or character, "the scene has no [[collider]] and no [character]"
+    # A skeleton's body is analytic (round cones, listed here); a glTF model's skinned mesh is
+    # not (it is on /colliders only).
+    skeletal = character and "model" not in scene["character"]
     parts = None
     assert [(t, v["frame"]) for t, v in states] == stats, "one message per /stats frame"
     worst = 0.0
@@ -111,7 +114,7 @@ def main(log_path: str) -> int:
         body = [c for c in value["colliders"] if c["name"].startswith("body/")]
         by_name = {c["name"]: c for c in value["colliders"] if c not in body}
         assert len(by_name) == len(colliders), sorted(by_name)
-        assert bool(body) == character, "body parts listed exactly when there is a character"
+        assert bool(body) == skeletal, "body parts listed exactly when there is a skeleton body"
         names = [c["name"] for c in body]
         assert parts is None or names == parts, "the same body parts every frame"
         parts = names
