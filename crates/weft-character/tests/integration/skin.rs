@@ -68,18 +68,24 @@ fn skinned_vertices_at_key_frames_match_the_hand_computation() {
     assert!((m.skin(1.0)[9] - DVec3::new(-1.0, 1.5, 0.0)).length() < 1e-9);
 }
 
-#[test]
-fn broken_gltf_files_are_errors_not_panics() {
-    let text = std::fs::read_to_string(fixture()).expect("fixture");
-    let no_skin = text.replacen("\"skin\" : 0,", "", 1);
-    let (doc, buffers) = parse_gltf_slice(no_skin.as_bytes()).expect("still glTF");
-    let data: Vec<Vec<u8>> = buffers
+/// A glTF text whose buffers are all embedded data URIs, parsed: its document and buffers.
+fn embedded(text: &str) -> (gltf::Document, Vec<Vec<u8>>) {
+    let (doc, buffers) = parse_gltf_slice(text.as_bytes()).expect("still glTF");
+    let data = buffers
         .into_iter()
         .map(|b| match b {
             weft_character::skin::BufferSource::Data(d) => d,
             other => panic!("{other:?}"),
         })
         .collect();
+    (doc, data)
+}
+
+#[test]
+fn broken_gltf_files_are_errors_not_panics() {
+    let text = std::fs::read_to_string(fixture()).expect("fixture");
+    let no_skin = text.replacen("\"skin\" : 0,", "", 1);
+    let (doc, data) = embedded(&no_skin);
     assert_eq!(
         SkinnedMesh::from_document(&doc, &data).err(),
         Some(SkinError::NoSkinnedMesh)
@@ -126,14 +132,7 @@ fn with_nan(buffer: usize, at: usize) -> Result<SkinnedMesh, SkinError> {
         engine.encode(&bytes),
         &text[end..]
     );
-    let (doc, buffers) = parse_gltf_slice(broken.as_bytes()).expect("still glTF");
-    let data: Vec<Vec<u8>> = buffers
-        .into_iter()
-        .map(|b| match b {
-            weft_character::skin::BufferSource::Data(d) => d,
-            other => panic!("{other:?}"),
-        })
-        .collect();
+    let (doc, data) = embedded(&broken);
     SkinnedMesh::from_document(&doc, &data)
 }
 
