@@ -6,6 +6,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Shape;
+use super::parts;
 use crate::coloring::color;
 use crate::params::FamilyParams;
 
@@ -56,6 +57,12 @@ pub(crate) struct Block<const N: usize, S> {
     pub colors: Vec<Range<usize>>,
     /// Insertion index of each constraint (before sorting by colour).
     pub order: Vec<u32>,
+    /// Boundaries of the particle parts (see [`parts`]): part p owns particles
+    /// `part_bounds[p] .. part_bounds[p + 1]`.
+    pub part_bounds: Vec<usize>,
+    /// Per colour, the boundaries of its parts' constraints, then of its straddlers: part p's
+    /// are `segments[c][p] .. segments[c][p + 1]`, the straddlers the last range.
+    pub segments: Vec<Vec<usize>>,
     /// Scratch corrections for the parallel path (one colour at a time).
     deltas: Vec<[DVec3; N]>,
 }
@@ -69,6 +76,8 @@ impl<const N: usize, S> Default for Block<N, S> {
             lambda: Vec::new(),
             colors: Vec::new(),
             order: Vec::new(),
+            part_bounds: vec![0, 0],
+            segments: Vec::new(),
             deltas: Vec::new(),
         }
     }
@@ -100,11 +109,18 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
         self.shapes.push(shape);
     }
 
-    /// Colours the constraints (ignoring particles that are not `free`) and sorts them by colour.
+    /// Colours the constraints (ignoring particles that are not `free`) and sorts them by colour,
+    /// and inside a colour by particle part (see [`parts`]; the order inside a colour does not
+    /// change a projection's result).
     pub fn finish(self, free: &[bool]) -> Block<N, S> {
         let colours = color(&self.particles, free);
+        let part_bounds = parts::split(&self.particles, free.len(), rayon::current_num_threads());
+        let part: Vec<usize> = (self.particles.iter())
+            .map(|idx| parts::part_of(idx, &part_bounds))
+            .collect();
         let mut order: Vec<usize> = (0..colours.len()).collect();
-        order.sort_by_key(|&i| colours[i]); // stable: keeps insertion order inside a colour
+        // Stable: keeps insertion order inside a colour's part.
+        order.sort_by_key(|&i| (colours[i], part[i]));
         let mut ranges: Vec<Range<usize>> = Vec::new();
         for (pos, &i) in order.iter().enumerate() {
             match ranges.last_mut() {
@@ -112,6 +128,15 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
                 _ => ranges.push(pos..pos + 1),
             }
         }
+        let parts_n = part_bounds.len() - 1;
+        let segments = ranges
+            .iter()
+            .map(|r| {
+                (0..=parts_n + 1)
+                    .map(|p| r.start + order[r.clone()].partition_point(|&i| part[i] < p))
+                    .collect()
+            })
+            .collect();
         let largest = ranges.iter().map(|r| r.len()).max().unwrap_or(0);
         Block {
             particles: order.iter().map(|&i| self.particles[i]).collect(),
@@ -120,6 +145,8 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
             lambda: vec![0.0; order.len()],
             colors: ranges,
             order: order.iter().map(|&i| i as u32).collect(),
+            part_bounds,
+            segments,
             deltas: vec![[DVec3::ZERO; N]; largest],
         }
     }
@@ -297,43 +324,6 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
                 x[idx[j] as usize] += *dj;
             }
         }
-    }
-
-    /// One symmetric Gauss–Seidel sweep: the colours forward, then backward.
-    ///
-    /// A single forward sweep of stiff, overlapping constraints acts like the non-symmetric
-    /// operator (D + L)⁻¹ instead of (D + L + U)⁻¹; its non-symmetric part is a circulatory
-    /// force that can feed energy into the cloth (flutter). The backward half makes the sweep
-    /// the symmetric preconditioner (D + L) D⁻¹ (D + U) (symmetric Gauss–Seidel, SSOR with
-    /// ω = 1: Saad, "Iterative Methods for Sparse Linear Systems", 2nd ed., §4.1), which does not. XPBD's multipliers carry over between
-    /// the halves; under PBD each half uses k' = 1 − (1 − k)^(1/2), so that the two halves
-    /// together correct an isolated constraint as one projection with k would (Müller et al.
-    /// 2007, §3.3).
-    pub fn project_symmetric(
-        &mut self,
-        x: &mut [DVec3],
-        prev: &[DVec3],
-        w: &[f64],
-        params: &[FamilyParams],
-        rule: Rule,
-    ) {
-        let halved: Vec<FamilyParams>;
-        let params = match rule {
-            Rule::Xpbd { .. } => params,
-            Rule::Pbd => {
-                halved = params
-                    .iter()
-                    .map(|p| FamilyParams {
-                        pbd_stiffness: 1.0 - (1.0 - p.pbd_stiffness).sqrt(),
-                        ..*p
-                    })
-                    .collect();
-                &halved
-            }
-        };
-        let k = self.colors.len();
-        self.project_colours(x, prev, w, params, rule, 0..k);
-        self.project_colours(x, prev, w, params, rule, (0..k).rev());
     }
 
     /// Adds spring forces fᵢ = −(k C + c Ċ) ∇Cᵢ, with Ċ = Σ ∇Cⱼ·vⱼ, to `forces`.

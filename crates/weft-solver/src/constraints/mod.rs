@@ -2,9 +2,12 @@
 
 mod block;
 mod dihedral;
+mod dihedral_lanes;
+mod dihedral_sweep;
 mod distance;
 pub(crate) mod lanes;
 mod linear;
+mod parts;
 mod seam;
 mod tether;
 
@@ -17,6 +20,7 @@ pub use tether::Tether;
 
 use glam::DVec3;
 
+use crate::domains::SimdPath;
 use crate::params::FamilyParams;
 
 /// A constraint function C(p) over `N` particles with its gradient.
@@ -144,8 +148,8 @@ impl ConstraintSet {
     }
 
     /// One Gauss–Seidel sweep over the dihedral, tether and seam constraints, colour by colour, the
-    /// dihedrals' symmetric (forward, then backward); the distance constraints are solved by
-    /// [`crate::domains::Domains`].
+    /// dihedrals' symmetric (forward, then backward) through their lane kernel on kernel path
+    /// `path`; the distance constraints are solved by [`crate::domains::Domains`].
     pub(crate) fn project_others(
         &mut self,
         x: &mut [DVec3],
@@ -153,8 +157,10 @@ impl ConstraintSet {
         w: &[f64],
         params: &[FamilyParams],
         rule: Rule,
+        path: SimdPath,
     ) {
-        self.dihedral.project_symmetric(x, prev, w, params, rule);
+        self.dihedral
+            .project_symmetric_lanes(x, prev, w, params, rule, path);
         self.tethers.project(x, prev, w, params, rule);
         self.seams.project(x, prev, w, &self.seam_params, rule);
     }

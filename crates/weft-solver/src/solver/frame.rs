@@ -128,6 +128,7 @@ impl Solver {
         if let Some(rule) = rule {
             self.domains.prepare(&self.params, rule);
         }
+        let path = self.domains.path();
         let mut whole = true;
         for k in 0..s.substeps {
             if self.stopping() {
@@ -191,6 +192,7 @@ impl Solver {
                             &p.inv_masses,
                             &self.params,
                             rule,
+                            path,
                         );
                         stats.contacts = hook.project(&ctx, p);
                     }

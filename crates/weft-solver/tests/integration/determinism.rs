@@ -14,6 +14,7 @@ fn build(method: Method, domain_size: usize) -> Solver {
     let mesh = top_pinned_grid((48, 48));
     let mut params = ClothParams::default()
         .edit(Family::BendDistance, |p| p.enabled = true)
+        .edit(Family::BendDihedral, |p| p.enabled = true)
         .edit(Family::Tether, |p| p.enabled = true);
     // Springs soft enough for explicit integration at h = 1/300 s with 0.4 g particles.
     for f in Family::ALL {

@@ -1,0 +1,139 @@
+//! Contiguous particle ranges ("parts") that let one colour of a block be projected in parallel
+//! with direct writes, without scratch buffers: a constraint whose particles all lie in one part
+//! is projected by that part's task on the part's own slice of positions; the others (the
+//! straddlers) are projected afterwards, one by one.
+//!
+//! Inside a colour no two constraints share a free particle, so the order in which a colour's
+//! constraints are projected does not change a bit: the parts change the speed, never the
+//! result, whatever their number.
+
+/// Most parts a block is split into (one task each).
+pub(crate) const MAX_PARTS: usize = 8;
+
+/// Splits particles `0..n` into at most `k` contiguous ranges for `constraints`: the
+/// boundaries sit near equal shares of the constraints, each moved within a window of a tenth
+/// of a share to where the fewest constraints straddle it (a garment's panels, a grid's rows).
+/// Returns the `parts + 1` boundaries, from 0 to `n`.
+pub(crate) fn split<const N: usize>(constraints: &[[u32; N]], n: usize, k: usize) -> Vec<usize> {
+    let k = k.clamp(1, MAX_PARTS);
+    if k == 1 || constraints.is_empty() || n < 2 * k {
+        return vec![0, n];
+    }
+    // cut[m]: constraints with lo < m ≤ hi (cut by a boundary at m);
+    // left[m]: constraints lying wholly below m (hi < m).
+    let mut cut = vec![0i64; n + 2];
+    let mut left = vec![0usize; n + 2];
+    for idx in constraints {
+        let lo = idx.iter().min().copied().unwrap_or(0) as usize;
+        let hi = idx.iter().max().copied().unwrap_or(0) as usize;
+        cut[lo + 1] += 1;
+        cut[hi + 1] -= 1;
+        left[hi + 1] += 1;
+    }
+    for m in 1..=n {
+        cut[m] += cut[m - 1];
+        left[m] += left[m - 1];
+    }
+    let total = constraints.len();
+    let share = total as f64 / k as f64;
+    let mut bounds = vec![0];
+    for j in 1..k {
+        let goal = share * j as f64;
+        let window = 0.1 * share;
+        let prev = bounds.last().copied().unwrap_or(0);
+        let best = (prev + 1..n)
+            .filter(|&m| (left[m] as f64 - goal).abs() <= window)
+            .min_by(|&a, &b| {
+                let da = (left[a] as f64 - goal).abs();
+                let db = (left[b] as f64 - goal).abs();
+                cut[a].cmp(&cut[b]).then(da.total_cmp(&db))
+            })
+            .or_else(|| {
+                (prev + 1..n).min_by(|&a, &b| {
+                    (left[a] as f64 - goal)
+                        .abs()
+                        .total_cmp(&(left[b] as f64 - goal).abs())
+                })
+            });
+        match best {
+            Some(m) => bounds.push(m),
+            None => break,
+        }
+    }
+    bounds.push(n);
+    bounds.dedup();
+    bounds
+}
+
+/// The part whose range holds every particle of `idx`, or `bounds.len() − 1` (one past the
+/// last part) for a straddler.
+pub(crate) fn part_of<const N: usize>(idx: &[u32; N], bounds: &[usize]) -> usize {
+    let parts = bounds.len() - 1;
+    let find = |i: u32| bounds[1..].partition_point(|&b| b <= i as usize);
+    let first = find(idx[0]);
+    if idx.iter().all(|&i| find(i) == first) {
+        first.min(parts)
+    } else {
+        parts
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The dihedral-like stencils of a `cols × rows` grid, row-major.
+    fn grid(cols: u32, rows: u32) -> Vec<[u32; 4]> {
+        let mut out = Vec::new();
+        for r in 0..rows - 1 {
+            for c in 0..cols - 1 {
+                let i = r * cols + c;
+                out.push([i, i + 1, i + cols, i + cols + 1]);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_grid_splits_between_rows_into_balanced_parts() {
+        let cons = grid(40, 40);
+        let bounds = split(&cons, 1600, 2);
+        assert_eq!(bounds.len(), 3);
+        assert_eq!(bounds[0], 0);
+        assert_eq!(bounds[2], 1600);
+        let straddlers = cons.iter().filter(|c| part_of(c, &bounds) == 2).count();
+        // One row of stencils crosses the boundary: 39 of 1,521.
+        assert!(straddlers <= 39, "{straddlers}");
+        let in0 = cons.iter().filter(|c| part_of(c, &bounds) == 0).count();
+        assert!((in0 as f64 - 741.0).abs() < 0.1 * 760.0, "{in0}");
+    }
+
+    #[test]
+    fn part_of_puts_each_constraint_in_the_range_holding_all_its_particles() {
+        let bounds = [0, 10, 20, 30];
+        assert_eq!(part_of(&[0, 9], &bounds), 0);
+        assert_eq!(part_of(&[10, 19], &bounds), 1);
+        assert_eq!(part_of(&[29, 20], &bounds), 2);
+        assert_eq!(part_of(&[9, 10], &bounds), 3);
+        assert_eq!(part_of(&[0, 29], &bounds), 3);
+    }
+
+    #[test]
+    fn panels_joined_by_few_constraints_split_at_the_join() {
+        // Two 30×30 panels, the second's particles after the first's, joined by 5 stencils;
+        // a third of the particles before the join would balance worse but cut nothing more.
+        let mut cons = grid(30, 30);
+        cons.extend(grid(30, 30).iter().map(|c| c.map(|i| i + 900)));
+        cons.extend((0..5).map(|j| [870 + j, 871 + j, 900 + j, 901 + j]));
+        let bounds = split(&cons, 1800, 2);
+        let straddlers = cons.iter().filter(|c| part_of(c, &bounds) == 2).count();
+        assert!(straddlers <= 5, "{straddlers}, bounds {bounds:?}");
+    }
+
+    #[test]
+    fn one_part_or_tiny_inputs_keep_everything_together() {
+        assert_eq!(split(&grid(5, 5), 25, 1), vec![0, 25]);
+        assert_eq!(split::<4>(&[], 25, 4), vec![0, 25]);
+        assert_eq!(split(&grid(2, 2), 3, 4), vec![0, 3]);
+    }
+}
