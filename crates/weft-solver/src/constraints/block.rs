@@ -110,11 +110,14 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
     }
 
     /// Colours the constraints (ignoring particles that are not `free`) and sorts them by colour,
-    /// and inside a colour by particle part (see [`parts`]; the order inside a colour does not
-    /// change a projection's result).
+    /// and inside a colour by particle part (see [`parts`]).
     pub fn finish(self, free: &[bool]) -> Block<N, S> {
         let colours = color(&self.particles, free);
-        let part_bounds = parts::split(&self.particles, free.len(), rayon::current_num_threads());
+        let part_bounds = parts::split(
+            &self.particles,
+            free.len(),
+            parts::count(self.particles.len()),
+        );
         let part: Vec<usize> = (self.particles.iter())
             .map(|idx| parts::part_of(idx, &part_bounds))
             .collect();

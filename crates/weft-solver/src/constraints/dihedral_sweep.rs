@@ -1,6 +1,9 @@
 //! The dihedral block's symmetric Gauss–Seidel sweep through the lane kernel
-//! ([`super::dihedral_lanes`]): colour by colour, each colour's parts in parallel on their own
-//! slices of the positions (see [`super::parts`]), then its straddlers.
+//! ([`super::dihedral_lanes`]), decomposed by particle ranges (see [`super::parts`]): every
+//! part's constraints colour by colour, the parts in parallel on their own slices of the
+//! positions, then the straddlers colour by colour; the backward half in the reverse order.
+//! One fork–join per half sweep instead of one per colour, and the order depends on the mesh
+//! alone, never on the thread count.
 
 use std::ops::Range;
 
@@ -13,10 +16,6 @@ use super::lanes::{Coef, Coefs};
 use super::{Block, Dihedral, Rule};
 use crate::domains::SimdPath;
 use crate::params::FamilyParams;
-
-/// Colours with fewer constraints than this are projected on the calling thread (a fork–join
-/// costs a few µs; a lane-kernel dihedral about 20 ns).
-const PARALLEL_MIN_COLOUR: usize = 512;
 
 /// The per-group coefficients of `rule`; under PBD each half of the symmetric sweep uses
 /// k' = 1 − (1 − k)^(1/2) (see [`Block::project_symmetric_lanes`]). A disabled group gets k = 0,
@@ -184,9 +183,10 @@ fn chunk<const L: usize, const DAMPED: bool>(seg: &mut Segment, start: usize) {
 }
 
 impl Block<4, Dihedral> {
-    /// One symmetric Gauss–Seidel sweep, the colours forward then backward, through the lane
-    /// kernel on kernel path `path`. Each large colour's parts run in parallel, each on its own
-    /// particles; the bits depend neither on the thread count nor on the path.
+    /// One symmetric Gauss–Seidel sweep through the lane kernel on kernel path `path`: forward,
+    /// every part's constraints colour by colour (the parts in parallel, each on its own
+    /// particles), then the straddlers colour by colour; backward, the same in reverse. The
+    /// bits depend neither on the thread count nor on the path.
     ///
     /// A single forward sweep of stiff, overlapping constraints acts like the non-symmetric
     /// operator (D + L)⁻¹ instead of (D + L + U)⁻¹; its non-symmetric part is a circulatory
@@ -210,91 +210,218 @@ impl Block<4, Dihedral> {
             return;
         }
         let (coef, damped) = coefficients(params, rule);
-        let k = self.colors.len();
-        for c in (0..k).chain((0..k).rev()) {
-            self.project_colour(c, x, prev, w, &coef, damped, path);
-        }
+        self.project_interiors(x, prev, w, &coef, damped, path, false);
+        self.project_straddlers(x, prev, w, &coef, damped, path, false);
+        self.project_straddlers(x, prev, w, &coef, damped, path, true);
+        self.project_interiors(x, prev, w, &coef, damped, path, true);
     }
 
-    /// Projects colour `c`: its parts (in parallel when the colour is large), then its
-    /// straddlers.
+    /// Every part's constraints, colour by colour (backward: in reverse), one task per part on
+    /// its own slice of the positions.
     #[allow(clippy::too_many_arguments)]
-    fn project_colour(
+    fn project_interiors(
         &mut self,
-        c: usize,
         x: &mut [DVec3],
         prev: &[DVec3],
         w: &[f64],
         coef: &[Coef],
         damped: bool,
         path: SimdPath,
+        backward: bool,
     ) {
-        let seg = &self.segments[c];
-        let colour = self.colors[c].clone();
-        let parts = self.part_bounds.len() - 1;
-        let straddle = seg[parts]..seg[parts + 1];
-        let make = |r: Range<usize>| (r.start - colour.start)..(r.end - colour.start);
-        let idx = &self.particles[colour.clone()];
-        let shapes = &self.shapes[colour.clone()];
-        let groups = &self.group[colour.clone()];
-        let lambda = &mut self.lambda[colour.clone()];
-        if colour.len() >= PARALLEL_MIN_COLOUR && parts > 1 {
-            // Split the positions at the part boundaries and the colour's multipliers at its
-            // segment boundaries; one task per part.
-            let (lam_parts, lam_straddle) = lambda.split_at_mut(straddle.start - colour.start);
-            let mut tasks = Vec::with_capacity(parts);
-            let (mut xs, mut lams) = (&mut x[..], lam_parts);
-            for p in 0..parts {
-                let (xp, xr) = xs.split_at_mut(self.part_bounds[p + 1] - self.part_bounds[p]);
-                let r = make(seg[p]..seg[p + 1]);
-                let (lp, lr) = lams.split_at_mut(r.len());
-                tasks.push(Segment {
-                    x: xp,
-                    base: self.part_bounds[p],
-                    prev,
-                    w,
-                    idx: &idx[r.clone()],
-                    shapes: &shapes[r.clone()],
-                    groups: &groups[r],
-                    lambda: lp,
-                    coef,
-                    damped,
-                });
-                (xs, lams) = (xr, lr);
+        let Block {
+            particles,
+            shapes,
+            group,
+            lambda,
+            segments,
+            part_bounds,
+            ..
+        } = self;
+        let parts = part_bounds.len() - 1;
+        // Each part's runs, one per colour: the constraint range and its multipliers.
+        let mut runs: Vec<Vec<(Range<usize>, &mut [f64])>> = (0..parts)
+            .map(|_| Vec::with_capacity(segments.len()))
+            .collect();
+        let (mut rest, mut offset) = (&mut lambda[..], 0);
+        for seg in segments.iter() {
+            for (p, part_runs) in runs.iter_mut().enumerate() {
+                let r = seg[p]..seg[p + 1];
+                let (_, tail) = rest.split_at_mut(r.start - offset);
+                let (mine, tail) = tail.split_at_mut(r.len());
+                part_runs.push((r.clone(), mine));
+                (rest, offset) = (tail, r.end);
             }
-            tasks.par_iter_mut().for_each(|t| run(t, path));
-            let r = make(straddle);
-            run(
-                &mut Segment {
-                    x,
-                    base: 0,
-                    prev,
-                    w,
-                    idx: &idx[r.clone()],
-                    shapes: &shapes[r.clone()],
-                    groups: &groups[r],
-                    lambda: lam_straddle,
-                    coef,
-                    damped,
-                },
-                path,
-            );
+        }
+        let mut slices = Vec::with_capacity(parts);
+        let mut xs = &mut x[..];
+        for p in 0..parts {
+            let (xp, xr) = xs.split_at_mut(part_bounds[p + 1] - part_bounds[p]);
+            slices.push((part_bounds[p], xp));
+            xs = xr;
+        }
+        let (particles, shapes, group) = (&particles[..], &shapes[..], &group[..]);
+        let project = |(base, xp): (usize, &mut [DVec3]),
+                       part_runs: Vec<(Range<usize>, &mut [f64])>| {
+            let mut one = |(r, lam): (Range<usize>, &mut [f64])| {
+                run(
+                    &mut Segment {
+                        x: &mut *xp,
+                        base,
+                        prev,
+                        w,
+                        idx: &particles[r.clone()],
+                        shapes: &shapes[r.clone()],
+                        groups: &group[r],
+                        lambda: lam,
+                        coef,
+                        damped,
+                    },
+                    path,
+                )
+            };
+            if backward {
+                part_runs.into_iter().rev().for_each(&mut one);
+            } else {
+                part_runs.into_iter().for_each(&mut one);
+            }
+        };
+        if parts == 1 {
+            for (slice, part_runs) in slices.into_iter().zip(runs) {
+                project(slice, part_runs);
+            }
         } else {
+            slices
+                .into_par_iter()
+                .zip(runs)
+                .for_each(|(slice, part_runs)| project(slice, part_runs));
+        }
+    }
+
+    /// The straddlers, colour by colour (backward: in reverse), on the calling thread.
+    #[allow(clippy::too_many_arguments)]
+    fn project_straddlers(
+        &mut self,
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        w: &[f64],
+        coef: &[Coef],
+        damped: bool,
+        path: SimdPath,
+        backward: bool,
+    ) {
+        let parts = self.part_bounds.len() - 1;
+        let k = self.colors.len();
+        let order: Vec<usize> = if backward {
+            (0..k).rev().collect()
+        } else {
+            (0..k).collect()
+        };
+        for c in order {
+            let r = self.segments[c][parts]..self.segments[c][parts + 1];
             run(
                 &mut Segment {
                     x,
                     base: 0,
                     prev,
                     w,
-                    idx,
-                    shapes,
-                    groups,
-                    lambda,
+                    idx: &self.particles[r.clone()],
+                    shapes: &self.shapes[r.clone()],
+                    groups: &self.group[r.clone()],
+                    lambda: &mut self.lambda[r],
                     coef,
                     damped,
                 },
                 path,
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::constraints::BlockBuilder;
+    use crate::topology::Topology;
+
+    /// A `n × n` grid of spacing 0.02 m, flat at rest, crumpled by up to ±`bump` in z.
+    fn crumpled(n: u32, bump: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let mut seed = 0x6a09_e667_f3bc_c909u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let x = (0..n * n)
+            .map(|i| DVec3::new(0.02 * (i % n) as f64, 0.02 * (i / n) as f64, bump * rnd()))
+            .collect();
+        let mut tris = Vec::new();
+        for r in 0..n - 1 {
+            for c in 0..n - 1 {
+                let i = r * n + c;
+                tris.push([i, i + 1, i + n]);
+                tris.push([i + 1, i + n + 1, i + n]);
+            }
+        }
+        (x, tris)
+    }
+
+    #[test]
+    fn sweeps_flatten_a_crumpled_sheet_through_every_part_and_straddler() {
+        let n = 48;
+        let (mut x, tris) = crumpled(n, 0.004);
+        let mut b = BlockBuilder::<4, Dihedral>::default();
+        for wing in Topology::new(&tris).wings {
+            b.push(
+                [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]],
+                0,
+                Dihedral { rest: 0.0 },
+            );
+        }
+        let free = vec![true; x.len()];
+        let mut block = b.finish(&free);
+        let parts = block.part_bounds.len() - 1;
+        let straddlers: usize = (block.segments.iter())
+            .map(|s| s[parts + 1] - s[parts])
+            .sum();
+        assert!(
+            parts >= 2 && straddlers > 0,
+            "{parts} parts, {straddlers} straddlers"
+        );
+        let params = [FamilyParams {
+            enabled: true,
+            compliance: 0.0,
+            damping: 0.0,
+            pbd_stiffness: 1.0,
+            spring_stiffness: 0.0,
+            spring_damping: 0.0,
+        }];
+        let prev = x.clone();
+        let w = vec![1.0; x.len()];
+        let worst = |x: &[DVec3], block: &Block<4, Dihedral>| {
+            (block.residuals(x)).fold(0.0f64, |m, c| m.max(c.abs()))
+        };
+        let start = worst(&x, &block);
+        for _ in 0..1000 {
+            block.reset_multipliers();
+            block.project_symmetric_lanes(
+                &mut x,
+                &prev,
+                &w,
+                &params,
+                Rule::Xpbd { h: 1e-3 },
+                SimdPath::widest(),
+            );
+        }
+        let end = worst(&x, &block);
+        // 6e-4 rad after 1,000 sweeps (bending alone converges slowly on long waves); with
+        // the straddlers left out their row of hinges keeps a crease of 0.02 rad.
+        assert!(
+            start > 0.2 && end < 3e-3,
+            "largest |θ − θ₀|: {start} → {end}"
+        );
     }
 }

@@ -3,12 +3,22 @@
 //! is projected by that part's task on the part's own slice of positions; the others (the
 //! straddlers) are projected afterwards, one by one.
 //!
-//! Inside a colour no two constraints share a free particle, so the order in which a colour's
-//! constraints are projected does not change a bit: the parts change the speed, never the
-//! result, whatever their number.
+//! Inside a colour no two constraints share a free particle, so the order of a colour's
+//! constraints does not change a bit; a sweep that runs each part's colours on their own
+//! (see `dihedral_sweep.rs`) changes the order across colours, so the number of parts is a
+//! function of the constraint count alone ([`count`]), never of the thread count.
 
 /// Most parts a block is split into (one task each).
 pub(crate) const MAX_PARTS: usize = 8;
+
+/// Constraints per part, at least: a part is one task of a parallel sweep, worth its fork.
+pub(crate) const MIN_PER_PART: usize = 2048;
+
+/// How many parts `constraints` constraints are split into: a function of the count alone,
+/// so that the sweep order (and so every bit) never depends on the machine's thread count.
+pub(crate) fn count(constraints: usize) -> usize {
+    (constraints / MIN_PER_PART).clamp(1, MAX_PARTS)
+}
 
 /// Splits particles `0..n` into at most `k` contiguous ranges for `constraints`: the
 /// boundaries sit near equal shares of the constraints, each moved within a window of a tenth
