@@ -183,17 +183,25 @@ mod tests {
         for _ in 0..2 {
             s.step_once().expect("steps");
         }
-        // Aim horizontally at the skirt's lowest particle from outside it.
+        // Aim horizontally from outside the skirt at the middle of a triangle at its lowest
+        // particle (at the particle itself the ray would graze the triangles' shared corner).
         let x = s.sim.cloth_positions(0);
         let centre = x.iter().copied().sum::<DVec3>() / x.len() as f64;
-        let p = x
-            .iter()
-            .copied()
-            .min_by(|a, b| a.y.total_cmp(&b.y))
+        let low = (0..x.len())
+            .min_by(|&a, &b| x[a].y.total_cmp(&x[b].y))
             .expect("particles");
-        let out = DVec3::new(p.x - centre.x, 0.0, p.z - centre.z).normalize();
+        let out = DVec3::new(x[low].x - centre.x, 0.0, x[low].z - centre.z).normalize();
+        let facing = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|i| x[i as usize]);
+            (b - a).cross(c - a).normalize_or_zero().dot(out).abs()
+        };
+        let tri = (s.sim.scene.cloths[0].mesh.triangles.iter())
+            .filter(|t| t.contains(&(low as u32)))
+            .max_by(|a, b| facing(a).total_cmp(&facing(b)))
+            .expect("the particle is in a triangle");
+        let aim = tri.iter().map(|&i| x[i as usize]).sum::<DVec3>() / 3.0;
         let ray = Ray {
-            origin: p + 2.0 * out,
+            origin: aim + 2.0 * out,
             dir: -out,
         };
         assert!(s.grab(&ray, -out), "the hem is under the ray");
