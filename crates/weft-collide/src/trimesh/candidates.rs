@@ -176,29 +176,27 @@ impl MeshFrame<'_> {
         let radius = r * (1.0 + SKIN) + (from - x).length() + (g.travel - g.travel_before);
         let old = lists.range[j];
         lists.live -= old.1 as usize;
+        let (lo, hi) = g.bounds();
+        let outside_box = box_distance_squared(x, lo, hi).sqrt();
+        // Inside a closed mesh's box an empty list needs the nearest triangle of all (the
+        // inside flag and the clearance): the same search finds it.
+        let deep = g.closed() && outside_box == 0.0;
         let start = lists.tris.len();
-        let nearest = g.within(x, radius, &mut lists.tris);
+        let nearest = g.within(x, radius, deep, &mut lists.tris);
         let len = lists.tris.len() - start;
         lists.live += len;
         lists.range[j] = (start as u32, len as u32);
         lists.anchor[j] = x;
         lists.travel[j] = g.travel_before;
-        let closed = g.closed();
-        let (lo, hi) = g.bounds();
-        let outside_box = box_distance_squared(x, lo, hi).sqrt();
-        let (clearance, inside) = if let Some(p) = nearest {
+        let (clearance, inside) = match nearest {
             // The nearest listed triangle is the nearest of all (it is within R).
-            (radius, p.distance < 0.0)
-        } else if !closed || outside_box > 0.0 {
-            (radius.max(outside_box), false)
-        } else {
-            match g.nearest(x, f64::INFINITY) {
-                Some(p) => (
-                    radius.max(p.distance.abs() * (1.0 - 1e-12)),
-                    p.distance < 0.0,
-                ),
-                None => (radius, false),
-            }
+            Some(p) if len > 0 => (radius, p.distance < 0.0),
+            Some(p) => (
+                radius.max(p.distance.abs() * (1.0 - 1e-12)),
+                p.distance < 0.0,
+            ),
+            None if deep => (radius, false),
+            None => (radius.max(outside_box), false),
         };
         lists.radius[j] = clearance;
         lists.inside[j] = inside;
