@@ -16,6 +16,9 @@
 use glam::DVec3;
 
 use super::MeshGeometry;
+#[cfg(test)]
+#[path = "candidates_tests.rs"]
+mod tests;
 use super::bvh::box_distance_squared;
 use super::ccd::{Crossing, moving_crossing, segment_crossing};
 use super::closest::closest_on_triangle;
@@ -53,6 +56,8 @@ pub(crate) struct ChunkLists {
     tris: Vec<u32>,
     /// Entries in use.
     live: usize,
+    /// The arena's spare buffer, for compaction.
+    spare: Vec<u32>,
     /// Lists built so far.
     pub builds: u64,
 }
@@ -70,6 +75,7 @@ impl ChunkLists {
             range: vec![(0, 0); n],
             tris: Vec::new(),
             live: 0,
+            spare: Vec::new(),
             builds: 0,
         }
     }
@@ -79,18 +85,20 @@ impl ChunkLists {
         self.live
     }
 
-    /// Drops stale entries once they are more than half the arena.
+    /// Drops stale entries and puts the lists back in particle order (the contact loop then
+    /// reads the arena front to back), whenever a list was rebuilt.
     pub fn compact(&mut self) {
-        if self.tris.len() <= 2 * self.live + 4096 {
+        if self.tris.len() == self.live {
             return;
         }
-        let mut fresh = Vec::with_capacity(2 * self.live + 64);
+        let mut fresh = std::mem::take(&mut self.spare);
+        fresh.clear();
         for r in &mut self.range {
             let s = fresh.len() as u32;
             fresh.extend_from_slice(&self.tris[r.0 as usize..(r.0 + r.1) as usize]);
             *r = (s, r.1);
         }
-        self.tris = fresh;
+        self.spare = std::mem::replace(&mut self.tris, fresh);
     }
 }
 
