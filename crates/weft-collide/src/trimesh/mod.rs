@@ -22,31 +22,28 @@ use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
 use normals::{Topology, face_normal, pseudo_normal};
 
-/// One triangle at the end of the substep: its corners, unit normal and in-plane outward
-/// edge normals (what the contact loops read, kept together for the cache).
+/// One triangle at the end of the substep: its corners and unit normal (what the contact
+/// loops read, 96 bytes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Face {
     /// Corners a, b, c (m, the collider's frame).
     pub corners: [DVec3; 3],
     /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
     pub normal: DVec3,
-    /// Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
-    pub edges: [DVec3; 3],
 }
 
 impl Face {
     fn new(corners: [DVec3; 3]) -> Self {
         let normal = face_normal(corners[0], corners[1], corners[2]);
-        let edge = |k: usize| {
-            (corners[(k + 1) % 3] - corners[k])
-                .cross(normal)
-                .normalize_or_zero()
-        };
-        Self {
-            corners,
-            normal,
-            edges: [edge(0), edge(1), edge(2)],
-        }
+        Self { corners, normal }
+    }
+
+    /// Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
+    fn edge_normal(&self, k: usize) -> DVec3 {
+        let c = &self.corners;
+        (c[(k + 1) % 3] - c[k])
+            .cross(self.normal)
+            .normalize_or_zero()
     }
 }
 
@@ -61,9 +58,9 @@ impl Planes {
         let mut p = [0f32; 16];
         let planes = [
             (f.normal, f.corners[0]),
-            (f.edges[0], f.corners[0]),
-            (f.edges[1], f.corners[1]),
-            (f.edges[2], f.corners[2]),
+            (f.edge_normal(0), f.corners[0]),
+            (f.edge_normal(1), f.corners[1]),
+            (f.edge_normal(2), f.corners[2]),
         ];
         for (k, (n, at)) in planes.into_iter().enumerate() {
             p[4 * k..4 * k + 3].copy_from_slice(&n.as_vec3().to_array());
