@@ -31,7 +31,10 @@ pub(crate) const SKIN: f64 = 0.5;
 
 /// Pushes per particle and projection (a push out of one face may land in another, in a
 /// concave corner).
-const ROUNDS: usize = 3;
+pub(crate) const ROUNDS: usize = 3;
+
+/// Triangles near enough to a contact to be checked again after its push, at most.
+const NEAR: usize = 16;
 
 /// The candidate lists of one mesh collider for one chunk of particles.
 #[derive(Clone, Debug, Default)]
@@ -166,20 +169,26 @@ impl MeshFrame<'_> {
         }
     }
 
-    /// Makes particle `j`'s list valid for position `x` and path start `from` (local).
-    fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+    /// Whether particle `j`'s list holds every triangle within `r` of `x` and of the path
+    /// `from → x` (local).
+    fn valid(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
         let g = self.geometry;
         let anchor = lists.anchor[j];
         // max(|x − anchor|, |from − anchor|) ≤ slack, compared squared.
         let slack = lists.radius[j] - (g.travel - lists.travel[j]) - r;
-        if slack >= 0.0
+        slack >= 0.0
             && (x - anchor)
                 .length_squared()
                 .max((from - anchor).length_squared())
                 <= slack * slack
-        {
+    }
+
+    /// Makes particle `j`'s list valid for position `x` and path start `from` (local).
+    fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+        if self.valid(lists, j, x, from, r) {
             return;
         }
+        let g = self.geometry;
         lists.builds += 1;
         let radius = r * (1.0 + SKIN) + (from - x).length() + (g.travel - g.travel_before);
         let old = lists.range[j];
@@ -310,15 +319,31 @@ impl MeshFrame<'_> {
             let mut second = f64::INFINITY;
             let x32 = xl.as_vec3();
             let hint = lists.hint[j];
-            if let Some(f) = g.faces.get(hint as usize)
-                && f64::from(g.planes[hint as usize].distance_squared_bound(x32, g.margin)) < bound
-            {
-                let [a, b, c] = f.corners;
-                let q = closest_on_triangle(xl, a, b, c);
-                let d2 = (xl - q.point).length_squared();
-                if d2 < bound {
-                    bound = d2;
-                    best = Some((d2, hint as usize, q));
+            // The triangles whose bound is within 2r (a push and a slip of up to r may bring
+            // them within r), and the least bound of the others (squared).
+            let (mut near, mut n_near, mut others) = ([0u32; NEAR], 0, f64::INFINITY);
+            let mut note = |t: u32, lower: f64| {
+                if lower >= 4.0 * r * r {
+                    others = others.min(lower);
+                } else if n_near < NEAR {
+                    near[n_near] = t;
+                    n_near += 1;
+                } else {
+                    others = 0.0; // too many to follow
+                }
+            };
+            if let Some(f) = g.faces.get(hint as usize) {
+                let lower =
+                    f64::from(g.planes[hint as usize].distance_squared_bound(x32, g.margin));
+                note(hint, lower);
+                if lower < bound {
+                    let [a, b, c] = f.corners;
+                    let q = closest_on_triangle(xl, a, b, c);
+                    let d2 = (xl - q.point).length_squared();
+                    if d2 < bound {
+                        bound = d2;
+                        best = Some((d2, hint as usize, q));
+                    }
                 }
             }
             for &t in &lists.tris[s as usize..(s + len) as usize] {
@@ -327,6 +352,7 @@ impl MeshFrame<'_> {
                 }
                 // Cheap reject: the plane and edge lines are no farther than the triangle.
                 let lower = f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin));
+                note(t, lower);
                 if lower >= bound {
                     second = second.min(lower);
                     continue;
@@ -344,6 +370,7 @@ impl MeshFrame<'_> {
                     second = second.min(d2);
                 }
             }
+            let scanned_at = xl;
             let hit = match best {
                 Some((d2, t, q)) => {
                     let mut p = g.signed(xl, t, q, d2);
@@ -366,6 +393,9 @@ impl MeshFrame<'_> {
                 }
                 None => break,
             };
+            // From outside, a push along the closest direction leaves the (convex) triangle at
+            // distance r, and a slip across that direction keeps it there.
+            let along_closest = best.is_some_and(|b| b.0 > 1e-24) && hit.distance > 0.0;
             lists.hint[j] = hit.triangle as u32;
             let depth = r - hit.distance;
             if depth <= 1e-6 * r.max(1e-3) {
@@ -385,6 +415,25 @@ impl MeshFrame<'_> {
                 again |= second.sqrt() - depth - correction.length() < r;
                 *x -= correction;
                 xl = self.to_local(self.pose, *x);
+            }
+            // Another round only if a triangle other than the one just left may be within r
+            // where the particle is now: its bound there, for those followed (the others moved
+            // at most |xl − scanned_at| nearer), on a list still valid here.
+            if again && along_closest {
+                let moved = (xl - scanned_at).length();
+                if others.sqrt() - moved >= r && self.valid(lists, j, xl, from, r) {
+                    let x32 = xl.as_vec3();
+                    again = near[..n_near].iter().any(|&t| {
+                        let t = t as usize;
+                        t != hit.triangle
+                            && f64::from(g.planes[t].distance_squared_bound(x32, g.margin)) < r * r
+                            && {
+                                let [a, b, c] = g.faces[t].corners;
+                                (xl - closest_on_triangle(xl, a, b, c).point).length_squared()
+                                    < r * r
+                            }
+                    });
+                }
             }
             out.contacts += 1;
             out.depth = out.depth.max(depth);
