@@ -333,8 +333,7 @@ impl MeshFrame<'_> {
                 }
             };
             if let Some(f) = g.faces.get(hint as usize) {
-                let lower =
-                    f64::from(g.planes[hint as usize].distance_squared_bound(x32, g.margin));
+                let lower = f64::from(f.planes.distance_squared_bound(x32, g.margin));
                 note(hint, lower);
                 if lower < bound {
                     let [a, b, c] = f.corners;
@@ -351,7 +350,11 @@ impl MeshFrame<'_> {
                     continue;
                 }
                 // Cheap reject: the plane and edge lines are no farther than the triangle.
-                let lower = f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin));
+                let lower = f64::from(
+                    g.faces[t as usize]
+                        .planes
+                        .distance_squared_bound(x32, g.margin),
+                );
                 note(t, lower);
                 if lower >= bound {
                     second = second.min(lower);
@@ -426,7 +429,8 @@ impl MeshFrame<'_> {
                     again = near[..n_near].iter().any(|&t| {
                         let t = t as usize;
                         t != hit.triangle
-                            && f64::from(g.planes[t].distance_squared_bound(x32, g.margin)) < r * r
+                            && f64::from(g.faces[t].planes.distance_squared_bound(x32, g.margin))
+                                < r * r
                             && {
                                 let [a, b, c] = g.faces[t].corners;
                                 (xl - closest_on_triangle(xl, a, b, c).point).length_squared()

@@ -22,10 +22,14 @@ use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
 use normals::{Topology, face_normal, pseudo_normal};
 
-/// One triangle at the end of the substep: its corners and unit normal (what the contact
-/// loops read, 96 bytes).
+/// One triangle at the end of the substep: its f32 planes, corners and unit normal (what the
+/// contact loops read), in three adjacent cache lines: the bound first, then the corners that
+/// a triangle passing it needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub(crate) struct Face {
+    /// The planes of the cheap distance bound.
+    pub planes: Planes,
     /// Corners a, b, c (m, the collider's frame).
     pub corners: [DVec3; 3],
     /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
@@ -35,15 +39,11 @@ pub(crate) struct Face {
 impl Face {
     fn new(corners: [DVec3; 3]) -> Self {
         let normal = face_normal(corners[0], corners[1], corners[2]);
-        Self { corners, normal }
-    }
-
-    /// Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
-    fn edge_normal(&self, k: usize) -> DVec3 {
-        let c = &self.corners;
-        (c[(k + 1) % 3] - c[k])
-            .cross(self.normal)
-            .normalize_or_zero()
+        Self {
+            planes: Planes::new(corners, normal),
+            corners,
+            normal,
+        }
     }
 }
 
@@ -54,13 +54,20 @@ impl Face {
 pub(crate) struct Planes([f32; 16]);
 
 impl Planes {
-    fn new(f: &Face) -> Self {
+    /// The planes of the triangle with `corners` and unit `normal`.
+    fn new(corners: [DVec3; 3], normal: DVec3) -> Self {
+        // Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
+        let edge = |k: usize| {
+            (corners[(k + 1) % 3] - corners[k])
+                .cross(normal)
+                .normalize_or_zero()
+        };
         let mut p = [0f32; 16];
         let planes = [
-            (f.normal, f.corners[0]),
-            (f.edge_normal(0), f.corners[0]),
-            (f.edge_normal(1), f.corners[1]),
-            (f.edge_normal(2), f.corners[2]),
+            (normal, corners[0]),
+            (edge(0), corners[0]),
+            (edge(1), corners[1]),
+            (edge(2), corners[2]),
         ];
         for (k, (n, at)) in planes.into_iter().enumerate() {
             p[4 * k..4 * k + 3].copy_from_slice(&n.as_vec3().to_array());
@@ -110,8 +117,6 @@ pub(crate) struct MeshGeometry {
     pub end: Vec<DVec3>,
     /// Faces at the end of the substep, in storage order.
     pub faces: Vec<Face>,
-    /// Their planes in f32, for the contact loops' first test.
-    pub planes: Vec<Planes>,
     /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
     pub margin: f32,
     /// The largest vertex coordinate, in absolute value (m).
@@ -146,7 +151,6 @@ impl MeshGeometry {
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         let mut geometry = Self {
             faces: Vec::new(),
-            planes: Vec::new(),
             margin: 0.0,
             extent: 0.0,
             triangles,
@@ -160,7 +164,6 @@ impl MeshGeometry {
             moving: false,
         };
         geometry.faces = geometry.compute_faces();
-        geometry.planes = geometry.faces.iter().map(Planes::new).collect();
         geometry.set_margin(extent);
         geometry
     }
@@ -211,12 +214,6 @@ impl MeshGeometry {
             return;
         }
         self.faces = self.compute_faces();
-        self.planes = self
-            .faces
-            .par_iter()
-            .with_min_len(1024)
-            .map(Planes::new)
-            .collect();
         let extent = self
             .end
             .iter()
@@ -286,7 +283,7 @@ impl MeshGeometry {
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
         let (t, d2, c) = self.bvh.nearest(x, limit, |t, bound| {
             // Cheap reject: a lower bound no nearer than the best so far.
-            if f64::from(self.planes[t].distance_squared_bound(x32, margin)) >= bound {
+            if f64::from(self.faces[t].planes.distance_squared_bound(x32, margin)) >= bound {
                 return None;
             }
             let [a, b, cc] = faces[t].corners;
@@ -314,7 +311,7 @@ impl MeshGeometry {
         let mut limit = if beyond { f64::INFINITY } else { r2 };
         self.bvh.branch_and_bound(x, limit, |t| {
             // Cheap reject on the planes (one cache line) before the corners.
-            if f64::from(self.planes[t].distance_squared_bound(x32, margin)) > limit {
+            if f64::from(self.faces[t].planes.distance_squared_bound(x32, margin)) > limit {
                 return limit;
             }
             let [a, b, c] = faces[t].corners;
