@@ -238,7 +238,8 @@ impl MeshFrame<'_> {
         } else {
             0.0
         };
-        if (x - from).length() + surface <= 0.5 * r {
+        let short = 0.5 * r - surface;
+        if short >= 0.0 && (x - from).length_squared() <= short * short {
             return None;
         }
         let mut best: Option<(Crossing, usize)> = None;
@@ -295,6 +296,8 @@ impl MeshFrame<'_> {
         // Continuous: a crossing on the path is undone, the particle left r off the surface
         // (where the surface is at the end of the substep) on the side it came from.
         self.ensure(lists, j, xl, from, r);
+        // The list is valid where the particle is (ensure needs calling only after a move).
+        let mut listed = true;
         let (s, len) = lists.range[j];
         if let Some((c, t)) =
             self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl, r)
@@ -303,6 +306,7 @@ impl MeshFrame<'_> {
             let [a, b, cc] = f.corners;
             let hit = a * c.bary[0] + b * c.bary[1] + cc * c.bary[2];
             moved(&mut xl, x, hit + f.normal * (c.side * r));
+            listed = false;
             out.swept += 1;
         }
         // After a push by δ every distance drops by at most δ: a round is needed again only
@@ -312,7 +316,10 @@ impl MeshFrame<'_> {
             if !again {
                 break;
             }
-            self.ensure(lists, j, xl, from, r);
+            if !listed {
+                self.ensure(lists, j, xl, from, r);
+            }
+            listed = false; // a push follows, or the loop ends
             let (s, len) = lists.range[j];
             let mut best: Option<(f64, usize, super::closest::Closest)> = None;
             let mut bound = r * r;
