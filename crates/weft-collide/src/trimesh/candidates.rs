@@ -327,30 +327,31 @@ impl MeshFrame<'_> {
             let x32 = xl.as_vec3();
             let hint = lists.hint[j];
             // The triangles whose bound is within 2r (a push and a slip of up to r may bring
-            // them within r), and the least bound of the others (squared).
-            let (mut near, mut n_near, mut others) = ([0u32; NEAR], 0, f64::INFINITY);
+            // them within r) with that bound, and the least bound of the others (squared).
+            let (mut near, mut n_near, mut others) = ([(0u32, 0.0f64); NEAR], 0, f64::INFINITY);
             let mut note = |t: u32, lower: f64| {
                 if lower >= 4.0 * r * r {
                     others = others.min(lower);
                 } else if n_near < NEAR {
-                    near[n_near] = t;
+                    near[n_near] = (t, lower);
                     n_near += 1;
                 } else {
                     others = 0.0; // too many to follow
                 }
             };
             if let Some(f) = g.faces.get(hint as usize) {
-                let lower = f64::from(f.planes.distance_squared_bound(x32, g.margin));
-                note(hint, lower);
+                let mut lower = f64::from(f.planes.distance_squared_bound(x32, g.margin));
                 if lower < bound {
                     let [a, b, c] = f.corners;
                     let q = closest_on_triangle(xl, a, b, c);
                     let d2 = (xl - q.point).length_squared();
+                    lower = d2;
                     if d2 < bound {
                         bound = d2;
                         best = Some((d2, hint as usize, q));
                     }
                 }
+                note(hint, lower);
             }
             for &t in &lists.tris[s as usize..(s + len) as usize] {
                 if t == hint {
@@ -362,14 +363,15 @@ impl MeshFrame<'_> {
                         .planes
                         .distance_squared_bound(x32, g.margin),
                 );
-                note(t, lower);
                 if lower >= bound {
+                    note(t, lower);
                     second = second.min(lower);
                     continue;
                 }
                 let [a, b, c] = g.faces[t as usize].corners;
                 let q = closest_on_triangle(xl, a, b, c);
                 let d2 = (xl - q.point).length_squared();
+                note(t, d2);
                 if d2 < bound {
                     if best.is_some() {
                         second = second.min(bound);
@@ -427,15 +429,17 @@ impl MeshFrame<'_> {
                 xl = self.to_local(self.pose, *x);
             }
             // Another round only if a triangle other than the one just left may be within r
-            // where the particle is now: its bound there, for those followed (the others moved
-            // at most |xl − scanned_at| nearer), on a list still valid here.
+            // where the particle is now: for those followed, a bound at the scan less the move,
+            // then a bound here, then the distance; the others' least bound less the move; on
+            // a list still valid here.
             if again && along_closest {
                 let moved = (xl - scanned_at).length();
                 if others.sqrt() - moved >= r && self.valid(lists, j, xl, from, r) {
                     let x32 = xl.as_vec3();
-                    again = near[..n_near].iter().any(|&t| {
+                    again = near[..n_near].iter().any(|&(t, was)| {
                         let t = t as usize;
                         t != hit.triangle
+                            && was.sqrt() - moved < r
                             && f64::from(g.faces[t].planes.distance_squared_bound(x32, g.margin))
                                 < r * r
                             && {
