@@ -299,6 +299,11 @@ impl MeshFrame<'_> {
         // The list is valid where the particle is (ensure needs calling only after a move).
         let mut listed = true;
         let (s, len) = lists.range[j];
+        if len == 0 && !lists.inside[j] {
+            // No triangle within r of the particle or its path: nothing to do.
+            lists.last[j] = xl;
+            return out;
+        }
         if let Some((c, t)) =
             self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl, r)
         {
