@@ -12,8 +12,10 @@
 //! CPU time is the sum over the process's threads of the time on a CPU
 //! (`/proc/self/task/*/schedstat`, Linux; "n/a" elsewhere).
 //!
-//! `cargo run --release -p weft-collide --example mesh_contact_cost -- [REPS]`; set
-//! `RAYON_NUM_THREADS` to choose the thread count.
+//! `cargo run --release -p weft-collide --example mesh_contact_cost -- [REPS] [SCENE]`; set
+//! `RAYON_NUM_THREADS` to choose the thread count and `WEFT_SIMD` the solver's kernel path.
+//! SCENE `mesh` or `deforming` steps only that scene's collider frame `REPS` times (for a
+//! profiler).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
@@ -99,12 +101,29 @@ fn main() {
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(15);
+    match std::env::args().nth(2).as_deref() {
+        Some("mesh") => {
+            let (s, w) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
+            show("20,480-triangle mesh + ground", with(reps, &s, &w));
+            return;
+        }
+        Some("deforming") => {
+            let (s, w) = in_contact(breathing_drop(Method::Xpbd, 90).expect("scene"));
+            show("deforming mesh + ground", with(reps, &s, &w));
+            return;
+        }
+        _ => {}
+    }
     let (solver, mesh_world) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
     let mut ground_world = CollisionWorld::new(&solver);
     ground_world
         .add_collider(&ground(-weft_collide::scenarios::SPHERE_RADIUS))
         .expect("ground");
+    println!(
+        "solver kernel path: {} (WEFT_SIMD=avx512|avx2|scalar forces one)",
+        solver.simd_path()
+    );
     println!("static, 128² cloth, per frame (median of {reps}):");
     let solve = bare(reps, &solver);
     let ground_only = with(reps, &solver, &ground_world);

@@ -147,34 +147,23 @@ impl Bvh {
         }
     }
 
-    /// Branch and bound: the primitive minimising `distance_squared(i)` (a value no less
-    /// than the squared distance from `x` to its box) among those below `limit_squared`,
-    /// nearer children first; ties keep the first found, so the answer is a function of the
-    /// input.
-    pub fn nearest<T>(
-        &self,
-        x: DVec3,
-        limit_squared: f64,
-        mut distance_squared: impl FnMut(usize) -> Option<(f64, T)>,
-    ) -> Option<(usize, f64, T)> {
-        let mut best: Option<(usize, f64, T)> = None;
-        let mut bound = limit_squared;
+    /// Branch and bound: calls `leaf(i)` for every primitive in a leaf whose box, and every
+    /// ancestor's box, lies within the current limit of `x` (squared; `limit` at first, then
+    /// what the last `leaf` call returned: it may shrink as the search finds nearer
+    /// primitives), nearer children first; in an order that is a function of the input.
+    pub fn branch_and_bound(&self, x: DVec3, limit: f64, mut leaf: impl FnMut(usize) -> f64) {
+        let mut limit = limit;
         let mut stack = [0u32; 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = self.nodes[stack[top] as usize];
-            if box_distance_squared(x, node.lo, node.hi) > bound {
+            if box_distance_squared(x, node.lo, node.hi) > limit {
                 continue;
             }
             if node.count > 0 {
                 for i in node.first..node.first + node.count {
-                    if let Some((d2, info)) = distance_squared(i as usize)
-                        && d2 < bound
-                    {
-                        bound = d2;
-                        best = Some((i as usize, d2, info));
-                    }
+                    limit = leaf(i as usize);
                 }
             } else {
                 let (a, b) = (node.first, node.first + 1);
@@ -193,6 +182,29 @@ impl Bvh {
                 top += 2;
             }
         }
+    }
+
+    /// Branch and bound: the primitive minimising `distance_squared(i, bound)` (a value no
+    /// less than the squared distance from `x` to its box; `None` if it is certainly no less
+    /// than `bound`, the best so far) among those below `limit_squared`; ties keep the first
+    /// found, so the answer is a function of the input.
+    pub fn nearest<T>(
+        &self,
+        x: DVec3,
+        limit_squared: f64,
+        mut distance_squared: impl FnMut(usize, f64) -> Option<(f64, T)>,
+    ) -> Option<(usize, f64, T)> {
+        let mut best: Option<(usize, f64, T)> = None;
+        let mut bound = limit_squared;
+        self.branch_and_bound(x, limit_squared, |i| {
+            if let Some((d2, info)) = distance_squared(i, bound)
+                && d2 < bound
+            {
+                bound = d2;
+                best = Some((i, d2, info));
+            }
+            bound
+        });
         best
     }
 }

@@ -16,6 +16,9 @@
 use glam::DVec3;
 
 use super::MeshGeometry;
+#[cfg(test)]
+#[path = "candidates_tests.rs"]
+mod tests;
 use super::bvh::box_distance_squared;
 use super::ccd::{Crossing, moving_crossing, segment_crossing};
 use super::closest::closest_on_triangle;
@@ -28,7 +31,10 @@ pub(crate) const SKIN: f64 = 0.5;
 
 /// Pushes per particle and projection (a push out of one face may land in another, in a
 /// concave corner).
-const ROUNDS: usize = 3;
+pub(crate) const ROUNDS: usize = 3;
+
+/// Triangles near enough to a contact to be checked again after its push, at most.
+const NEAR: usize = 16;
 
 /// The candidate lists of one mesh collider for one chunk of particles.
 #[derive(Clone, Debug, Default)]
@@ -53,6 +59,8 @@ pub(crate) struct ChunkLists {
     tris: Vec<u32>,
     /// Entries in use.
     live: usize,
+    /// The arena's spare buffer, for compaction.
+    spare: Vec<u32>,
     /// Lists built so far.
     pub builds: u64,
 }
@@ -70,6 +78,7 @@ impl ChunkLists {
             range: vec![(0, 0); n],
             tris: Vec::new(),
             live: 0,
+            spare: Vec::new(),
             builds: 0,
         }
     }
@@ -79,18 +88,20 @@ impl ChunkLists {
         self.live
     }
 
-    /// Drops stale entries once they are more than half the arena.
+    /// Drops stale entries and puts the lists back in particle order (the contact loop then
+    /// reads the arena front to back), whenever a list was rebuilt.
     pub fn compact(&mut self) {
-        if self.tris.len() <= 2 * self.live + 4096 {
+        if self.tris.len() == self.live {
             return;
         }
-        let mut fresh = Vec::with_capacity(2 * self.live + 64);
+        let mut fresh = std::mem::take(&mut self.spare);
+        fresh.clear();
         for r in &mut self.range {
             let s = fresh.len() as u32;
             fresh.extend_from_slice(&self.tris[r.0 as usize..(r.0 + r.1) as usize]);
             *r = (s, r.1);
         }
-        self.tris = fresh;
+        self.spare = std::mem::replace(&mut self.tris, fresh);
     }
 }
 
@@ -158,47 +169,51 @@ impl MeshFrame<'_> {
         }
     }
 
-    /// Makes particle `j`'s list valid for position `x` and path start `from` (local).
-    fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+    /// Whether particle `j`'s list holds every triangle within `r` of `x` and of the path
+    /// `from → x` (local).
+    fn valid(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
         let g = self.geometry;
         let anchor = lists.anchor[j];
         // max(|x − anchor|, |from − anchor|) ≤ slack, compared squared.
         let slack = lists.radius[j] - (g.travel - lists.travel[j]) - r;
-        if slack >= 0.0
+        slack >= 0.0
             && (x - anchor)
                 .length_squared()
                 .max((from - anchor).length_squared())
                 <= slack * slack
-        {
+    }
+
+    /// Makes particle `j`'s list valid for position `x` and path start `from` (local).
+    fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+        if self.valid(lists, j, x, from, r) {
             return;
         }
+        let g = self.geometry;
         lists.builds += 1;
         let radius = r * (1.0 + SKIN) + (from - x).length() + (g.travel - g.travel_before);
         let old = lists.range[j];
         lists.live -= old.1 as usize;
+        let (lo, hi) = g.bounds();
+        let outside_box = box_distance_squared(x, lo, hi).sqrt();
+        // Inside a closed mesh's box an empty list needs the nearest triangle of all (the
+        // inside flag and the clearance): the same search finds it.
+        let deep = g.closed() && outside_box == 0.0;
         let start = lists.tris.len();
-        let nearest = g.within(x, radius, &mut lists.tris);
+        let nearest = g.within(x, radius, deep, &mut lists.tris);
         let len = lists.tris.len() - start;
         lists.live += len;
         lists.range[j] = (start as u32, len as u32);
         lists.anchor[j] = x;
         lists.travel[j] = g.travel_before;
-        let closed = g.closed();
-        let (lo, hi) = g.bounds();
-        let outside_box = box_distance_squared(x, lo, hi).sqrt();
-        let (clearance, inside) = if let Some(p) = nearest {
+        let (clearance, inside) = match nearest {
             // The nearest listed triangle is the nearest of all (it is within R).
-            (radius, p.distance < 0.0)
-        } else if !closed || outside_box > 0.0 {
-            (radius.max(outside_box), false)
-        } else {
-            match g.nearest(x, f64::INFINITY) {
-                Some(p) => (
-                    radius.max(p.distance.abs() * (1.0 - 1e-12)),
-                    p.distance < 0.0,
-                ),
-                None => (radius, false),
-            }
+            Some(p) if len > 0 => (radius, p.distance < 0.0),
+            Some(p) => (
+                radius.max(p.distance.abs() * (1.0 - 1e-12)),
+                p.distance < 0.0,
+            ),
+            None if deep => (radius, false),
+            None => (radius.max(outside_box), false),
         };
         lists.radius[j] = clearance;
         lists.inside[j] = inside;
@@ -223,7 +238,8 @@ impl MeshFrame<'_> {
         } else {
             0.0
         };
-        if (x - from).length() + surface <= 0.5 * r {
+        let short = 0.5 * r - surface;
+        if short >= 0.0 && (x - from).length_squared() <= short * short {
             return None;
         }
         let mut best: Option<(Crossing, usize)> = None;
@@ -280,7 +296,14 @@ impl MeshFrame<'_> {
         // Continuous: a crossing on the path is undone, the particle left r off the surface
         // (where the surface is at the end of the substep) on the side it came from.
         self.ensure(lists, j, xl, from, r);
+        // The list is valid where the particle is (ensure needs calling only after a move).
+        let mut listed = true;
         let (s, len) = lists.range[j];
+        if len == 0 && !lists.inside[j] {
+            // No triangle within r of the particle or its path: nothing to do.
+            lists.last[j] = xl;
+            return out;
+        }
         if let Some((c, t)) =
             self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl, r)
         {
@@ -288,6 +311,7 @@ impl MeshFrame<'_> {
             let [a, b, cc] = f.corners;
             let hit = a * c.bary[0] + b * c.bary[1] + cc * c.bary[2];
             moved(&mut xl, x, hit + f.normal * (c.side * r));
+            listed = false;
             out.swept += 1;
         }
         // After a push by δ every distance drops by at most δ: a round is needed again only
@@ -297,37 +321,62 @@ impl MeshFrame<'_> {
             if !again {
                 break;
             }
-            self.ensure(lists, j, xl, from, r);
+            if !listed {
+                self.ensure(lists, j, xl, from, r);
+            }
+            listed = false; // a push follows, or the loop ends
             let (s, len) = lists.range[j];
             let mut best: Option<(f64, usize, super::closest::Closest)> = None;
             let mut bound = r * r;
             let mut second = f64::INFINITY;
             let x32 = xl.as_vec3();
             let hint = lists.hint[j];
-            if let Some(f) = g.faces.get(hint as usize)
-                && f64::from(g.planes[hint as usize].distance_squared_bound(x32, g.margin)) < bound
-            {
-                let [a, b, c] = f.corners;
-                let q = closest_on_triangle(xl, a, b, c);
-                let d2 = (xl - q.point).length_squared();
-                if d2 < bound {
-                    bound = d2;
-                    best = Some((d2, hint as usize, q));
+            // The triangles whose bound is within 2r (a push and a slip of up to r may bring
+            // them within r) with that bound, and the least bound of the others (squared).
+            let (mut near, mut n_near, mut others) = ([(0u32, 0.0f64); NEAR], 0, f64::INFINITY);
+            let mut note = |t: u32, lower: f64| {
+                if lower >= 4.0 * r * r {
+                    others = others.min(lower);
+                } else if n_near < NEAR {
+                    near[n_near] = (t, lower);
+                    n_near += 1;
+                } else {
+                    others = 0.0; // too many to follow
                 }
+            };
+            if let Some(f) = g.faces.get(hint as usize) {
+                let mut lower = f64::from(f.planes.distance_squared_bound(x32, g.margin));
+                if lower < bound {
+                    let [a, b, c] = f.corners;
+                    let q = closest_on_triangle(xl, a, b, c);
+                    let d2 = (xl - q.point).length_squared();
+                    lower = d2;
+                    if d2 < bound {
+                        bound = d2;
+                        best = Some((d2, hint as usize, q));
+                    }
+                }
+                note(hint, lower);
             }
             for &t in &lists.tris[s as usize..(s + len) as usize] {
                 if t == hint {
                     continue;
                 }
                 // Cheap reject: the plane and edge lines are no farther than the triangle.
-                let lower = f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin));
+                let lower = f64::from(
+                    g.faces[t as usize]
+                        .planes
+                        .distance_squared_bound(x32, g.margin),
+                );
                 if lower >= bound {
+                    note(t, lower);
                     second = second.min(lower);
                     continue;
                 }
                 let [a, b, c] = g.faces[t as usize].corners;
                 let q = closest_on_triangle(xl, a, b, c);
                 let d2 = (xl - q.point).length_squared();
+                note(t, d2);
                 if d2 < bound {
                     if best.is_some() {
                         second = second.min(bound);
@@ -338,6 +387,7 @@ impl MeshFrame<'_> {
                     second = second.min(d2);
                 }
             }
+            let scanned_at = xl;
             let hit = match best {
                 Some((d2, t, q)) => {
                     let mut p = g.signed(xl, t, q, d2);
@@ -360,6 +410,9 @@ impl MeshFrame<'_> {
                 }
                 None => break,
             };
+            // From outside, a push along the closest direction leaves the (convex) triangle at
+            // distance r, and a slip across that direction keeps it there.
+            let along_closest = best.is_some_and(|b| b.0 > 1e-24) && hit.distance > 0.0;
             lists.hint[j] = hit.triangle as u32;
             let depth = r - hit.distance;
             if depth <= 1e-6 * r.max(1e-3) {
@@ -379,6 +432,28 @@ impl MeshFrame<'_> {
                 again |= second.sqrt() - depth - correction.length() < r;
                 *x -= correction;
                 xl = self.to_local(self.pose, *x);
+            }
+            // Another round only if a triangle other than the one just left may be within r
+            // where the particle is now: for those followed, a bound at the scan less the move,
+            // then a bound here, then the distance; the others' least bound less the move; on
+            // a list still valid here.
+            if again && along_closest {
+                let moved = (xl - scanned_at).length();
+                if others.sqrt() - moved >= r && self.valid(lists, j, xl, from, r) {
+                    let x32 = xl.as_vec3();
+                    again = near[..n_near].iter().any(|&(t, was)| {
+                        let t = t as usize;
+                        t != hit.triangle
+                            && was.sqrt() - moved < r
+                            && f64::from(g.faces[t].planes.distance_squared_bound(x32, g.margin))
+                                < r * r
+                            && {
+                                let [a, b, c] = g.faces[t].corners;
+                                (xl - closest_on_triangle(xl, a, b, c).point).length_squared()
+                                    < r * r
+                            }
+                    });
+                }
             }
             out.contacts += 1;
             out.depth = out.depth.max(depth);

@@ -11,53 +11,39 @@ pub(crate) mod closest;
 pub(crate) mod deforming;
 pub(crate) mod normals;
 #[cfg(test)]
+mod queries_vs_brute_force;
+#[cfg(test)]
 mod vs_parry;
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use bvh::{Bvh, box_distance_squared};
+use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
 use normals::{Topology, face_normal, pseudo_normal};
 
-/// One triangle at the end of the substep: its corners, unit normal and in-plane outward
-/// edge normals (what the contact loops read, kept together for the cache).
+/// One triangle at the end of the substep: its f32 planes, corners and unit normal (what the
+/// contact loops read), in three adjacent cache lines: the bound first, then the corners that
+/// a triangle passing it needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub(crate) struct Face {
+    /// The planes of the cheap distance bound.
+    pub planes: Planes,
     /// Corners a, b, c (m, the collider's frame).
     pub corners: [DVec3; 3],
     /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
     pub normal: DVec3,
-    /// Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
-    pub edges: [DVec3; 3],
 }
 
 impl Face {
     fn new(corners: [DVec3; 3]) -> Self {
         let normal = face_normal(corners[0], corners[1], corners[2]);
-        let edge = |k: usize| {
-            (corners[(k + 1) % 3] - corners[k])
-                .cross(normal)
-                .normalize_or_zero()
-        };
         Self {
+            planes: Planes::new(corners, normal),
             corners,
             normal,
-            edges: [edge(0), edge(1), edge(2)],
         }
-    }
-
-    /// A lower bound on the squared distance from `x` to the triangle: the squared distance
-    /// to its plane plus the square of the farthest in-plane distance beyond an edge's line.
-    #[inline]
-    pub fn distance_squared_bound(&self, x: DVec3) -> f64 {
-        let h = self.normal.dot(x - self.corners[0]);
-        let beyond = self.edges[0]
-            .dot(x - self.corners[0])
-            .max(self.edges[1].dot(x - self.corners[1]))
-            .max(self.edges[2].dot(x - self.corners[2]))
-            .max(0.0);
-        h * h + beyond * beyond
     }
 }
 
@@ -68,13 +54,20 @@ impl Face {
 pub(crate) struct Planes([f32; 16]);
 
 impl Planes {
-    fn new(f: &Face) -> Self {
+    /// The planes of the triangle with `corners` and unit `normal`.
+    fn new(corners: [DVec3; 3], normal: DVec3) -> Self {
+        // Unit in-plane normal of edge k (corners k, k + 1), pointing away from the triangle.
+        let edge = |k: usize| {
+            (corners[(k + 1) % 3] - corners[k])
+                .cross(normal)
+                .normalize_or_zero()
+        };
         let mut p = [0f32; 16];
         let planes = [
-            (f.normal, f.corners[0]),
-            (f.edges[0], f.corners[0]),
-            (f.edges[1], f.corners[1]),
-            (f.edges[2], f.corners[2]),
+            (normal, corners[0]),
+            (edge(0), corners[0]),
+            (edge(1), corners[1]),
+            (edge(2), corners[2]),
         ];
         for (k, (n, at)) in planes.into_iter().enumerate() {
             p[4 * k..4 * k + 3].copy_from_slice(&n.as_vec3().to_array());
@@ -84,7 +77,8 @@ impl Planes {
     }
 
     /// A lower bound on the squared distance from `x` to the triangle, less `margin` (the
-    /// f32 rounding of these terms) on each part: as [`Face::distance_squared_bound`].
+    /// f32 rounding of these terms) on each part: the squared distance to the plane plus the
+    /// square of the farthest in-plane distance beyond an edge's line.
     #[inline]
     pub fn distance_squared_bound(&self, x: glam::Vec3, margin: f32) -> f32 {
         let p = &self.0;
@@ -123,10 +117,10 @@ pub(crate) struct MeshGeometry {
     pub end: Vec<DVec3>,
     /// Faces at the end of the substep, in storage order.
     pub faces: Vec<Face>,
-    /// Their planes in f32, for the contact loops' first test.
-    pub planes: Vec<Planes>,
     /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
     pub margin: f32,
+    /// The largest vertex coordinate, in absolute value (m).
+    pub extent: f64,
     /// Adjacency and closedness.
     pub topology: Topology,
     /// Boxes of the triangles over the substep (start and end).
@@ -157,8 +151,8 @@ impl MeshGeometry {
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         let mut geometry = Self {
             faces: Vec::new(),
-            planes: Vec::new(),
             margin: 0.0,
+            extent: 0.0,
             triangles,
             rest: vertices.to_vec(),
             start: vertices.to_vec(),
@@ -170,7 +164,6 @@ impl MeshGeometry {
             moving: false,
         };
         geometry.faces = geometry.compute_faces();
-        geometry.planes = geometry.faces.iter().map(Planes::new).collect();
         geometry.set_margin(extent);
         geometry
     }
@@ -178,7 +171,14 @@ impl MeshGeometry {
     /// The rounding margin for particles near a mesh within `extent` of the origin: a few
     /// f32 ulps of the largest coordinate (with the lists' reach, 1 m).
     fn set_margin(&mut self, extent: f64) {
+        self.extent = extent;
         self.margin = (1e-6 * (extent + 1.0)) as f32;
+    }
+
+    /// The rounding margin of [`Planes::distance_squared_bound`] for a particle at `x`,
+    /// anywhere: as [`Self::margin`] with x's own size added.
+    fn margin_at(&self, x: DVec3) -> f32 {
+        (1e-6 * (self.extent + x.abs().max_element() + 1.0)) as f32
     }
 
     fn compute_faces(&self) -> Vec<Face> {
@@ -214,12 +214,6 @@ impl MeshGeometry {
             return;
         }
         self.faces = self.compute_faces();
-        self.planes = self
-            .faces
-            .par_iter()
-            .with_min_len(1024)
-            .map(Planes::new)
-            .collect();
         let extent = self
             .end
             .iter()
@@ -286,7 +280,12 @@ impl MeshGeometry {
         } else {
             f64::INFINITY
         };
-        let (t, d2, c) = self.bvh.nearest(x, limit, |t| {
+        let (x32, margin) = (x.as_vec3(), self.margin_at(x));
+        let (t, d2, c) = self.bvh.nearest(x, limit, |t, bound| {
+            // Cheap reject: a lower bound no nearer than the best so far.
+            if f64::from(self.faces[t].planes.distance_squared_bound(x32, margin)) >= bound {
+                return None;
+            }
             let [a, b, cc] = faces[t].corners;
             let c = closest_on_triangle(x, a, b, cc);
             Some(((x - c.point).length_squared(), c))
@@ -295,29 +294,40 @@ impl MeshGeometry {
     }
 
     /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
-    /// a fixed order; returns the nearest of them.
-    pub fn within(&self, x: DVec3, radius: f64, out: &mut Vec<u32>) -> Option<MeshPoint> {
+    /// a fixed order; returns the nearest of them or, with `beyond`, the nearest triangle of
+    /// all (found in the same search).
+    pub fn within(
+        &self,
+        x: DVec3,
+        radius: f64,
+        beyond: bool,
+        out: &mut Vec<u32>,
+    ) -> Option<MeshPoint> {
         let r2 = radius * radius;
         let faces = &self.faces;
+        let (x32, margin) = (x.as_vec3(), self.margin_at(x));
         let mut best: Option<(f64, usize, Closest)> = None;
-        self.bvh.visit(
-            |lo, hi| box_distance_squared(x, lo, hi) <= r2,
-            |t| {
-                let f = &faces[t];
-                if f.distance_squared_bound(x) > r2 {
-                    return;
+        // What a triangle must be within to matter: r², or the best so far beyond it.
+        let mut limit = if beyond { f64::INFINITY } else { r2 };
+        self.bvh.branch_and_bound(x, limit, |t| {
+            // Cheap reject on the planes (one cache line) before the corners.
+            if f64::from(self.faces[t].planes.distance_squared_bound(x32, margin)) > limit {
+                return limit;
+            }
+            let [a, b, c] = faces[t].corners;
+            let q = closest_on_triangle(x, a, b, c);
+            let d2 = (x - q.point).length_squared();
+            if d2 <= r2 {
+                out.push(t as u32);
+            }
+            if d2 <= limit && best.is_none_or(|b| d2 < b.0) {
+                best = Some((d2, t, q));
+                if beyond {
+                    limit = d2.max(r2);
                 }
-                let [a, b, c] = f.corners;
-                let q = closest_on_triangle(x, a, b, c);
-                let d2 = (x - q.point).length_squared();
-                if d2 <= r2 {
-                    out.push(t as u32);
-                    if best.is_none_or(|b| d2 < b.0) {
-                        best = Some((d2, t, q));
-                    }
-                }
-            },
-        );
+            }
+            limit
+        });
         best.map(|(d2, t, q)| self.signed(x, t, q, d2))
     }
 

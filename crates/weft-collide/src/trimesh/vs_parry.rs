@@ -12,7 +12,7 @@ use crate::mesh::TriangleMesh;
 use crate::shape::ShapeDesc;
 
 /// A closed, non-convex mesh: an icosphere with pseudo-random bumps.
-fn bumpy_sphere() -> TriangleMesh {
+pub(super) fn bumpy_sphere() -> TriangleMesh {
     let mut m = TriangleMesh::icosphere(0.5, 3);
     let mut rng = Rng(11);
     for v in &mut m.vertices {
