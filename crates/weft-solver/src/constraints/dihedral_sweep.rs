@@ -116,27 +116,26 @@ fn run_modes<const L: usize>(seg: &mut Segment) {
     }
 }
 
-/// Full chunks of `L` constraints through the `L`-lane kernel, then the rest as one chunk
-/// with its spare lanes idle (they repeat the first constraint's inputs and are not written
-/// back; every lane's arithmetic is its own, so the bits are those of one lane at a time).
+/// Full chunks of `L` constraints through the `L`-lane kernel, the rest one at a time.
 #[inline(always)]
 fn run_with<const L: usize, const DAMPED: bool>(seg: &mut Segment) {
     let n = seg.idx.len();
     let full = n / L * L;
     for start in (0..full).step_by(L) {
-        chunk::<L, DAMPED>(seg, start, L);
+        chunk::<L, DAMPED>(seg, start);
     }
-    if full < n {
-        chunk::<L, DAMPED>(seg, full, n - full);
+    for k in full..n {
+        chunk::<1, DAMPED>(seg, k);
     }
 }
 
-/// Gathers constraints `start .. start + active` (`active` ≤ `L`) into lanes, projects them,
-/// scatters their positions and multipliers back.
+/// Gathers constraints `start .. start + L`, projects them, scatters the positions back.
 #[inline(always)]
-fn chunk<const L: usize, const DAMPED: bool>(seg: &mut Segment, start: usize, active: usize) {
-    let pick = |l: usize| start + if l < active { l } else { 0 };
-    let idx: [[u32; 4]; L] = std::array::from_fn(|l| seg.idx[pick(l)]);
+fn chunk<const L: usize, const DAMPED: bool>(seg: &mut Segment, start: usize) {
+    let idx: &[[u32; 4]; L] = match seg.idx[start..start + L].try_into() {
+        Ok(a) => a,
+        Err(_) => return,
+    };
     // Slice-local indices, clamped into the slice (a no-op for the block's constraints) so
     // that the loads below need no bounds checks and compile to vector gathers.
     let last = seg.x.len().saturating_sub(1);
@@ -169,16 +168,18 @@ fn chunk<const L: usize, const DAMPED: bool>(seg: &mut Segment, start: usize, ac
             w[v][l] = mass[(at[v][l] + seg.base).min(mass.len().saturating_sub(1))];
         }
     }
-    let rest: [f64; L] = std::array::from_fn(|l| seg.shapes[pick(l)].rest);
-    let coef = Coefs::from_fn(|l| seg.coef[seg.groups[pick(l)] as usize]);
-    let mut lambda: [f64; L] = std::array::from_fn(|l| seg.lambda[pick(l)]);
-    dihedral_lanes::project::<L, DAMPED>(&mut x, &prev, &w, &rest, &coef, &mut lambda);
+    let rest: [f64; L] = std::array::from_fn(|l| seg.shapes[start + l].rest);
+    let coef = Coefs::from_fn(|l| seg.coef[seg.groups[start + l] as usize]);
+    let lambda: &mut [f64; L] = match (&mut seg.lambda[start..start + L]).try_into() {
+        Ok(a) => a,
+        Err(_) => return,
+    };
+    dihedral_lanes::project::<L, DAMPED>(&mut x, &prev, &w, &rest, &coef, lambda);
     for v in 0..4 {
-        for l in 0..active {
+        for l in 0..L {
             seg.x[at[v][l]] = DVec3::new(x[v][0][l], x[v][1][l], x[v][2][l]);
         }
     }
-    seg.lambda[start..start + active].copy_from_slice(&lambda[..active]);
 }
 
 impl Block<4, Dihedral> {
