@@ -17,35 +17,24 @@ use super::{Block, Dihedral, Rule};
 use crate::domains::SimdPath;
 use crate::params::FamilyParams;
 
-/// The per-group coefficients of `rule`; under PBD each half of the symmetric sweep uses
-/// k' = 1 − (1 − k)^(1/2) (see [`Block::project_symmetric_lanes`]). A disabled group gets k = 0,
-/// α̃ = 1, γ = 0, which leaves its constraints (whose λ stays 0) where they are.
+/// The per-group coefficients of `rule` ([`Coef::of`]), and whether any group is damped; under
+/// PBD each half of the symmetric sweep uses k' = 1 − (1 − k)^(1/2) (see
+/// [`Block::project_symmetric_lanes`]).
 fn coefficients(params: &[FamilyParams], rule: Rule) -> (Vec<Coef>, bool) {
-    let mut damped = false;
-    let coef = params
+    let coef: Vec<Coef> = params
         .iter()
-        .map(|p| match (p.enabled, rule) {
-            (false, _) => Coef {
-                k: 0.0,
-                alpha: 1.0,
-                gamma: 0.0,
-            },
-            (true, Rule::Xpbd { h }) => {
-                let (alpha, gamma) = Rule::xpbd_terms(p, h);
-                damped |= gamma > 0.0;
-                Coef {
-                    k: 1.0,
-                    alpha,
-                    gamma,
-                }
+        .map(|p| {
+            let c = Coef::of(p, rule);
+            match rule {
+                Rule::Pbd if p.enabled => Coef {
+                    k: 1.0 - (1.0 - c.k).sqrt(),
+                    ..c
+                },
+                _ => c,
             }
-            (true, Rule::Pbd) => Coef {
-                k: 1.0 - (1.0 - p.pbd_stiffness).sqrt(),
-                alpha: 0.0,
-                gamma: 0.0,
-            },
         })
         .collect();
+    let damped = (params.iter().zip(&coef)).any(|(p, c)| p.enabled && c.gamma > 0.0);
     (coef, damped)
 }
 

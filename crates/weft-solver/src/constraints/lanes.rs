@@ -9,6 +9,9 @@
 // that each compiles to one vector operation per axis.
 #![allow(clippy::needless_range_loop)]
 
+use super::Rule;
+use crate::params::FamilyParams;
+
 /// Lanes per SIMD chunk (8 × f64: one AVX-512 register, two AVX2 ones, four SSE2 ones).
 pub(crate) const LANES: usize = 8;
 
@@ -21,6 +24,33 @@ pub(crate) struct Coef {
     pub alpha: f64,
     /// Damping γ = α β / h (XPBD, Macklin et al. 2016 eq. 26; 0 for PBD).
     pub gamma: f64,
+}
+
+impl Coef {
+    /// The coefficients of a family with parameters `p` under `rule`. A disabled family gets
+    /// k = 0, α̃ = 1, γ = 0, which leaves its constraints (whose λ stays 0) where they are.
+    pub fn of(p: &FamilyParams, rule: Rule) -> Self {
+        match (p.enabled, rule) {
+            (false, _) => Self {
+                k: 0.0,
+                alpha: 1.0,
+                gamma: 0.0,
+            },
+            (true, Rule::Xpbd { h }) => {
+                let (alpha, gamma) = Rule::xpbd_terms(p, h);
+                Self {
+                    k: 1.0,
+                    alpha,
+                    gamma,
+                }
+            }
+            (true, Rule::Pbd) => Self {
+                k: p.pbd_stiffness,
+                alpha: 0.0,
+                gamma: 0.0,
+            },
+        }
+    }
 }
 
 /// [`Coef`] for `L` lanes, struct-of-arrays.

@@ -189,26 +189,7 @@ impl Domains {
         self.coef.clear();
         self.mode = Mode::default();
         for p in params {
-            let c = match (p.enabled, rule) {
-                (false, _) => Coef {
-                    k: 0.0,
-                    alpha: 1.0,
-                    gamma: 0.0,
-                },
-                (true, Rule::Xpbd { h }) => {
-                    let (alpha, gamma) = Rule::xpbd_terms(p, h);
-                    Coef {
-                        k: 1.0,
-                        alpha,
-                        gamma,
-                    }
-                }
-                (true, Rule::Pbd) => Coef {
-                    k: p.pbd_stiffness,
-                    alpha: 0.0,
-                    gamma: 0.0,
-                },
-            };
+            let c = Coef::of(p, rule);
             if p.enabled {
                 self.mode.damped |= c.gamma > 0.0;
                 self.mode.lambda |= c.alpha > 0.0;
