@@ -10,12 +10,12 @@ use super::parts;
 use crate::coloring::color;
 use crate::params::FamilyParams;
 
-/// Colours with at least this many constraints are computed in parallel (dihedral, tethers).
+/// Colours with at least this many constraints are computed in parallel (tethers, seams; the
+/// dihedrals have their own sweep, `dihedral_sweep.rs`).
 ///
 /// A parallel colour costs one rayon fork–join (a few µs) and a serial pass applying the scratch
-/// corrections; a dihedral's projection costs about 0.1 µs, so 512 of them already outweigh the
-/// fork. (The 10,172-particle T-shirt's ~30,000 dihedrals fall into colours smaller than the
-/// former 4,096 — the distance domains' particle count reused — so they all ran serially.)
+/// corrections; a scalar projection costs about 0.1 µs, so 512 of them already outweigh the
+/// fork.
 const PARALLEL_MIN_BATCH: usize = 512;
 
 /// Smallest number of constraints one parallel task takes from a colour.
