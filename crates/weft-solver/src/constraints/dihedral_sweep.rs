@@ -38,16 +38,26 @@ fn coefficients(params: &[FamilyParams], rule: Rule) -> (Vec<Coef>, bool) {
     (coef, damped)
 }
 
+/// What every run of one sweep shares.
+struct Sweep<'a> {
+    /// Previous positions (global), read when damped.
+    prev: &'a [DVec3],
+    /// Inverse masses (global).
+    w: &'a [f64],
+    /// Coefficients per group.
+    coef: &'a [Coef],
+    /// Whether any group is damped.
+    damped: bool,
+    /// The kernel path.
+    path: SimdPath,
+}
+
 /// One run of constraints projected on one slice of the positions.
 struct Segment<'a> {
     /// The positions of particles `base ..`.
     x: &'a mut [DVec3],
     /// Global index of `x[0]`.
     base: usize,
-    /// Previous positions (global), read when damped.
-    prev: &'a [DVec3],
-    /// Inverse masses (global).
-    w: &'a [f64],
     /// The constraints' particles (global indices, all in `base .. base + x.len()`).
     idx: &'a [[u32; 4]],
     /// Their rest angles.
@@ -56,15 +66,34 @@ struct Segment<'a> {
     groups: &'a [u32],
     /// Their multipliers.
     lambda: &'a mut [f64],
-    /// Coefficients per group.
-    coef: &'a [Coef],
-    /// Whether any group is damped.
-    damped: bool,
+    /// The sweep's shared inputs.
+    sweep: &'a Sweep<'a>,
 }
 
-/// [`Segment`] projected on kernel path `path` (every path gives the same bits).
-fn run(seg: &mut Segment, path: SimdPath) {
-    match path {
+/// Projects the block's constraints `r` (arrays `particles`, `shapes`, `groups`; multipliers
+/// `lambda`, already sliced to `r`) on the positions `x` of particles `base ..`, on the
+/// sweep's kernel path (every path gives the same bits).
+#[allow(clippy::too_many_arguments)]
+fn project_run(
+    sweep: &Sweep,
+    x: &mut [DVec3],
+    base: usize,
+    particles: &[[u32; 4]],
+    shapes: &[Dihedral],
+    groups: &[u32],
+    r: Range<usize>,
+    lambda: &mut [f64],
+) {
+    let seg = &mut Segment {
+        x,
+        base,
+        idx: &particles[r.clone()],
+        shapes: &shapes[r.clone()],
+        groups: &groups[r],
+        lambda,
+        sweep,
+    };
+    match sweep.path {
         SimdPath::Avx512 => run_avx512(seg),
         SimdPath::Avx2 => run_avx2(seg),
         SimdPath::Neon => run_neon(seg),
@@ -72,7 +101,7 @@ fn run(seg: &mut Segment, path: SimdPath) {
     }
 }
 
-/// [`run`] compiled for AVX-512 (the baseline build where the CPU lacks it), over 4 lanes: 8
+/// [`project_run`] compiled for AVX-512 (the baseline build where the CPU lacks it), over 4 lanes: 8
 /// lanes (gathers, scatters and twice the lane arrays) measured 17 % slower on Zen 4 (T-shirt
 /// solve only, 2 threads: 26.4–29.6 against 21.9–23.6 ms).
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
@@ -80,19 +109,19 @@ fn run_avx512(seg: &mut Segment) {
     run_modes::<4>(seg);
 }
 
-/// [`run`] compiled for AVX2 and FMA.
+/// [`project_run`] compiled for AVX2 and FMA.
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn run_avx2(seg: &mut Segment) {
     run_modes::<4>(seg);
 }
 
-/// [`run`] compiled for NEON.
+/// [`project_run`] compiled for NEON.
 #[multiversion(targets("aarch64+neon"))]
 fn run_neon(seg: &mut Segment) {
     run_modes::<2>(seg);
 }
 
-/// [`run`] compiled for the baseline target.
+/// [`project_run`] compiled for the baseline target.
 #[inline(never)]
 fn run_scalar(seg: &mut Segment) {
     run_modes::<2>(seg);
@@ -100,7 +129,7 @@ fn run_scalar(seg: &mut Segment) {
 
 #[inline(always)]
 fn run_modes<const L: usize>(seg: &mut Segment) {
-    if seg.damped {
+    if seg.sweep.damped {
         run_with::<L, true>(seg);
     } else {
         run_with::<L, false>(seg);
@@ -139,7 +168,7 @@ fn chunk<const L: usize, const DAMPED: bool>(seg: &mut Segment, start: usize) {
     let mut x: Quads<L> = [[[0.0; L]; 3]; 4];
     let mut prev: Quads<L> = [[[0.0; L]; 3]; 4];
     let mut w = [[0.0; L]; 4];
-    let (pos, old, mass) = (&*seg.x, seg.prev, seg.w);
+    let (pos, old, mass) = (&*seg.x, seg.sweep.prev, seg.sweep.w);
     for v in 0..4 {
         for l in 0..L {
             let p = pos[at[v][l]];
@@ -160,7 +189,7 @@ fn chunk<const L: usize, const DAMPED: bool>(seg: &mut Segment, start: usize) {
         }
     }
     let rest: [f64; L] = std::array::from_fn(|l| seg.shapes[start + l].rest);
-    let coef = Coefs::from_fn(|l| seg.coef[seg.groups[start + l] as usize]);
+    let coef = Coefs::from_fn(|l| seg.sweep.coef[seg.groups[start + l] as usize]);
     let lambda: &mut [f64; L] = match (&mut seg.lambda[start..start + L]).try_into() {
         Ok(a) => a,
         Err(_) => return,
@@ -201,25 +230,22 @@ impl Block<4, Dihedral> {
             return;
         }
         let (coef, damped) = coefficients(params, rule);
-        self.project_interiors(x, prev, w, &coef, damped, path, false);
-        self.project_straddlers(x, prev, w, &coef, damped, path, false);
-        self.project_straddlers(x, prev, w, &coef, damped, path, true);
-        self.project_interiors(x, prev, w, &coef, damped, path, true);
+        let sweep = Sweep {
+            prev,
+            w,
+            coef: &coef,
+            damped,
+            path,
+        };
+        self.project_interiors(x, &sweep, false);
+        self.project_straddlers(x, &sweep, false);
+        self.project_straddlers(x, &sweep, true);
+        self.project_interiors(x, &sweep, true);
     }
 
     /// Every part's constraints, colour by colour (backward: in reverse), one task per part on
     /// its own slice of the positions.
-    #[allow(clippy::too_many_arguments)]
-    fn project_interiors(
-        &mut self,
-        x: &mut [DVec3],
-        prev: &[DVec3],
-        w: &[f64],
-        coef: &[Coef],
-        damped: bool,
-        path: SimdPath,
-        backward: bool,
-    ) {
+    fn project_interiors(&mut self, x: &mut [DVec3], sweep: &Sweep, backward: bool) {
         let Block {
             particles,
             shapes,
@@ -255,21 +281,7 @@ impl Block<4, Dihedral> {
         let project = |(base, xp): (usize, &mut [DVec3]),
                        part_runs: Vec<(Range<usize>, &mut [f64])>| {
             let mut one = |(r, lam): (Range<usize>, &mut [f64])| {
-                run(
-                    &mut Segment {
-                        x: &mut *xp,
-                        base,
-                        prev,
-                        w,
-                        idx: &particles[r.clone()],
-                        shapes: &shapes[r.clone()],
-                        groups: &group[r],
-                        lambda: lam,
-                        coef,
-                        damped,
-                    },
-                    path,
-                )
+                project_run(sweep, xp, base, particles, shapes, group, r, lam)
             };
             if backward {
                 part_runs.into_iter().rev().for_each(&mut one);
@@ -290,41 +302,27 @@ impl Block<4, Dihedral> {
     }
 
     /// The straddlers, colour by colour (backward: in reverse), on the calling thread.
-    #[allow(clippy::too_many_arguments)]
-    fn project_straddlers(
-        &mut self,
-        x: &mut [DVec3],
-        prev: &[DVec3],
-        w: &[f64],
-        coef: &[Coef],
-        damped: bool,
-        path: SimdPath,
-        backward: bool,
-    ) {
+    fn project_straddlers(&mut self, x: &mut [DVec3], sweep: &Sweep, backward: bool) {
         let parts = self.part_bounds.len() - 1;
-        let k = self.colors.len();
-        let order: Vec<usize> = if backward {
-            (0..k).rev().collect()
-        } else {
-            (0..k).collect()
-        };
-        for c in order {
+        let mut colour = |c: usize| {
             let r = self.segments[c][parts]..self.segments[c][parts + 1];
-            run(
-                &mut Segment {
-                    x,
-                    base: 0,
-                    prev,
-                    w,
-                    idx: &self.particles[r.clone()],
-                    shapes: &self.shapes[r.clone()],
-                    groups: &self.group[r.clone()],
-                    lambda: &mut self.lambda[r],
-                    coef,
-                    damped,
-                },
-                path,
+            let lambda = &mut self.lambda[r.clone()];
+            project_run(
+                sweep,
+                x,
+                0,
+                &self.particles,
+                &self.shapes,
+                &self.group,
+                r,
+                lambda,
             );
+        };
+        let k = self.colors.len();
+        if backward {
+            (0..k).rev().for_each(&mut colour);
+        } else {
+            (0..k).for_each(&mut colour);
         }
     }
 }
@@ -335,17 +333,12 @@ mod tests {
 
     use super::*;
     use crate::constraints::BlockBuilder;
+    use crate::test_rand::rng;
     use crate::topology::Topology;
 
     /// A `n × n` grid of spacing 0.02 m, flat at rest, crumpled by up to ±`bump` in z.
     fn crumpled(n: u32, bump: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-        let mut seed = 0x6a09_e667_f3bc_c909u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = rng(0x6a09_e667_f3bc_c909);
         let x = (0..n * n)
             .map(|i| DVec3::new(0.02 * (i % n) as f64, 0.02 * (i / n) as f64, bump * rnd()))
             .collect();
