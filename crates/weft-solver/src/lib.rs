@@ -28,6 +28,8 @@ mod settings;
 mod solver;
 mod spring_defaults;
 mod stability;
+#[cfg(test)]
+mod test_rand;
 mod topology;
 
 pub use builder::SolverBuilder;

@@ -226,16 +226,7 @@ mod tests {
     use super::*;
     use crate::constraints::lanes::Coef;
     use crate::constraints::{Dihedral, Shape};
-
-    /// xorshift64 in [−0.5, 0.5).
-    fn rng(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-    }
+    use crate::test_rand::rng;
 
     fn quads<const L: usize>(p: &[[DVec3; 4]; L]) -> Quads<L> {
         std::array::from_fn(|v| std::array::from_fn(|k| std::array::from_fn(|l| p[l][v][k])))

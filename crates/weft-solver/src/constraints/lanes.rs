@@ -193,6 +193,7 @@ fn stiffness_term<const LAMBDA: bool, const UNIT_K: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rand::rng;
 
     fn ends<const L: usize>(p: [[f64; 3]; L], q: [[f64; 3]; L]) -> Ends<L> {
         Ends {
@@ -236,13 +237,7 @@ mod tests {
 
     #[test]
     fn lanes_agree_bit_for_bit_with_one_lane_at_a_time() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = rng(0x2545_f491_4f6c_dd1du64);
         let p: [[f64; 3]; LANES] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
         let q: [[f64; 3]; LANES] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
         let prev = ends(q, p);
@@ -295,13 +290,7 @@ mod tests {
     /// (what a sweep without multipliers passes) and k = 1 (XPBD), and compares bits.
     #[test]
     fn the_forms_without_lambda_or_k_give_the_general_bits() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = rng(0x9e37_79b9_7f4a_7c15u64);
         for round in 0..64 {
             let p: [[f64; 3]; LANES] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
             let q: [[f64; 3]; LANES] = std::array::from_fn(|_| [rnd(), rnd(), rnd()]);
