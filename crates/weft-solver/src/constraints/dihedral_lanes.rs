@@ -1,9 +1,11 @@
-//! The dihedral-bending projection written over `L` independent lanes at once.
+//! The dihedral-bending projection written over `L` independent lanes at once, in explicit
+//! vectors of any [`pulp::Simd`] (eight lanes of AVX-512, four of AVX2, portable or one-lane
+//! forms for the rest).
 //!
-//! As in [`super::lanes`], one generic function serves the SIMD chunks (`L` = the vector width)
-//! and the scalar remainder (`L = 1`): every lane runs the same IEEE operations in the same
-//! order, so a constraint gets bit-identical results whichever path projects it, and runs do
-//! not depend on the thread count, the kernel path or how constraints fall into chunks.
+//! One generic function serves the SIMD chunks (`L` = the vector width) and the scalar
+//! remainder (`L = 1`): every lane runs the same IEEE operations in the same order (no fused
+//! multiply-adds), so a constraint gets bit-identical results whichever path projects it, and
+//! runs do not depend on the thread count, the kernel path or how constraints fall into chunks.
 //!
 //! Against the scalar [`super::Dihedral::evaluate`] (the reference, used by the mass-spring
 //! methods), the angle here skips the normalisations, θ = atan2((N₁ × N₂)·E, (N₁·N₂)|E|) (both
@@ -17,6 +19,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+use pulp::Simd;
 
 use super::lanes::Coefs;
 
@@ -46,52 +50,143 @@ const Q: [f64; 5] = [
     1.945_506_571_482_614e2,
 ];
 
+/// The lanes of `a` as one vector of `S` (`L` = `S`'s f64 lanes).
+#[inline(always)]
+fn load<S: Simd, const L: usize>(a: [f64; L]) -> S::f64s {
+    bytemuck::cast(a)
+}
+
+/// The lanes of `v` as an array.
+#[inline(always)]
+fn store<S: Simd, const L: usize>(v: S::f64s) -> [f64; L] {
+    bytemuck::cast(v)
+}
+
+/// A 3-vector of lanes.
+type V<S> = [<S as Simd>::f64s; 3];
+
+/// The vector operations of the kernel on `S`, as functions rather than closures: a closure
+/// is a function of its own without the target features, into which the intrinsics do not
+/// inline (measured: `_mm256_mul_pd` as a call, the kernel twice as slow as scalar code).
+#[derive(Clone, Copy)]
+struct Ops<S>(S);
+
+impl<S: Simd> Ops<S> {
+    #[inline(always)]
+    fn c(self, v: f64) -> S::f64s {
+        self.0.splat_f64s(v)
+    }
+    #[inline(always)]
+    fn add(self, a: S::f64s, b: S::f64s) -> S::f64s {
+        self.0.add_f64s(a, b)
+    }
+    #[inline(always)]
+    fn sub(self, a: S::f64s, b: S::f64s) -> S::f64s {
+        self.0.sub_f64s(a, b)
+    }
+    #[inline(always)]
+    fn mul(self, a: S::f64s, b: S::f64s) -> S::f64s {
+        self.0.mul_f64s(a, b)
+    }
+    #[inline(always)]
+    fn div(self, a: S::f64s, b: S::f64s) -> S::f64s {
+        self.0.div_f64s(a, b)
+    }
+    #[inline(always)]
+    fn neg(self, a: S::f64s) -> S::f64s {
+        self.0.neg_f64s(a)
+    }
+    #[inline(always)]
+    fn sel(self, m: S::m64s, t: S::f64s, f: S::f64s) -> S::f64s {
+        self.0.select_f64s(m, t, f)
+    }
+    #[inline(always)]
+    fn gt(self, a: S::f64s, b: S::f64s) -> S::m64s {
+        self.0.greater_than_f64s(a, b)
+    }
+    #[inline(always)]
+    fn ge(self, a: S::f64s, b: S::f64s) -> S::m64s {
+        self.0.greater_than_or_equal_f64s(a, b)
+    }
+    #[inline(always)]
+    fn le(self, a: S::f64s, b: S::f64s) -> S::m64s {
+        self.0.less_than_or_equal_f64s(a, b)
+    }
+    #[inline(always)]
+    fn lt(self, a: S::f64s, b: S::f64s) -> S::m64s {
+        self.0.less_than_f64s(a, b)
+    }
+    #[inline(always)]
+    fn and(self, a: S::m64s, b: S::m64s) -> S::m64s {
+        self.0.and_m64s(a, b)
+    }
+    /// a − b per axis.
+    #[inline(always)]
+    fn dif(self, a: &V<S>, b: &V<S>) -> V<S> {
+        [
+            self.sub(a[0], b[0]),
+            self.sub(a[1], b[1]),
+            self.sub(a[2], b[2]),
+        ]
+    }
+    /// u × v.
+    #[inline(always)]
+    fn cross(self, u: &V<S>, v: &V<S>) -> V<S> {
+        [
+            self.sub(self.mul(u[1], v[2]), self.mul(u[2], v[1])),
+            self.sub(self.mul(u[2], v[0]), self.mul(u[0], v[2])),
+            self.sub(self.mul(u[0], v[1]), self.mul(u[1], v[0])),
+        ]
+    }
+    /// u · v.
+    #[inline(always)]
+    fn dot(self, u: &V<S>, v: &V<S>) -> S::f64s {
+        let xy = self.add(self.mul(u[0], v[0]), self.mul(u[1], v[1]));
+        self.add(xy, self.mul(u[2], v[2]))
+    }
+}
+
 /// atan2(y, x) in every lane, without branches: Cephes' argument reduction of |y|/|x| to
 /// |t| ≤ 0.66 (t = |y|/|x|, (|y| − |x|)/(|y| + |x|) around π/4 or −|x|/|y| near π/2, chosen
 /// by comparing |y| with 0.66 |x| and tan(3π/8) |x|, so one division serves all three), the
 /// rational approximation, then the quadrant from the signs. Within about 1 ulp of libm's
 /// `atan2` (tested); atan2(0, 0) is 0, and the sign of a zero `x` is not looked at.
 #[inline(always)]
-pub(crate) fn atan2<const L: usize>(y: &[f64; L], x: &[f64; L]) -> [f64; L] {
-    let mut out = [0.0; L];
-    for l in 0..L {
-        let (ay, ax) = (y[l].abs(), x[l].abs());
-        let big = ay > TAN_3PI_8 * ax;
-        let mid = ay > 0.66 * ax;
-        let num = if big {
-            -ax
-        } else if mid {
-            ay - ax
-        } else {
-            ay
-        };
-        let den = if big {
-            ay
-        } else if mid {
-            ay + ax
-        } else {
-            ax
-        };
-        let (base, more) = if big {
-            (FRAC_PI_2, MOREBITS)
-        } else if mid {
-            (FRAC_PI_4, 0.5 * MOREBITS)
-        } else {
-            (0.0, 0.0)
-        };
-        // 0/0 only when both are zero; a one there keeps the lane finite.
-        let t = num / if den > 0.0 { den } else { 1.0 };
-        let z = t * t;
-        let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
-        let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
-        let r = base + ((t * (z * p / q) + t) + more);
-        let r = if x[l] < 0.0 { PI - r } else { r };
-        out[l] = if y[l] < 0.0 { -r } else { r };
+pub(crate) fn atan2<S: Simd>(s: S, y: S::f64s, x: S::f64s) -> S::f64s {
+    let o = Ops(s);
+    let (ay, ax) = (s.abs_f64s(y), s.abs_f64s(x));
+    let big = o.gt(ay, o.mul(o.c(TAN_3PI_8), ax));
+    let mid = o.gt(ay, o.mul(o.c(0.66), ax));
+    let num = o.sel(big, o.neg(ax), o.sel(mid, o.sub(ay, ax), ay));
+    let den = o.sel(big, ay, o.sel(mid, o.add(ay, ax), ax));
+    let base = o.sel(big, o.c(FRAC_PI_2), o.sel(mid, o.c(FRAC_PI_4), o.c(0.0)));
+    let more = o.sel(
+        big,
+        o.c(MOREBITS),
+        o.sel(mid, o.c(0.5 * MOREBITS), o.c(0.0)),
+    );
+    // 0/0 only when both are zero; a one there keeps the lane finite.
+    let t = o.div(num, o.sel(o.gt(den, o.c(0.0)), den, o.c(1.0)));
+    let z = o.mul(t, t);
+    let mut p = o.c(P[0]);
+    for coef in &P[1..] {
+        p = o.add(o.mul(p, z), o.c(*coef));
     }
-    out
+    let mut q = z;
+    for (i, coef) in Q.iter().enumerate() {
+        q = o.add(q, o.c(*coef));
+        if i + 1 < Q.len() {
+            q = o.mul(q, z);
+        }
+    }
+    let r = o.add(base, o.add(o.add(o.mul(t, o.div(o.mul(z, p), q)), t), more));
+    let r = o.sel(o.lt(x, o.c(0.0)), o.sub(o.c(PI), r), r);
+    o.sel(o.lt(y, o.c(0.0)), o.neg(r), r)
 }
 
-/// Projects `L` independent dihedral constraints C = θ − θ₀ in place.
+/// Projects `L` independent dihedral constraints C = θ − θ₀ in place, `L` being the f64 lanes
+/// of `S` (one vector per coordinate; every lane runs the same IEEE operations, so any `S`
+/// gives the same bits per constraint).
 ///
 /// θ and ∇C are those of [`super::Dihedral`] (Bridson et al. 2003, §4): with N₁ = (x₁ − x₃) ×
 /// (x₁ − x₄), N₂ = (x₂ − x₄) × (x₂ − x₃) and E = x₄ − x₃, ∇₁C = −|E| N₁/|N₁|²,
@@ -103,7 +198,8 @@ pub(crate) fn atan2<const L: usize>(y: &[f64; L], x: &[f64; L]) -> [f64; L] {
 /// a zero denominator, or Σ wᵢ|∇ᵢC|² ≤ 1e-12 Σ|∇ᵢC|² max wᵢ: the free particles cannot turn
 /// the hinge) are left alone. `prev` is read only when `DAMPED`.
 #[inline(always)]
-pub(crate) fn project<const L: usize, const DAMPED: bool>(
+pub(crate) fn project<S: Simd, const L: usize, const DAMPED: bool>(
+    s: S,
     x: &mut Quads<L>,
     prev: &Quads<L>,
     w: &[[f64; L]; 4],
@@ -111,110 +207,87 @@ pub(crate) fn project<const L: usize, const DAMPED: bool>(
     coef: &Coefs<L>,
     lambda: &mut [f64; L],
 ) {
-    let sub = |a: usize, b: usize| -> [[f64; L]; 3] {
-        std::array::from_fn(|k| std::array::from_fn(|l| x[a][k][l] - x[b][k][l]))
-    };
-    let cross = |u: &[[f64; L]; 3], v: &[[f64; L]; 3]| -> [[f64; L]; 3] {
-        let mut c = [[0.0; L]; 3];
-        for l in 0..L {
-            c[0][l] = u[1][l] * v[2][l] - u[2][l] * v[1][l];
-            c[1][l] = u[2][l] * v[0][l] - u[0][l] * v[2][l];
-            c[2][l] = u[0][l] * v[1][l] - u[1][l] * v[0][l];
-        }
-        c
-    };
-    let dot = |u: &[[f64; L]; 3], v: &[[f64; L]; 3]| -> [f64; L] {
-        std::array::from_fn(|l| u[0][l] * v[0][l] + u[1][l] * v[1][l] + u[2][l] * v[2][l])
-    };
-    let (a1, b1) = (sub(0, 2), sub(0, 3)); // x₁ − x₃, x₁ − x₄
-    let (a2, b2) = (sub(1, 3), sub(1, 2)); // x₂ − x₄, x₂ − x₃
-    let e = sub(3, 2);
-    let (n1, n2) = (cross(&a1, &b1), cross(&a2, &b2));
-    let (q1, q2, ee) = (dot(&n1, &n1), dot(&n2, &n2), dot(&e, &e));
-    let mut ok = [false; L];
-    let mut le = [0.0; L];
-    for l in 0..L {
-        le[l] = ee[l].sqrt();
-        ok[l] = (q1[l] >= 1e-24) & (q2[l] >= 1e-24) & (le[l] >= 1e-9);
-    }
-    // θ = atan2((N₁ × N₂)·E, (N₁·N₂)|E|).
-    let sin_part = dot(&cross(&n1, &n2), &e);
-    let n12 = dot(&n1, &n2);
-    let cos_part: [f64; L] = std::array::from_fn(|l| n12[l] * le[l]);
-    let theta = atan2(&sin_part, &cos_part);
-    let mut c = [0.0; L];
-    for l in 0..L {
-        let d = theta[l] - rest[l];
-        c[l] = if d > PI {
-            d - 2.0 * PI
-        } else if d <= -PI {
-            d + 2.0 * PI
-        } else {
-            d
-        };
-    }
-    // m₁ = N₁/|N₁|², m₂ = N₂/|N₂|²; degenerate lanes divide by one instead.
-    let mut inv_q1 = [0.0; L];
-    let mut inv_q2 = [0.0; L];
-    let mut inv_le = [0.0; L];
-    for l in 0..L {
-        inv_q1[l] = 1.0 / if ok[l] { q1[l] } else { 1.0 };
-        inv_q2[l] = 1.0 / if ok[l] { q2[l] } else { 1.0 };
-        inv_le[l] = 1.0 / if ok[l] { le[l] } else { 1.0 };
-    }
-    let (s13, s23) = (dot(&b1, &e), dot(&a2, &e)); // (x₁ − x₄)·E, (x₂ − x₄)·E
-    let (t13, t23) = (dot(&a1, &e), dot(&b2, &e)); // (x₁ − x₃)·E, (x₂ − x₃)·E
-    let mut g = [[[0.0; L]; 3]; 4];
-    for k in 0..3 {
-        for l in 0..L {
-            let m1 = n1[k][l] * inv_q1[l];
-            let m2 = n2[k][l] * inv_q2[l];
-            g[0][k][l] = -(le[l] * m1);
-            g[1][k][l] = -(le[l] * m2);
-            g[2][k][l] = -((s13[l] * inv_le[l]) * m1 + (s23[l] * inv_le[l]) * m2);
-            g[3][k][l] = (t13[l] * inv_le[l]) * m1 + (t23[l] * inv_le[l]) * m2;
-        }
-    }
-    let mut w_grad2 = [0.0; L];
-    let mut grad_dx = [0.0; L];
-    // Σ |∇ᵢC|² max wᵢ: what Σ wᵢ|∇ᵢC|² would be if every particle moved freely.
-    let mut g2_wmax = [[0.0; L]; 2];
-    for v in 0..4 {
-        for l in 0..L {
-            let g2 = g[v][0][l] * g[v][0][l] + g[v][1][l] * g[v][1][l] + g[v][2][l] * g[v][2][l];
-            w_grad2[l] += w[v][l] * g2;
-            g2_wmax[0][l] += g2;
-            g2_wmax[1][l] = g2_wmax[1][l].max(w[v][l]);
-        }
-        if DAMPED {
-            for k in 0..3 {
-                for l in 0..L {
-                    grad_dx[l] += g[v][k][l] * (x[v][k][l] - prev[v][k][l]);
-                }
-            }
-        }
-    }
-    let mut dl = [0.0; L];
-    for l in 0..L {
-        let gamma = coef.gamma[l];
-        let denom = (1.0 + gamma) * w_grad2[l] + coef.alpha[l];
-        let mut num = -coef.k[l] * c[l] - coef.alpha[l] * lambda[l];
-        if DAMPED {
-            num -= gamma * grad_dx[l];
-        }
-        // A constraint whose free particles barely move its angle (a free hinge particle
-        // level with its pinned wings: ∇C there is ~0) would take a step of C/|∇C_free|, far
-        // beyond the element, and shake a stiff pinned strip chaotically: it is left alone.
-        let singular = w_grad2[l] <= 1e-12 * g2_wmax[0][l] * g2_wmax[1][l];
-        let live = ok[l] & (denom > f64::MIN_POSITIVE) & !singular;
-        dl[l] = if live { num / denom } else { 0.0 };
-        lambda[l] += dl[l];
-    }
+    debug_assert_eq!(L, S::F64_LANES);
+    let o = Ops(s);
+    let zero = o.c(0.0);
+    let mut xs: [V<S>; 4] = [[zero; 3]; 4];
     for v in 0..4 {
         for k in 0..3 {
-            for l in 0..L {
-                x[v][k][l] += g[v][k][l] * (w[v][l] * dl[l]);
+            xs[v][k] = load::<S, L>(x[v][k]);
+        }
+    }
+    let (a1, b1) = (o.dif(&xs[0], &xs[2]), o.dif(&xs[0], &xs[3])); // x₁ − x₃, x₁ − x₄
+    let (a2, b2) = (o.dif(&xs[1], &xs[3]), o.dif(&xs[1], &xs[2])); // x₂ − x₄, x₂ − x₃
+    let e = o.dif(&xs[3], &xs[2]);
+    let (n1, n2) = (o.cross(&a1, &b1), o.cross(&a2, &b2));
+    let (q1, q2, ee) = (o.dot(&n1, &n1), o.dot(&n2, &n2), o.dot(&e, &e));
+    let le = s.sqrt_f64s(ee);
+    let tiny = o.c(1e-24);
+    let ok = o.and(o.and(o.ge(q1, tiny), o.ge(q2, tiny)), o.ge(le, o.c(1e-9)));
+    // θ = atan2((N₁ × N₂)·E, (N₁·N₂)|E|), C = θ − θ₀ wrapped into (−π, π].
+    let sin_part = o.dot(&o.cross(&n1, &n2), &e);
+    let cos_part = o.mul(o.dot(&n1, &n2), le);
+    let d = o.sub(atan2(s, sin_part, cos_part), load::<S, L>(*rest));
+    let wrapped = o.sel(o.le(d, o.c(-PI)), o.add(d, o.c(2.0 * PI)), d);
+    let c = o.sel(o.gt(d, o.c(PI)), o.sub(d, o.c(2.0 * PI)), wrapped);
+    // m₁ = N₁/|N₁|², m₂ = N₂/|N₂|²; degenerate lanes divide by one instead.
+    let one = o.c(1.0);
+    let inv_q1 = o.div(one, o.sel(ok, q1, one));
+    let inv_q2 = o.div(one, o.sel(ok, q2, one));
+    let inv_le = o.div(one, o.sel(ok, le, one));
+    let s13 = o.mul(o.dot(&b1, &e), inv_le); // (x₁ − x₄)·Ê
+    let s23 = o.mul(o.dot(&a2, &e), inv_le); // (x₂ − x₄)·Ê
+    let t13 = o.mul(o.dot(&a1, &e), inv_le); // (x₁ − x₃)·Ê
+    let t23 = o.mul(o.dot(&b2, &e), inv_le); // (x₂ − x₃)·Ê
+    let mut g: [V<S>; 4] = [[zero; 3]; 4];
+    for k in 0..3 {
+        let m1 = o.mul(n1[k], inv_q1);
+        let m2 = o.mul(n2[k], inv_q2);
+        g[0][k] = o.neg(o.mul(le, m1));
+        g[1][k] = o.neg(o.mul(le, m2));
+        g[2][k] = o.neg(o.add(o.mul(s13, m1), o.mul(s23, m2)));
+        g[3][k] = o.add(o.mul(t13, m1), o.mul(t23, m2));
+    }
+    let mut wv = [zero; 4];
+    let (mut w_grad2, mut grad_dx) = (zero, zero);
+    // Σ |∇ᵢC|² max wᵢ: what Σ wᵢ|∇ᵢC|² would be if every particle moved freely.
+    let (mut g2_sum, mut w_max) = (zero, zero);
+    for v in 0..4 {
+        wv[v] = load::<S, L>(w[v]);
+        let g2 = o.dot(&g[v], &g[v]);
+        w_grad2 = o.add(w_grad2, o.mul(wv[v], g2));
+        g2_sum = o.add(g2_sum, g2);
+        w_max = o.sel(o.gt(wv[v], w_max), wv[v], w_max);
+        if DAMPED {
+            for k in 0..3 {
+                let moved = o.sub(xs[v][k], load::<S, L>(prev[v][k]));
+                grad_dx = o.add(grad_dx, o.mul(g[v][k], moved));
             }
+        }
+    }
+    let (k, alpha) = (load::<S, L>(coef.k), load::<S, L>(coef.alpha));
+    let gamma = load::<S, L>(coef.gamma);
+    let lam = load::<S, L>(*lambda);
+    let denom = o.add(o.mul(o.add(one, gamma), w_grad2), alpha);
+    let mut num = o.sub(o.mul(o.neg(k), c), o.mul(alpha, lam));
+    if DAMPED {
+        num = o.sub(num, o.mul(gamma, grad_dx));
+    }
+    // A constraint whose free particles barely move its angle (a free hinge particle level
+    // with its pinned wings: ∇C there is ~0) would take a step of C/|∇C_free|, far beyond the
+    // element, and shake a stiff pinned strip chaotically: it is left alone.
+    let singular = o.le(w_grad2, o.mul(o.mul(o.c(1e-12), g2_sum), w_max));
+    let live = o.and(
+        o.and(ok, o.gt(denom, o.c(f64::MIN_POSITIVE))),
+        s.not_m64s(singular),
+    );
+    // Divided in every lane; a dead lane's quotient is discarded.
+    let dl = o.sel(live, o.div(num, denom), zero);
+    *lambda = store::<S, L>(o.add(lam, dl));
+    for v in 0..4 {
+        let step = o.mul(wv[v], dl);
+        for k in 0..3 {
+            x[v][k] = store::<S, L>(o.add(xs[v][k], o.mul(g[v][k], step)));
         }
     }
 }
@@ -222,6 +295,8 @@ pub(crate) fn project<const L: usize, const DAMPED: bool>(
 #[cfg(test)]
 mod tests {
     use glam::DVec3;
+
+    use pulp::{Scalar, Scalar128b, Scalar256b, Scalar512b};
 
     use super::*;
     use crate::constraints::lanes::Coef;
@@ -246,16 +321,16 @@ mod tests {
                 3 => (rnd().signum(), rnd().signum() * (0.66 + 1e-3 * rnd())),
                 _ => (rnd(), rnd()),
             };
-            let got = atan2(&[y], &[x])[0];
+            let got = atan2(Scalar, y, x);
             let want = y.atan2(x);
             let ulp = (want.abs().max(f64::MIN_POSITIVE) * f64::EPSILON).max(1e-300);
             worst = worst.max((got - want).abs() / ulp);
         }
         assert!(worst <= 2.0, "worst error {worst} ulp");
-        assert_eq!(atan2(&[0.0], &[0.0]), [0.0]);
-        assert_eq!(atan2(&[0.0], &[-1.0]), [PI]);
-        assert_eq!(atan2(&[1.0], &[0.0]), [FRAC_PI_2]);
-        assert_eq!(atan2(&[-1.0], &[0.0]), [-FRAC_PI_2]);
+        assert_eq!(atan2(Scalar, 0.0, 0.0), 0.0);
+        assert_eq!(atan2(Scalar, 0.0, -1.0), PI);
+        assert_eq!(atan2(Scalar, 1.0, 0.0), FRAC_PI_2);
+        assert_eq!(atan2(Scalar, -1.0, 0.0), -FRAC_PI_2);
     }
 
     /// The scalar reference: [`Dihedral::evaluate`] and the multiplier step of XPBD.
@@ -294,7 +369,21 @@ mod tests {
 
     #[test]
     fn lanes_match_the_scalar_reference_and_one_lane_at_a_time_bit_for_bit() {
-        const L: usize = 8;
+        lanes_match::<Scalar512b, 8>(Scalar512b);
+        lanes_match::<Scalar256b, 4>(Scalar256b);
+    }
+
+    /// The AVX2 vectors the sweep runs on x86-64 (every x86-64 machine Weft is tested on has
+    /// AVX2 and FMA: the test fails, not skips, on one without).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_lanes_match_one_lane_at_a_time_bit_for_bit() {
+        let v3 = pulp::x86::V3::try_new().expect("a CPU with AVX2 and FMA");
+        lanes_match::<pulp::x86::V3, 4>(v3);
+    }
+
+    /// `S`'s `L` lanes against one lane at a time (same bits) and the scalar reference.
+    fn lanes_match<S: Simd, const L: usize>(s: S) {
         let mut rnd = rng(0xd1ed_4a11);
         for round in 0..200 {
             let p: [[DVec3; 4]; L] = std::array::from_fn(|_| random_quad(&mut rnd));
@@ -313,7 +402,8 @@ mod tests {
             let mut wide = quads(&p);
             let mut lambda = lambda0;
             let wl: [[f64; L]; 4] = std::array::from_fn(|v| std::array::from_fn(|l| w[l][v]));
-            project::<L, true>(
+            project::<S, L, true>(
+                s,
                 &mut wide,
                 &quads(&prev),
                 &wl,
@@ -324,7 +414,8 @@ mod tests {
             for l in 0..L {
                 let mut one = quads(&[p[l]]);
                 let mut lam = [lambda0[l]];
-                project::<1, true>(
+                project::<Scalar, 1, true>(
+                    Scalar,
                     &mut one,
                     &quads(&[prev[l]]),
                     &std::array::from_fn(|v| [w[l][v]]),
@@ -378,9 +469,25 @@ mod tests {
             let mut x = quads(&p);
             let mut lambda = [0.0; L];
             if damped {
-                project::<L, true>(&mut x, &quads(&p), &w, &rest, &coef, &mut lambda);
+                project::<Scalar256b, L, true>(
+                    Scalar256b,
+                    &mut x,
+                    &quads(&p),
+                    &w,
+                    &rest,
+                    &coef,
+                    &mut lambda,
+                );
             } else {
-                project::<L, false>(&mut x, &quads(&p), &w, &rest, &coef, &mut lambda);
+                project::<Scalar256b, L, false>(
+                    Scalar256b,
+                    &mut x,
+                    &quads(&p),
+                    &w,
+                    &rest,
+                    &coef,
+                    &mut lambda,
+                );
             }
             (
                 x.map(|a| a.map(|b| b.map(f64::to_bits))),
@@ -404,7 +511,8 @@ mod tests {
         let mut x = quads(&[p]);
         let before = x;
         let mut lambda = [0.0];
-        project::<1, false>(
+        project::<Scalar, 1, false>(
+            Scalar,
             &mut x,
             &before,
             &[[0.0], [0.0], [0.0], [1.0]],
@@ -423,7 +531,8 @@ mod tests {
         let mut q = p;
         q[0].x = -0.2;
         let mut x = quads(&[q]);
-        project::<1, false>(
+        project::<Scalar, 1, false>(
+            Scalar,
             &mut x,
             &quads(&[q]),
             &[[0.0], [0.0], [0.0], [1.0]],
@@ -449,7 +558,8 @@ mod tests {
         let mut x = quads(&p);
         let before = x;
         let mut lambda = [0.0; 2];
-        project::<2, false>(
+        project::<Scalar128b, 2, false>(
+            Scalar128b,
             &mut x,
             &before,
             &[[1.0; 2]; 4],
