@@ -116,8 +116,8 @@ fn project_run(
 ///
 /// Written with explicit vectors: left to LLVM's SLP vectoriser, the same kernel over lane
 /// arrays compiled to scalar divisions and branches once inlined into the sweep (T-shirt,
-/// solve only, 2 threads: 22.8 ms against 12.9 ms with `V3`, 12.8–13.0 against 14.3–14.7 ms
-/// with `V4` side by side).
+/// solve only, 2 threads: 22.8 ms against 12.9 ms with `V3`; `V4` against `V3` alternated:
+/// 12.1, 12.1, 12.5 against 13.1, 13.3, 14.3 ms).
 struct Run<'s, 'a, const L: usize>(&'s mut Segment<'a>);
 
 impl<const L: usize> WithSimd for Run<'_, '_, L> {
