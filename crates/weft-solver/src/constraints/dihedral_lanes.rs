@@ -71,26 +71,32 @@ type V<S> = [<S as Simd>::f64s; 3];
 #[derive(Clone, Copy)]
 struct Ops<S>(S);
 
+/// `Ops` methods that forward two vectors to a `Simd` method of the same meaning.
+macro_rules! binary {
+    ($($name:ident => $method:ident -> $out:ident;)*) => {
+        $(
+            #[inline(always)]
+            fn $name(self, a: S::f64s, b: S::f64s) -> S::$out {
+                self.0.$method(a, b)
+            }
+        )*
+    };
+}
+
 impl<S: Simd> Ops<S> {
+    binary! {
+        add => add_f64s -> f64s;
+        sub => sub_f64s -> f64s;
+        mul => mul_f64s -> f64s;
+        div => div_f64s -> f64s;
+        gt => greater_than_f64s -> m64s;
+        ge => greater_than_or_equal_f64s -> m64s;
+        le => less_than_or_equal_f64s -> m64s;
+        lt => less_than_f64s -> m64s;
+    }
     #[inline(always)]
     fn c(self, v: f64) -> S::f64s {
         self.0.splat_f64s(v)
-    }
-    #[inline(always)]
-    fn add(self, a: S::f64s, b: S::f64s) -> S::f64s {
-        self.0.add_f64s(a, b)
-    }
-    #[inline(always)]
-    fn sub(self, a: S::f64s, b: S::f64s) -> S::f64s {
-        self.0.sub_f64s(a, b)
-    }
-    #[inline(always)]
-    fn mul(self, a: S::f64s, b: S::f64s) -> S::f64s {
-        self.0.mul_f64s(a, b)
-    }
-    #[inline(always)]
-    fn div(self, a: S::f64s, b: S::f64s) -> S::f64s {
-        self.0.div_f64s(a, b)
     }
     #[inline(always)]
     fn neg(self, a: S::f64s) -> S::f64s {
@@ -99,22 +105,6 @@ impl<S: Simd> Ops<S> {
     #[inline(always)]
     fn sel(self, m: S::m64s, t: S::f64s, f: S::f64s) -> S::f64s {
         self.0.select_f64s(m, t, f)
-    }
-    #[inline(always)]
-    fn gt(self, a: S::f64s, b: S::f64s) -> S::m64s {
-        self.0.greater_than_f64s(a, b)
-    }
-    #[inline(always)]
-    fn ge(self, a: S::f64s, b: S::f64s) -> S::m64s {
-        self.0.greater_than_or_equal_f64s(a, b)
-    }
-    #[inline(always)]
-    fn le(self, a: S::f64s, b: S::f64s) -> S::m64s {
-        self.0.less_than_or_equal_f64s(a, b)
-    }
-    #[inline(always)]
-    fn lt(self, a: S::f64s, b: S::f64s) -> S::m64s {
-        self.0.less_than_f64s(a, b)
     }
     #[inline(always)]
     fn and(self, a: S::m64s, b: S::m64s) -> S::m64s {
@@ -468,27 +458,29 @@ mod tests {
         let run = |damped: bool| {
             let mut x = quads(&p);
             let mut lambda = [0.0; L];
-            if damped {
-                project::<Scalar256b, L, true>(
-                    Scalar256b,
-                    &mut x,
-                    &quads(&p),
-                    &w,
-                    &rest,
-                    &coef,
-                    &mut lambda,
-                );
+            type Kernel = fn(
+                Scalar256b,
+                &mut Quads<L>,
+                &Quads<L>,
+                &[[f64; L]; 4],
+                &[f64; L],
+                &Coefs<L>,
+                &mut [f64; L],
+            );
+            let kernel: Kernel = if damped {
+                project::<Scalar256b, L, true>
             } else {
-                project::<Scalar256b, L, false>(
-                    Scalar256b,
-                    &mut x,
-                    &quads(&p),
-                    &w,
-                    &rest,
-                    &coef,
-                    &mut lambda,
-                );
-            }
+                project::<Scalar256b, L, false>
+            };
+            kernel(
+                Scalar256b,
+                &mut x,
+                &quads(&p),
+                &w,
+                &rest,
+                &coef,
+                &mut lambda,
+            );
             (
                 x.map(|a| a.map(|b| b.map(f64::to_bits))),
                 lambda.map(f64::to_bits),
