@@ -186,7 +186,12 @@ fn chunk<S: Simd, const L: usize, const DAMPED: bool>(s: S, seg: &mut Segment, s
         }
     }
     let rest: [f64; L] = std::array::from_fn(|l| seg.shapes[start + l].rest);
-    let coef = Coefs::from_fn(|l| seg.sweep.coef[seg.groups[start + l] as usize]);
+    // One parameter group (one cloth) is the common case: its coefficients in every lane
+    // without a per-lane lookup.
+    let coef = match seg.sweep.coef {
+        [one] => Coefs::splat(*one),
+        all => Coefs::from_fn(|l| all[seg.groups[start + l] as usize]),
+    };
     let lambda: &mut [f64; L] = match (&mut seg.lambda[start..start + L]).try_into() {
         Ok(a) => a,
         Err(_) => return,
@@ -404,5 +409,64 @@ mod tests {
             start > 0.2 && end < 3e-3,
             "largest |θ − θ₀|: {start} → {end}"
         );
+    }
+
+    #[test]
+    fn each_constraint_takes_its_own_group_coefficients() {
+        // Two crumpled sheets in one block (so with more than one group, the lanes look their
+        // coefficients up): group 0 rigid, group 1 disabled. The first sheet flattens, the
+        // second does not move a bit.
+        let n = 16;
+        let (sheet, tris) = crumpled(n, 0.004);
+        let count = sheet.len() as u32;
+        let mut x: Vec<DVec3> = sheet.iter().chain(&sheet).copied().collect();
+        let mut b = BlockBuilder::<4, Dihedral>::default();
+        for wing in Topology::new(&tris).wings {
+            let q = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
+            b.push(q, 0, Dihedral { rest: 0.0 });
+            b.push(q.map(|i| i + count), 1, Dihedral { rest: 0.0 });
+        }
+        let mut block = b.finish(&vec![true; x.len()]);
+        let rigid = FamilyParams {
+            enabled: true,
+            compliance: 0.0,
+            damping: 0.0,
+            pbd_stiffness: 1.0,
+            spring_stiffness: 0.0,
+            spring_damping: 0.0,
+        };
+        let params = [
+            rigid,
+            FamilyParams {
+                enabled: false,
+                ..rigid
+            },
+        ];
+        let (prev, w) = (x.clone(), vec![1.0; x.len()]);
+        let second = x[sheet.len()..].to_vec();
+        let worst = |x: &[DVec3]| {
+            let mut one = BlockBuilder::<4, Dihedral>::default();
+            for wing in Topology::new(&tris).wings {
+                let q = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
+                one.push(q, 0, Dihedral { rest: 0.0 });
+            }
+            let one = one.finish(&vec![true; x.len()]);
+            one.residuals(x).fold(0.0f64, |m, c| m.max(c.abs()))
+        };
+        let start = worst(&x[..sheet.len()]);
+        for _ in 0..200 {
+            block.reset_multipliers();
+            block.project_symmetric_lanes(
+                &mut x,
+                &prev,
+                &w,
+                &params,
+                Rule::Xpbd { h: 1e-3 },
+                SimdPath::widest(),
+            );
+        }
+        let end = worst(&x[..sheet.len()]);
+        assert!(start > 0.1 && end < 0.2 * start, "{start} → {end}");
+        assert_eq!(x[sheet.len()..], second[..], "the disabled group moved");
     }
 }
