@@ -14,8 +14,8 @@
 //!
 //! `cargo run --release -p weft-collide --example mesh_contact_cost -- [REPS] [SCENE]`; set
 //! `RAYON_NUM_THREADS` to choose the thread count and `WEFT_SIMD` the solver's kernel path.
-//! SCENE `mesh` or `deforming` steps only that scene's collider frame `REPS` times (for a
-//! profiler).
+//! SCENE `mesh`, `sphere` or `deforming` steps only that scene's collider frame `REPS` times
+//! (for a profiler).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
@@ -105,6 +105,11 @@ fn main() {
         Some("mesh") => {
             let (s, w) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
             show("20,480-triangle mesh + ground", with(reps, &s, &w));
+            return;
+        }
+        Some("sphere") => {
+            let (s, w) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
+            show("analytic sphere + ground", with(reps, &s, &w));
             return;
         }
         Some("deforming") => {

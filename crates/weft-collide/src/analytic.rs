@@ -23,7 +23,7 @@ pub(crate) struct WorldPose {
     /// Rotation R as a unit quaternion.
     pub rotation: DQuat,
     /// R as a matrix (its columns are the local axes in world space).
-    basis: DMat3,
+    pub basis: DMat3,
 }
 
 impl WorldPose {

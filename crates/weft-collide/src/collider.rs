@@ -217,6 +217,11 @@ impl Collider {
         self.mesh.as_deref()
     }
 
+    /// The closed form of the shape, if it has one.
+    pub(crate) fn analytic(&self) -> Option<Analytic> {
+        self.analytic
+    }
+
     /// The f64 poses at the end and start of the substep, and whether they are equal.
     pub(crate) fn poses64(&self) -> (&WorldPose, &WorldPose, bool) {
         (&self.pose64, &self.prev_pose64, self.still)

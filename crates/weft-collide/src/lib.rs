@@ -15,6 +15,7 @@ mod friction;
 mod grid;
 mod mesh;
 mod obj;
+mod reach;
 pub mod scenarios;
 mod self_collision;
 mod shape;

@@ -13,12 +13,15 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
-use weft_solver::{Contacts, ParticleContacts, Particles, Solver, SubstepContext, SubstepHook};
+use weft_solver::{
+    Contacts, ParticleContacts, ParticleRun, Particles, Solver, SubstepContext, SubstepHook,
+};
 
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::friction::Friction;
+use crate::reach::{Bounds, Reach};
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::deforming::MeshAnimation;
@@ -53,6 +56,9 @@ pub struct CollisionWorld {
     /// Per collider, its world AABB at the current pose grown by [`Self::search_margin`], or
     /// `None` if unbounded; refreshed every substep.
     bounds: Vec<Option<Bounds>>,
+    /// Per collider, which particles it can touch at the current pose; refreshed every
+    /// substep with `bounds`.
+    reach: Vec<Reach>,
     /// Largest thickness of any particle (m).
     max_thickness: f64,
     fresh: bool,
@@ -72,14 +78,6 @@ const ROUNDS: usize = 3;
 /// alone, so results are the same bit for bit for any number of threads.
 pub(crate) const CHUNK: usize = 1024;
 
-/// An axis-aligned box in f64: (min corner, max corner).
-type Bounds = (DVec3, DVec3);
-
-/// Whether `x` lies in `b` (`None`: unbounded, always).
-fn within(b: &Option<Bounds>, x: DVec3) -> bool {
-    b.is_none_or(|(lo, hi)| x.cmpge(lo).all() && x.cmple(hi).all())
-}
-
 impl CollisionWorld {
     /// An empty world for `solver`'s particles, with each cloth's thickness.
     pub fn new(solver: &Solver) -> Self {
@@ -90,6 +88,7 @@ impl CollisionWorld {
             thickness: Vec::new(),
             self_collision: None,
             bounds: Vec::new(),
+            reach: Vec::new(),
             max_thickness: 0.0,
             fresh: true,
             stats: ContactStats::default(),
@@ -171,6 +170,7 @@ impl CollisionWorld {
     fn push(&mut self, c: Collider) -> Result<usize, ShapeError> {
         self.colliders.push(c);
         self.bounds.push(None);
+        self.reach.push(Reach::Box(None));
         self.mesh_lists.clear();
         Ok(self.colliders.len() - 1)
     }
@@ -328,7 +328,7 @@ impl CollisionWorld {
             })
             .collect();
         let parry = self.parry_meshes;
-        let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
+        let (colliders, reach, thickness) = (&self.colliders, &self.reach, &self.thickness);
         let (positions, prev, inv) = moving_views(p);
         let (contacts, deepest, swept) = positions
             .par_chunks_mut(CHUNK)
@@ -343,15 +343,15 @@ impl CollisionWorld {
                         continue;
                     }
                     let mut slot = 0;
-                    for ((c, b), frame) in colliders.iter().zip(bounds).zip(&frames) {
+                    for ((c, reach), frame) in colliders.iter().zip(reach).zip(&frames) {
                         if let Some(frame) = frame {
                             let o = frame.resolve(&mut lists[slot], j, prev[i], x, thickness[i]);
                             slot += 1;
                             contacts += o.contacts;
                             deepest = deepest.max(o.depth);
                             swept += o.swept;
-                        } else if within(b, *x) {
-                            // Cheap reject: farther than the margin from the collider's box.
+                        } else if reach.may_touch(*x, thickness[i]) {
+                            // Cheap reject: out of the collider's reach.
                             let (n, depth) = resolve_one(c, parry, prev[i], x, thickness[i]);
                             contacts += n;
                             deepest = deepest.max(depth);
@@ -501,12 +501,16 @@ impl SubstepHook for CollisionWorld {
     fn begin_substep(&mut self, ctx: &SubstepContext, _particles: &Particles) {
         let t0 = ctx.time - ctx.h;
         let margin = self.search_margin();
-        for (c, b) in self.colliders.iter_mut().zip(&mut self.bounds) {
+        for ((c, b), reach) in (self.colliders.iter_mut())
+            .zip(&mut self.bounds)
+            .zip(&mut self.reach)
+        {
             c.set_time(t0, ctx.time);
             *b = c.world_aabb(0.0).map(|a| {
                 let m = DVec3::splat(margin);
                 (a.mins.as_dvec3() - m, a.maxs.as_dvec3() + m)
             });
+            *reach = Reach::of(c, *b);
         }
         let reach = 2.0 * self.max_thickness;
         for b in &mut self.bodies {
@@ -577,23 +581,48 @@ impl SubstepHook for CollisionWorld {
     }
 }
 
-/// One particle's part of [`SubstepHook::project`] with closed-form colliders only: on the
-/// substep's first pass the sweep, then the push-out from each collider in order — the same
-/// calls as `sweep` and `resolve_colliders` make for that particle.
-impl ParticleContacts for CollisionWorld {
-    fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
+impl CollisionWorld {
+    /// One particle's part of [`SubstepHook::project`] with closed-form colliders only: on
+    /// the substep's first pass the sweep, then the push-out from each collider in reach, in
+    /// order — the same calls as `sweep` and `resolve_colliders` make for that particle.
+    #[inline]
+    fn contacts_of(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let (parry, r) = (self.parry_meshes, self.thickness[i]);
         let mut out = Contacts::default();
         if fresh {
             out.swept = sweep_one(&self.colliders, &self.bounds, |_| false, parry, prev, x, r);
         }
-        for (c, b) in self.colliders.iter().zip(&self.bounds) {
-            if within(b, *x) {
+        for (c, reach) in self.colliders.iter().zip(&self.reach) {
+            if reach.may_touch(*x, r) {
                 let (n, depth) = resolve_one(c, parry, prev, x, r);
                 out.contacts += n;
                 out.depth = out.depth.max(depth);
             }
         }
         out
+    }
+}
+
+impl ParticleContacts for CollisionWorld {
+    fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
+        self.contacts_of(i, x, prev, fresh)
+    }
+
+    /// As `resolve` on each particle, without a call through the trait object per particle:
+    /// most particles are out of every collider's reach and cost a few comparisons.
+    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
+        let ParticleRun { start, x, prev, w } = run;
+        let [x0, x1, x2] = x;
+        let mut total = Contacts::default();
+        for j in 0..w.len() {
+            if w[j] == 0.0 {
+                continue;
+            }
+            let mut p = DVec3::new(x0[j], x1[j], x2[j]);
+            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
+            total = total.merge(self.contacts_of(start + j, &mut p, before, fresh));
+            (x0[j], x1[j], x2[j]) = (p.x, p.y, p.z);
+        }
+        total
     }
 }

@@ -70,6 +70,38 @@ pub trait ParticleContacts: Sync {
     /// Moves free particle `i` (global index) at `x` out of obstacles; `prev` is its position
     /// at the substep's start, `fresh` marks the substep's first pass.
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts;
+
+    /// [`Self::resolve`] on every free particle of `run` (nonzero inverse mass), in order:
+    /// one call per run of particles, so that an implementation can skip the particles out
+    /// of reach cheaply. The default calls `resolve` on each.
+    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
+        let ParticleRun { start, x, prev, w } = run;
+        let mut total = Contacts::default();
+        for (j, &wj) in w.iter().enumerate() {
+            if wj == 0.0 {
+                continue;
+            }
+            let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
+            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
+            total = total.merge(self.resolve(start + j, &mut p, before, fresh));
+            for a in 0..3 {
+                x[a][j] = p[a];
+            }
+        }
+        total
+    }
+}
+
+/// Consecutive particles in struct-of-arrays form, for [`ParticleContacts::resolve_run`].
+pub struct ParticleRun<'a> {
+    /// Global index of the first particle.
+    pub start: usize,
+    /// Positions per axis, moved in place.
+    pub x: [&'a mut [f64]; 3],
+    /// Positions at the substep's start, per axis.
+    pub prev: [&'a [f64]; 3],
+    /// Inverse masses; a pinned particle (0) is left alone.
+    pub w: &'a [f64],
 }
 
 /// What per-particle contacts did: summed (counts) and maximised (depth) over particles.

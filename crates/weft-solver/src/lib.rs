@@ -40,7 +40,7 @@ pub use driver::PinDriver;
 pub use error::{BuildError, MeshError, ParamError, SolverError};
 pub use forces::{Aero, Forces, Wind};
 pub use grid::{Corner, Edge, GridDesc, Orientation, Pin};
-pub use hook::{Contacts, ParticleContacts, SubstepContext, SubstepHook};
+pub use hook::{Contacts, ParticleContacts, ParticleRun, SubstepContext, SubstepHook};
 pub use material::{Material, MaterialStiffness};
 pub use method::{Method, UnknownMethod};
 pub use motion::{KinematicPin, Motion, RigidTransform};

@@ -14,7 +14,7 @@ use super::simd::SimdPath;
 use super::sweep::sweep;
 use crate::constraints::lanes::Coef;
 use crate::forces::Forces;
-use crate::hook::{Contacts, ParticleContacts};
+use crate::hook::{Contacts, ParticleContacts, ParticleRun};
 
 /// Distance constraints as struct-of-arrays.
 #[derive(Clone, Debug, Default)]
@@ -175,19 +175,16 @@ impl Domain {
 
     /// Resolves the contacts of every free particle (see [`crate::ParticleContacts`]).
     pub fn collide(&mut self, contacts: &dyn ParticleContacts, fresh: bool) -> Contacts {
-        let mut total = Contacts::default();
-        for i in 0..self.len() {
-            if self.w[i] == 0.0 {
-                continue;
-            }
-            let at = |v: &[Vec<f64>; 3]| DVec3::new(v[0][i], v[1][i], v[2][i]);
-            let (mut x, prev) = (at(&self.x), at(&self.prev));
-            total = total.merge(contacts.resolve(self.start + i, &mut x, prev, fresh));
-            for a in 0..3 {
-                self.x[a][i] = x[a];
-            }
-        }
-        total
+        let n = self.len();
+        let [x0, x1, x2] = &mut self.x;
+        let [p0, p1, p2] = &self.prev;
+        let run = ParticleRun {
+            start: self.start,
+            x: [&mut x0[..n], &mut x1[..n], &mut x2[..n]],
+            prev: [&p0[..n], &p1[..n], &p2[..n]],
+            w: &self.w[..n],
+        };
+        contacts.resolve_run(run, fresh)
     }
 
     /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
