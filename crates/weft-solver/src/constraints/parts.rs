@@ -10,8 +10,9 @@
 
 /// Most parts a block is split into (one task each). More contiguous ranges cut far more
 /// constraints on garments, whose panel vertices come boundary first, then interior points in
-/// refinement order: on the 10,172-particle T-shirt 8 ranges leave 12,250 of its 28,706
-/// dihedrals straddling (projected serially), 2 ranges 4,327.
+/// refinement order: on the 10,172-particle T-shirt 8 ranges left 12,250 of its 28,706
+/// dihedrals straddling (projected serially); 2 ranges leave 3,972, with 12,358 and 12,376 in
+/// the parts.
 pub(crate) const MAX_PARTS: usize = 2;
 
 /// Constraints per part, at least: a part is one task of a parallel sweep, worth its fork.
@@ -23,10 +24,13 @@ pub(crate) fn count(constraints: usize) -> usize {
     (constraints / MIN_PER_PART).clamp(1, MAX_PARTS)
 }
 
-/// Splits particles `0..n` into at most `k` contiguous ranges for `constraints`: the
-/// boundaries sit near equal shares of the constraints, each moved within a window of a tenth
-/// of a share to where the fewest constraints straddle it (a garment's panels, a grid's rows).
-/// Returns the `parts + 1` boundaries, from 0 to `n`.
+/// Splits particles `0..n` into at most `k` contiguous ranges for `constraints`, boundary by
+/// boundary, each where the sweep it leads to is quickest: the parts run in parallel and the
+/// constraints a boundary cuts (the straddlers) run alone afterwards, so a boundary at m costs
+/// max(this part, an equal share of the rest) + the constraints it cuts, all counted in
+/// constraints. That balances the parts where cuts are alike (a grid's rows) and moves a
+/// boundary to a panel join when the imbalance costs less than the cut saves. Returns the
+/// `parts + 1` boundaries, from 0 to `n`; ties go to the lowest boundary.
 pub(crate) fn split<const N: usize>(constraints: &[[u32; N]], n: usize, k: usize) -> Vec<usize> {
     let k = k.clamp(1, MAX_PARTS);
     if k == 1 || constraints.is_empty() || n < 2 * k {
@@ -35,7 +39,7 @@ pub(crate) fn split<const N: usize>(constraints: &[[u32; N]], n: usize, k: usize
     // cut[m]: constraints with lo < m ≤ hi (cut by a boundary at m);
     // left[m]: constraints lying wholly below m (hi < m).
     let mut cut = vec![0i64; n + 2];
-    let mut left = vec![0usize; n + 2];
+    let mut left = vec![0i64; n + 2];
     for idx in constraints {
         let lo = idx.iter().min().copied().unwrap_or(0) as usize;
         let hi = idx.iter().max().copied().unwrap_or(0) as usize;
@@ -47,27 +51,19 @@ pub(crate) fn split<const N: usize>(constraints: &[[u32; N]], n: usize, k: usize
         cut[m] += cut[m - 1];
         left[m] += left[m - 1];
     }
-    let total = constraints.len();
-    let share = total as f64 / k as f64;
+    let total = constraints.len() as i64;
     let mut bounds = vec![0];
     for j in 1..k {
-        let goal = share * j as f64;
-        let window = 0.1 * share;
         let prev = bounds.last().copied().unwrap_or(0);
-        let best = (prev + 1..n)
-            .filter(|&m| (left[m] as f64 - goal).abs() <= window)
-            .min_by(|&a, &b| {
-                let da = (left[a] as f64 - goal).abs();
-                let db = (left[b] as f64 - goal).abs();
-                cut[a].cmp(&cut[b]).then(da.total_cmp(&db))
-            })
-            .or_else(|| {
-                (prev + 1..n).min_by(|&a, &b| {
-                    (left[a] as f64 - goal)
-                        .abs()
-                        .total_cmp(&(left[b] as f64 - goal).abs())
-                })
-            });
+        let parts_after = (k - j) as i64;
+        // This part: the constraints wholly in prev..m (those below prev are earlier parts'
+        // or already cut); the rest: those wholly above m, shared by the parts still to come.
+        let cost = |m: usize| {
+            let here = left[m] - left[prev];
+            let rest = total - left[m] - cut[m];
+            here.max((rest + parts_after - 1) / parts_after) + cut[m]
+        };
+        let best = (prev + 1..n).min_by(|&a, &b| cost(a).cmp(&cost(b)).then(a.cmp(&b)));
         match best {
             Some(m) => bounds.push(m),
             None => break,
@@ -141,6 +137,46 @@ mod tests {
         let bounds = split(&cons, 1800, 2);
         let straddlers = cons.iter().filter(|c| part_of(c, &bounds) == 2).count();
         assert!(straddlers <= 5, "{straddlers}, bounds {bounds:?}");
+    }
+
+    /// The sweep time `split` models for two parts: the larger part plus the straddlers.
+    fn two_part_time(cons: &[[u32; 4]], bounds: &[usize]) -> usize {
+        let mut count = [0usize; 3];
+        for c in cons {
+            count[part_of(c, bounds)] += 1;
+        }
+        count[0].max(count[1]) + count[2]
+    }
+
+    #[test]
+    fn two_parts_take_the_quickest_boundary_of_all() {
+        // A panel numbered boundary first, then interior row by row (as garments are), next
+        // to a plain grid: the fewest cuts lie near the join, the balance elsewhere.
+        let (cols, rows) = (30u32, 30u32);
+        let ring: Vec<u32> = (0..cols * rows)
+            .filter(|&i| {
+                let (c, r) = (i % cols, i / cols);
+                c == 0 || r == 0 || c == cols - 1 || r == rows - 1
+            })
+            .collect();
+        let mut order = vec![0u32; (cols * rows) as usize];
+        let inner = (0..cols * rows).filter(|i| !ring.contains(i));
+        for (k, i) in ring.iter().copied().chain(inner).enumerate() {
+            order[i as usize] = k as u32;
+        }
+        let mut cons: Vec<[u32; 4]> = grid(cols, rows)
+            .iter()
+            .map(|c| c.map(|i| order[i as usize]))
+            .collect();
+        cons.extend(grid(20, 20).iter().map(|c| c.map(|i| i + 900)));
+        let n = 1300;
+        let bounds = split(&cons, n, 2);
+        let got = two_part_time(&cons, &bounds);
+        let best = (1..n)
+            .map(|m| two_part_time(&cons, &[0, m, n]))
+            .min()
+            .unwrap_or(0);
+        assert_eq!(got, best, "bounds {bounds:?}");
     }
 
     #[test]
