@@ -355,6 +355,41 @@ mod tests {
         (x, tris)
     }
 
+    /// A dihedral family at compliance 0, undamped.
+    fn rigid() -> FamilyParams {
+        FamilyParams {
+            enabled: true,
+            compliance: 0.0,
+            damping: 0.0,
+            pbd_stiffness: 1.0,
+            spring_stiffness: 0.0,
+            spring_damping: 0.0,
+        }
+    }
+
+    /// `sweeps` symmetric XPBD sweeps (h = 1 ms) of `block` on the widest path, each from
+    /// cleared multipliers, with `prev` and inverse masses 1.
+    fn sweep(
+        block: &mut Block<4, Dihedral>,
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        params: &[FamilyParams],
+        sweeps: usize,
+    ) {
+        let w = vec![1.0; x.len()];
+        for _ in 0..sweeps {
+            block.reset_multipliers();
+            block.project_symmetric_lanes(
+                x,
+                prev,
+                &w,
+                params,
+                Rule::Xpbd { h: 1e-3 },
+                SimdPath::widest(),
+            );
+        }
+    }
+
     #[test]
     fn sweeps_flatten_a_crumpled_sheet_through_every_part_and_straddler() {
         let n = 48;
@@ -377,31 +412,12 @@ mod tests {
             parts >= 2 && straddlers > 0,
             "{parts} parts, {straddlers} straddlers"
         );
-        let params = [FamilyParams {
-            enabled: true,
-            compliance: 0.0,
-            damping: 0.0,
-            pbd_stiffness: 1.0,
-            spring_stiffness: 0.0,
-            spring_damping: 0.0,
-        }];
         let prev = x.clone();
-        let w = vec![1.0; x.len()];
         let worst = |x: &[DVec3], block: &Block<4, Dihedral>| {
             (block.residuals(x)).fold(0.0f64, |m, c| m.max(c.abs()))
         };
         let start = worst(&x, &block);
-        for _ in 0..1000 {
-            block.reset_multipliers();
-            block.project_symmetric_lanes(
-                &mut x,
-                &prev,
-                &w,
-                &params,
-                Rule::Xpbd { h: 1e-3 },
-                SimdPath::widest(),
-            );
-        }
+        sweep(&mut block, &mut x, &prev, &[rigid()], 1000);
         let end = worst(&x, &block);
         // 6e-4 rad after 1,000 sweeps (bending alone converges slowly on long waves); with
         // the straddlers left out their row of hinges keeps a crease of 0.02 rad.
@@ -427,22 +443,14 @@ mod tests {
             b.push(q.map(|i| i + count), 1, Dihedral { rest: 0.0 });
         }
         let mut block = b.finish(&vec![true; x.len()]);
-        let rigid = FamilyParams {
-            enabled: true,
-            compliance: 0.0,
-            damping: 0.0,
-            pbd_stiffness: 1.0,
-            spring_stiffness: 0.0,
-            spring_damping: 0.0,
-        };
         let params = [
-            rigid,
+            rigid(),
             FamilyParams {
                 enabled: false,
-                ..rigid
+                ..rigid()
             },
         ];
-        let (prev, w) = (x.clone(), vec![1.0; x.len()]);
+        let prev = x.clone();
         let second = x[sheet.len()..].to_vec();
         let worst = |x: &[DVec3]| {
             let mut one = BlockBuilder::<4, Dihedral>::default();
@@ -454,17 +462,7 @@ mod tests {
             one.residuals(x).fold(0.0f64, |m, c| m.max(c.abs()))
         };
         let start = worst(&x[..sheet.len()]);
-        for _ in 0..200 {
-            block.reset_multipliers();
-            block.project_symmetric_lanes(
-                &mut x,
-                &prev,
-                &w,
-                &params,
-                Rule::Xpbd { h: 1e-3 },
-                SimdPath::widest(),
-            );
-        }
+        sweep(&mut block, &mut x, &prev, &params, 200);
         let end = worst(&x[..sheet.len()]);
         assert!(start > 0.1 && end < 0.2 * start, "{start} → {end}");
         assert_eq!(x[sheet.len()..], second[..], "the disabled group moved");
