@@ -13,9 +13,7 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
-use weft_solver::{
-    Contacts, ParticleContacts, ParticleRun, Particles, Solver, SubstepContext, SubstepHook,
-};
+use weft_solver::{Contacts, ParticleContacts, Particles, Solver, SubstepContext, SubstepHook};
 
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
 use crate::collider::{Collider, ColliderDesc};
@@ -581,12 +579,13 @@ impl SubstepHook for CollisionWorld {
     }
 }
 
-impl CollisionWorld {
-    /// One particle's part of [`SubstepHook::project`] with closed-form colliders only: on
-    /// the substep's first pass the sweep, then the push-out from each collider in reach, in
-    /// order — the same calls as `sweep` and `resolve_colliders` make for that particle.
+/// One particle's part of [`SubstepHook::project`] with closed-form colliders only: on the
+/// substep's first pass the sweep, then the push-out from each collider in reach, in order —
+/// the same calls as `sweep` and `resolve_colliders` make for that particle. The fused pass
+/// reaches it through the trait's default `resolve_run`, one trait-object call per domain.
+impl ParticleContacts for CollisionWorld {
     #[inline]
-    fn contacts_of(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
+    fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let (parry, r) = (self.parry_meshes, self.thickness[i]);
         let mut out = Contacts::default();
         if fresh {
@@ -600,29 +599,5 @@ impl CollisionWorld {
             }
         }
         out
-    }
-}
-
-impl ParticleContacts for CollisionWorld {
-    fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
-        self.contacts_of(i, x, prev, fresh)
-    }
-
-    /// As `resolve` on each particle, without a call through the trait object per particle:
-    /// most particles are out of every collider's reach and cost a few comparisons.
-    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
-        let ParticleRun { start, x, prev, w } = run;
-        let [x0, x1, x2] = x;
-        let mut total = Contacts::default();
-        for j in 0..w.len() {
-            if w[j] == 0.0 {
-                continue;
-            }
-            let mut p = DVec3::new(x0[j], x1[j], x2[j]);
-            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
-            total = total.merge(self.contacts_of(start + j, &mut p, before, fresh));
-            (x0[j], x1[j], x2[j]) = (p.x, p.y, p.z);
-        }
-        total
     }
 }

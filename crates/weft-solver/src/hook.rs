@@ -72,8 +72,8 @@ pub trait ParticleContacts: Sync {
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts;
 
     /// [`Self::resolve`] on every free particle of `run` (nonzero inverse mass), in order:
-    /// one call per run of particles, so that an implementation can skip the particles out
-    /// of reach cheaply. The default calls `resolve` on each.
+    /// one call through a trait object per run of particles; inside it `resolve` is called
+    /// directly, so an implementation's per-particle work can inline.
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let ParticleRun { start, x, prev, w } = run;
         let mut total = Contacts::default();
