@@ -136,10 +136,8 @@ fn raster_order(n: usize, h: f64, points: Vec<DVec2>, triangles: Vec<[u32; 3]>) 
     for (k, &old) in interior.iter().enumerate() {
         new_index[old] = (n + k) as u32;
     }
-    let mut renumbered = points.clone();
-    for (old, &new) in new_index.iter().enumerate() {
-        renumbered[new as usize] = points[old];
-    }
+    let mut renumbered = points[..n].to_vec();
+    renumbered.extend(interior.iter().map(|&i| points[i]));
     let mut triangles: Vec<[u32; 3]> = triangles
         .into_iter()
         .map(|t| t.map(|i| new_index[i as usize]))
