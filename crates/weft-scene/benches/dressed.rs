@@ -1,8 +1,8 @@
 //! The walker in its T-shirt (assets/scenes/character.toml: 10,172 particles, 10 substeps,
 //! body contact, self-collision), one frame at a time once the seams have closed, and the
 //! same frame without self-collision and without any contact, so that the differences split
-//! the cost into solve, body contact and self-collision; and the whole frame with
-//! bend-distance bending instead of the preset's dihedral bending. The skinned glTF character
+//! the cost into solve, body contact and self-collision; and the whole frame and the solve
+//! with dihedral bending instead of the isometric bending the jersey preset gets. The skinned glTF character
 //! in its cape (assets/scenes/glb_character.toml: 2,374 particles, a 5,126-triangle body
 //! skinned and refitted every substep) split the same way.
 #![allow(clippy::unwrap_used)]
@@ -59,16 +59,27 @@ fn bench(c: &mut Criterion) {
     group.bench_function("tshirt: solve only", |b| {
         b.iter(|| solve.solver.step_with(&mut Nothing).unwrap())
     });
-    // The jersey preset bends through dihedral angles (an atan2 per constraint, two sweeps);
-    // the same shirt with the cheap bend-distance constraints instead.
-    let mut cheap = dressed(&[
-        "cloth.tshirt.bend_dihedral_enabled=false",
-        "cloth.tshirt.bend_distance_enabled=true",
-    ]);
-    group.bench_function(
-        "tshirt, bend-distance: solve + body + self-collision",
-        |b| b.iter(|| cheap.step().unwrap()),
-    );
+    // The jersey preset is soft per substep, so it bends isometrically (constant weights,
+    // one division per hinge); the same shirt through dihedral angles (an atan2 and six
+    // divisions per hinge) at about the stiffness the preset gave them, 1/(B |e|²/A_e).
+    let dihedral = [
+        "cloth.tshirt.bend_isometric_enabled=false",
+        "cloth.tshirt.bend_dihedral_enabled=true",
+        "cloth.tshirt.bend_dihedral_compliance=1.77e5",
+    ];
+    let mut angles = dressed(&dihedral);
+    group.bench_function("tshirt, dihedral: solve + body + self-collision", |b| {
+        b.iter(|| angles.step().unwrap())
+    });
+    let with_self_off: Vec<&str> = dihedral
+        .iter()
+        .copied()
+        .chain(["self_collision.enabled=false"])
+        .collect();
+    let mut angles_solve = dressed(&with_self_off);
+    group.bench_function("tshirt, dihedral: solve only", |b| {
+        b.iter(|| angles_solve.solver.step_with(&mut Nothing).unwrap())
+    });
     // The skinned glTF character: its body a deforming mesh skinned every substep.
     let mut glb = shipped("glb_character.toml", &[]);
     group.bench_function("glb cape: solve + skinned body + self-collision", |b| {

@@ -3,7 +3,9 @@
 use glam::DVec3;
 
 use crate::cloth::ClothMesh;
-use crate::constraints::{BlockBuilder, ConstraintSet, Dihedral, Distance, Seam, Tether};
+use crate::constraints::{
+    BlockBuilder, ConstraintSet, Dihedral, Distance, Isometric, Seam, Tether,
+};
 use crate::error::{BuildError, ParamError};
 use crate::forces::Forces;
 use crate::motion::{KinematicPin, Motion};
@@ -26,6 +28,7 @@ pub struct SolverBuilder {
     params: Vec<FamilyParams>,
     distance: BlockBuilder<2, Distance>,
     dihedral: BlockBuilder<4, Dihedral>,
+    isometric: BlockBuilder<4, Isometric>,
     tethers: BlockBuilder<2, Tether>,
     seams: BlockBuilder<2, Seam>,
     seam_params: Vec<FamilyParams>,
@@ -45,6 +48,7 @@ impl SolverBuilder {
             params: Vec::new(),
             distance: BlockBuilder::default(),
             dihedral: BlockBuilder::default(),
+            isometric: BlockBuilder::default(),
             tethers: BlockBuilder::default(),
             seams: BlockBuilder::default(),
             seam_params: Vec::new(),
@@ -122,6 +126,15 @@ impl SolverBuilder {
                 if let Some(rest) = Dihedral::angle(&idx.map(|i| p[i as usize])) {
                     self.dihedral
                         .push(idx.map(g), group(Family::BendDihedral), Dihedral { rest });
+                }
+            }
+        }
+        if params.get(Family::BendIsometric).enabled {
+            for wing in &topo.wings {
+                let idx = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
+                if let Some(shape) = Isometric::at_rest(&idx.map(|i| p[i as usize])) {
+                    self.isometric
+                        .push(idx.map(g), group(Family::BendIsometric), shape);
                 }
             }
         }
@@ -227,6 +240,7 @@ impl SolverBuilder {
         let constraints = ConstraintSet {
             distance: self.distance.finish(&free),
             dihedral: self.dihedral.finish(&free),
+            isometric: self.isometric.finish(&free),
             tethers: self.tethers.finish(&free),
             seams: self.seams.finish(&free),
             seam_params: self.seam_params,

@@ -22,6 +22,16 @@
 //!   cylinder of curvature κ about its grid lines stores ½ B κ² per unit area: there only the
 //!   grid lines fold, by θ = κL, each for L² of cloth, so ½ k_θ θ² = ½ B κ² L² gives k_θ = B
 //!   = B L²/A_e. The distance-based bending family is switched off.
+//! * **Isometric bending instead, where it is soft**: when α/h² = 1/(B h²) is at least the
+//!   median Σ wᵢ|∇ᵢC|² of the isometric hinges at rest (a projection removes at most half of a
+//!   hinge's error), the quadratic isometric energy replaces the dihedral: C = |Σᵢ kᵢ xᵢ| with
+//!   the hinge's cotangent weights scaled by 1/√A_e, whose ½ B C² summed over the edges is
+//!   ½ B ∫ (κ₁ + κ₂)² dA for an unstretched surface (Bergou et al. 2006, "A quadratic bending
+//!   model for inextensible surfaces"; see [`crate::constraints::Isometric`]), so its stiffness
+//!   is B itself at any resolution. It costs a fraction of the dihedral's angle and gradient;
+//!   stiffer than that, its in-plane part and the inextensible edges, solved one after the
+//!   other, were measured to gain energy (`tests/integration/isometric_bending.rs`), so the
+//!   dihedral stays there.
 //!
 //! Each family keeps one value per cloth (the median over its constraints, i.e. the interior
 //! value on grids of square cells; boundary edges, which Van Gelder gives half, get the
@@ -35,7 +45,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use crate::cloth::ClothMesh;
-use crate::constraints::{Dihedral, Shape};
+use crate::constraints::{Dihedral, Isometric, Shape};
 use crate::error::ParamError;
 use crate::params::{ClothParams, Family};
 use crate::settings::Settings;
@@ -129,6 +139,7 @@ impl Material {
             stretch: median(stretch),
             shear: median(shear),
             bending: median(bending),
+            isometric: (!isometric_hinges(mesh).is_empty()).then_some(self.bending),
         }
     }
 
@@ -144,6 +155,16 @@ impl Material {
             .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
             .collect();
         let rest_dihedral = rest_weights_dihedral(mesh, &w);
+        let rest_isometric = median(
+            isometric_hinges(mesh)
+                .iter()
+                .map(|(idx, shape)| {
+                    (0..4)
+                        .map(|k| w[idx[k] as usize] * shape.weights[k] * shape.weights[k])
+                        .sum()
+                })
+                .collect(),
+        );
         let rest_distance = |pairs: &[[u32; 2]]| {
             median(
                 pairs
@@ -173,7 +194,17 @@ impl Material {
         set(Family::Stretch, k.stretch, rest_distance(&mesh.stretch));
         set(Family::Shear, k.shear, rest_distance(&mesh.shear));
         set(Family::BendDistance, None, None);
-        set(Family::BendDihedral, k.bending, rest_dihedral);
+        let soft = match (k.isometric, rest_isometric) {
+            (Some(b), Some(s)) => 1.0 / (b * h * h) >= s,
+            _ => false,
+        };
+        if soft {
+            set(Family::BendDihedral, None, None);
+            set(Family::BendIsometric, k.isometric, rest_isometric);
+        } else {
+            set(Family::BendDihedral, k.bending, rest_dihedral);
+            set(Family::BendIsometric, None, None);
+        }
         out
     }
 }
@@ -187,6 +218,22 @@ pub struct MaterialStiffness {
     pub shear: Option<f64>,
     /// Dihedral springs (N·m/rad).
     pub bending: Option<f64>,
+    /// Isometric bending stiffness, B itself (N·m); `None` without interior edges.
+    pub isometric: Option<f64>,
+}
+
+/// Every interior edge's particles `[wing_a, wing_b, edge_0, edge_1]` and isometric shape at
+/// rest (degenerate hinges left out, as the solver builder leaves them out).
+fn isometric_hinges(mesh: &ClothMesh) -> Vec<([u32; 4], Isometric)> {
+    let topo = Topology::new(&mesh.triangles);
+    let p = &mesh.positions;
+    topo.wings
+        .iter()
+        .filter_map(|wing| {
+            let idx = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
+            Some((idx, Isometric::at_rest(&idx.map(|i| p[i as usize]))?))
+        })
+        .collect()
 }
 
 /// Median of Σ wᵢ |∇ᵢθ|² over the dihedral constraints at rest.
@@ -279,7 +326,18 @@ mod tests {
         let p1 = CLOTH.params(&mesh, &s1, &ClothParams::default());
         let st = p1.get(Family::Stretch);
         assert!((st.compliance * st.spring_stiffness - 1.0).abs() < 1e-12);
-        assert!(!p1.get(Family::BendDistance).enabled && p1.get(Family::BendDihedral).enabled);
+        // Soft per substep (1/(B h²) ≫ Σ w|∇C|²): isometric bending of stiffness B.
+        assert!(!p1.get(Family::BendDistance).enabled && !p1.get(Family::BendDihedral).enabled);
+        let bend = p1.get(Family::BendIsometric);
+        assert!(bend.enabled && (bend.compliance * 1e-5 - 1.0).abs() < 1e-12);
+        assert_eq!(bend.spring_stiffness, 1e-5);
+        // A board-stiff fabric on a fine, light grid is stiff per substep: the dihedral.
+        let board = Material {
+            bending: 1.0,
+            ..CLOTH
+        };
+        let fine = board.params(&grid(64, (0.1, 0.1)), &s1, &ClothParams::default());
+        assert!(fine.get(Family::BendDihedral).enabled && !fine.get(Family::BendIsometric).enabled);
         // More iterations: a smaller k per projection, the same fraction per substep.
         let s4 = Settings {
             iterations: 4,

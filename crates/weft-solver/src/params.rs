@@ -14,17 +14,21 @@ pub enum Family {
     BendDistance,
     /// Dihedral angle across each interior edge.
     BendDihedral,
+    /// Isometric bending across each interior edge: the quadratic energy of Bergou et al. 2006,
+    /// flat at rest (constant weights, no angle: cheaper than the dihedral).
+    BendIsometric,
     /// Long-range attachments to pinned particles (unilateral: only resists stretching).
     Tether,
 }
 
 impl Family {
     /// Every family, in a fixed order.
-    pub const ALL: [Family; 5] = [
+    pub const ALL: [Family; 6] = [
         Family::Stretch,
         Family::Shear,
         Family::BendDistance,
         Family::BendDihedral,
+        Family::BendIsometric,
         Family::Tether,
     ];
 
@@ -43,6 +47,7 @@ impl Family {
             Family::Shear => "shear",
             Family::BendDistance => "bend_distance",
             Family::BendDihedral => "bend_dihedral",
+            Family::BendIsometric => "bend_isometric",
             Family::Tether => "tether",
         }
     }
@@ -51,7 +56,9 @@ impl Family {
 /// The parameters of one constraint family, for each method.
 ///
 /// Units: distance families (stretch, shear, bend-distance, tether) use m/N for compliance and
-/// N/m for spring stiffness; the dihedral family uses rad/(N·m) and N·m/rad.
+/// N/m for spring stiffness; the dihedral family uses rad/(N·m) and N·m/rad; the isometric
+/// family's C is dimensionless (|e| θ/√A_e for a small fold θ) and its stiffness is the
+/// bending stiffness B itself: 1/(N·m) and N·m.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FamilyParams {
     /// Whether the family's constraints are created at all.
@@ -81,6 +88,7 @@ impl FamilyParams {
             Family::Shear => (true, 1e-6, 1.0, 2.0e3),
             Family::BendDistance => (true, 1e-3, 0.1, 50.0),
             Family::BendDihedral => (false, 1.0, 0.05, 0.05),
+            Family::BendIsometric => (false, 1e4, 0.05, 1e-4),
             Family::Tether => (false, 0.0, 1.0, 5.0e3),
         };
         Self {

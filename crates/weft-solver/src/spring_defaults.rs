@@ -22,13 +22,13 @@ pub const DEFAULT_SPRING_SUBSTEP: f64 = 1.0 / 600.0;
 /// the margin covers spring damping, stretched tethers and springs a user sets by hand).
 pub const DEFAULT_SPRING_HW: f64 = 1.0;
 
-/// Relative spring constant of each family (stretch 1); the dihedral's is per m² of edge.
+/// Relative spring constant of each family (stretch 1); the bending families' are per m² of edge.
 fn weight(family: Family, mean_edge: f64) -> f64 {
     match family {
         Family::Stretch | Family::Tether => 1.0,
         Family::Shear => 0.4,
         Family::BendDistance => 0.01,
-        Family::BendDihedral => 0.01 * mean_edge * mean_edge,
+        Family::BendDihedral | Family::BendIsometric => 0.01 * mean_edge * mean_edge,
     }
 }
 

@@ -25,7 +25,9 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::constraints::{Block, ConstraintSet, Dihedral, Distance, Seam, Shape, Tether};
+use crate::constraints::{
+    Block, ConstraintSet, Dihedral, Distance, Isometric, Seam, Shape, Tether,
+};
 use crate::params::FamilyParams;
 
 /// How fast a cloth's springs can ring and how much their dampers can bite.
@@ -40,6 +42,13 @@ pub struct StabilityBound {
     pub mode_omega: f64,
     /// That mode's damping rate (its Rayleigh quotient of M^{-1/2} D M^{-1/2}).
     pub mode_gamma: f64,
+}
+
+/// ∇C of an isometric hinge, kᵢ n with n = v/|v|; on a flat hinge (v = 0), where its stiffness
+/// k kᵢ kⱼ I is the same in every direction, along z.
+fn isometric_gradient(s: &Isometric, p: &[DVec3; 4]) -> Option<[DVec3; 4]> {
+    let n = s.curvature(p).try_normalize().unwrap_or(DVec3::Z);
+    Some(s.weights.map(|k| n * k))
 }
 
 /// Largest h with h²ω² + 2hγ < 4.
@@ -219,6 +228,16 @@ fn highest_mode(
             &mut kz,
             &mut cz,
         );
+        product(
+            &constraints.isometric,
+            x,
+            &sw,
+            params,
+            isometric_gradient,
+            &z,
+            &mut kz,
+            &mut cz,
+        );
         let g = |_: &Tether, p: &[DVec3; 2]| {
             let d = p[0] - p[1];
             let len = d.length();
@@ -270,6 +289,7 @@ pub(crate) fn bound(
     rows.add(&constraints.dihedral, x, w, params, |s, p| {
         s.evaluate(p).map(|(_, g)| g)
     });
+    rows.add(&constraints.isometric, x, w, params, isometric_gradient);
     // A tether pulls only once stretched; bound it as the spring it becomes then.
     rows.add(&constraints.tethers, x, w, params, |_, p| {
         let d = p[0] - p[1];

@@ -192,6 +192,9 @@ cloth_section! {
         BendDihedral: bend_dihedral_enabled, bend_dihedral_compliance, bend_dihedral_damping,
             bend_dihedral_pbd_stiffness, bend_dihedral_spring_stiffness,
             bend_dihedral_spring_damping;
+        BendIsometric: bend_isometric_enabled, bend_isometric_compliance,
+            bend_isometric_damping, bend_isometric_pbd_stiffness,
+            bend_isometric_spring_stiffness, bend_isometric_spring_damping;
         Tether: tether_enabled, tether_compliance, tether_damping,
             tether_pbd_stiffness, tether_spring_stiffness, tether_spring_damping;
     }

@@ -10,7 +10,7 @@ fn scene(cloth: &str) -> Result<weft_scene::Scene, weft_scene::SceneErrors> {
 }
 
 #[test]
-fn a_preset_sets_mass_and_every_method_and_turns_dihedral_bending_on() {
+fn a_preset_sets_mass_and_every_method_and_turns_isometric_bending_on() {
     let s = scene("material = \"denim\"").expect("valid");
     let c = &s.cloths[0];
     let denim = preset("denim").expect("preset");
@@ -19,7 +19,10 @@ fn a_preset_sets_mass_and_every_method_and_turns_dihedral_bending_on() {
         "1 m² of 400 g/m²"
     );
     let p = c.params;
-    assert!(p.get(Family::BendDihedral).enabled && !p.get(Family::BendDistance).enabled);
+    // Soft per substep at this resolution: isometric bending with stiffness B, no other.
+    assert!(p.get(Family::BendIsometric).enabled && !p.get(Family::BendDistance).enabled);
+    assert!(!p.get(Family::BendDihedral).enabled);
+    assert_eq!(p.get(Family::BendIsometric).spring_stiffness, denim.bending);
     let st = p.get(Family::Stretch);
     // Square cells: k = E − G per grid line; XPBD gets 1/k.
     assert!((st.spring_stiffness - (denim.stretch - denim.shear)).abs() < 1e-6);
@@ -35,7 +38,7 @@ fn fields_and_family_keys_override_the_preset() {
     let c = &s.cloths[0];
     assert!((c.mesh.total_mass() - 0.2).abs() < 1e-12);
     let p = c.params;
-    assert!((p.get(Family::BendDihedral).spring_stiffness - 2e-5).abs() < 1e-15);
+    assert_eq!(p.get(Family::BendIsometric).spring_stiffness, 2e-5);
     assert_eq!(p.get(Family::Shear).compliance, 0.5);
 }
 

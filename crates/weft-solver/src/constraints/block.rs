@@ -51,7 +51,7 @@ pub(crate) struct Block<const N: usize, S> {
     pub group: Vec<u32>,
     /// Rest data of each constraint.
     pub shapes: Vec<S>,
-    /// XPBD Lagrange multipliers, reset each substep.
+    /// XPBD Lagrange multipliers, reset each substep ([`Shape::MULTIPLIERS`] per constraint).
     pub lambda: Vec<f64>,
     /// Contiguous range of each colour.
     pub colors: Vec<Range<usize>>,
@@ -145,7 +145,7 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
             particles: order.iter().map(|&i| self.particles[i]).collect(),
             group: order.iter().map(|&i| self.group[i]).collect(),
             shapes: order.iter().map(|&i| self.shapes[i]).collect(),
-            lambda: vec![0.0; order.len()],
+            lambda: vec![0.0; order.len() * S::MULTIPLIERS],
             colors: ranges,
             order: order.iter().map(|&i| i as u32).collect(),
             part_bounds,
@@ -237,6 +237,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
         params: &[FamilyParams],
         rule: Rule,
     ) {
+        debug_assert_eq!(S::MULTIPLIERS, 1, "a vector constraint has its own sweep");
         let k = self.colors.len();
         self.project_colours(x, prev, w, params, rule, 0..k);
     }

@@ -23,10 +23,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use pulp::Simd;
 
 use super::lanes::Coefs;
-
-/// Positions of the four particles of `L` dihedrals, `[particle][axis][lane]`, in the
-/// order `[wing_a, wing_b, edge_0, edge_1]` of [`super::Dihedral`].
-pub(crate) type Quads<const L: usize> = [[[f64; L]; 3]; 4];
+use super::quad_sweep::Quads;
 
 /// tan(3π/8).
 const TAN_3PI_8: f64 = 2.414_213_562_373_095;

@@ -15,7 +15,7 @@
 
 use glam::DVec3;
 
-use super::{Block, ConstraintSet, Dihedral, Distance, Seam, Shape, Tether};
+use super::{Block, ConstraintSet, Dihedral, Distance, Isometric, Seam, Shape, Tether};
 use crate::params::FamilyParams;
 
 /// One spring evaluated at the current state.
@@ -40,6 +40,7 @@ struct Linear<const N: usize, S> {
 pub(crate) struct Springs {
     distance: Vec<Linear<2, Distance>>,
     dihedral: Vec<Linear<4, Dihedral>>,
+    isometric: Vec<Linear<4, Isometric>>,
     tethers: Vec<Linear<2, Tether>>,
     seams: Vec<Linear<2, Seam>>,
 }
@@ -114,6 +115,7 @@ impl ConstraintSet {
     ) {
         linearize(&self.distance, x, v, params, &mut out.distance);
         linearize(&self.dihedral, x, v, params, &mut out.dihedral);
+        linearize(&self.isometric, x, v, params, &mut out.isometric);
         linearize(&self.tethers, x, v, params, &mut out.tethers);
         linearize(&self.seams, x, v, &self.seam_params, &mut out.seams);
     }
@@ -131,6 +133,7 @@ impl Springs {
         }
         add(&self.distance, f);
         add(&self.dihedral, f);
+        add(&self.isometric, f);
         add(&self.tethers, f);
         add(&self.seams, f);
     }
@@ -141,6 +144,9 @@ impl Springs {
             l.product(a_k, a_c, p, out);
         }
         for l in &self.dihedral {
+            l.product(a_k, a_c, p, out);
+        }
+        for l in &self.isometric {
             l.product(a_k, a_c, p, out);
         }
         for l in &self.tethers {
@@ -158,6 +164,9 @@ impl Springs {
             l.diagonal(a_k, a_c, diag);
         }
         for l in &self.dihedral {
+            l.diagonal(a_k, a_c, diag);
+        }
+        for l in &self.isometric {
             l.diagonal(a_k, a_c, diag);
         }
         for l in &self.tethers {

@@ -3,17 +3,20 @@
 mod block;
 mod dihedral;
 mod dihedral_lanes;
-mod dihedral_sweep;
 mod distance;
+mod isometric;
+mod isometric_lanes;
 pub(crate) mod lanes;
 mod linear;
 mod parts;
+mod quad_sweep;
 mod seam;
 mod tether;
 
 pub(crate) use block::{Block, BlockBuilder, Rule};
 pub use dihedral::Dihedral;
 pub use distance::Distance;
+pub use isometric::Isometric;
 pub(crate) use linear::Springs;
 pub use seam::Seam;
 pub use tether::Tether;
@@ -25,6 +28,10 @@ use crate::params::FamilyParams;
 
 /// A constraint function C(p) over `N` particles with its gradient.
 pub trait Shape<const N: usize>: Copy + Send + Sync {
+    /// XPBD multipliers per constraint: 1 for a scalar C, 3 for a vector C (the isometric
+    /// bending's, one per axis).
+    const MULTIPLIERS: usize = 1;
+
     /// Returns C and ∇C at `p`, or `None` when the constraint is inactive or degenerate there.
     fn evaluate(&self, p: &[DVec3; N]) -> Option<(f64, [DVec3; N])>;
 
@@ -67,13 +74,16 @@ pub(crate) fn distance_curvature(p: &[DVec3; 2], dp: &[DVec3; 2]) -> [DVec3; 2] 
     [h, -h]
 }
 
-/// Every constraint of a solver: distance-like pairs, dihedral quadruples, tethers and seams.
+/// Every constraint of a solver: distance-like pairs, dihedral and isometric bending
+/// quadruples, tethers and seams.
 #[derive(Clone, Debug, Default)]
 pub struct ConstraintSet {
     /// Stretch, shear and bend-distance constraints.
     pub(crate) distance: Block<2, Distance>,
     /// Dihedral bending constraints.
     pub(crate) dihedral: Block<4, Dihedral>,
+    /// Isometric bending constraints.
+    pub(crate) isometric: Block<4, Isometric>,
     /// Long-range attachments.
     pub(crate) tethers: Block<2, Tether>,
     /// Seams being sewn or held closed; their group indexes `seam_params`.
@@ -96,7 +106,11 @@ pub struct Residual {
 impl ConstraintSet {
     /// Number of constraints of every shape.
     pub fn len(&self) -> usize {
-        self.distance.len() + self.dihedral.len() + self.tethers.len() + self.seams.len()
+        self.distance.len()
+            + self.dihedral.len()
+            + self.isometric.len()
+            + self.tethers.len()
+            + self.seams.len()
     }
 
     /// Whether there is no constraint.
@@ -104,11 +118,12 @@ impl ConstraintSet {
         self.len() == 0
     }
 
-    /// Number of colours in each block (distance, dihedral, tether).
-    pub fn color_counts(&self) -> [usize; 3] {
+    /// Number of colours in each block (distance, dihedral, isometric, tether).
+    pub fn color_counts(&self) -> [usize; 4] {
         [
             self.distance.color_count(),
             self.dihedral.color_count(),
+            self.isometric.color_count(),
             self.tethers.color_count(),
         ]
     }
@@ -143,13 +158,14 @@ impl ConstraintSet {
     pub(crate) fn reset_multipliers(&mut self) {
         // The distance constraints' multipliers live in `Domains`, which clears its own.
         self.dihedral.reset_multipliers();
+        self.isometric.reset_multipliers();
         self.tethers.reset_multipliers();
         self.seams.reset_multipliers();
     }
 
-    /// One Gauss–Seidel sweep over the dihedral, tether and seam constraints, colour by colour, the
-    /// dihedrals' symmetric (forward, then backward) through their lane kernel on kernel path
-    /// `path`; the distance constraints are solved by [`crate::domains::Domains`].
+    /// One Gauss–Seidel sweep over the bending, tether and seam constraints, colour by colour,
+    /// the bending blocks' symmetric (forward, then backward) through their lane kernels on
+    /// kernel path `path`; the distance constraints are solved by [`crate::domains::Domains`].
     pub(crate) fn project_others(
         &mut self,
         x: &mut [DVec3],
@@ -160,6 +176,8 @@ impl ConstraintSet {
         path: SimdPath,
     ) {
         self.dihedral
+            .project_symmetric_lanes(x, prev, w, params, rule, path);
+        self.isometric
             .project_symmetric_lanes(x, prev, w, params, rule, path);
         self.tethers.project(x, prev, w, params, rule);
         self.seams.project(x, prev, w, &self.seam_params, rule);
@@ -187,6 +205,7 @@ impl ConstraintSet {
     ) {
         self.distance.spring_forces(x, v, params, forces);
         self.dihedral.spring_forces(x, v, params, forces);
+        self.isometric.spring_forces(x, v, params, forces);
         self.tethers.spring_forces(x, v, params, forces);
         self.seams.spring_forces(x, v, &self.seam_params, forces);
     }

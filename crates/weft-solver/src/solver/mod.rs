@@ -437,6 +437,7 @@ impl Solver {
     fn fusable(&self) -> bool {
         self.forces.wind.aero.is_none()
             && self.constraints.dihedral.len() == 0
+            && self.constraints.isometric.len() == 0
             && self.constraints.tethers.len() == 0
             && self.constraints.seams.len() == 0
     }

@@ -12,6 +12,7 @@ mod free_fall;
 mod hanging_cloth;
 mod hanging_mass;
 mod implicit;
+mod isometric_bending;
 mod materials;
 mod oscillator;
 mod simd_paths;

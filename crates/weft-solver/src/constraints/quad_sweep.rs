@@ -1,5 +1,6 @@
-//! The dihedral block's symmetric Gauss–Seidel sweep through the lane kernel
-//! ([`super::dihedral_lanes`]), decomposed by particle ranges (see [`super::parts`]): every
+//! The symmetric Gauss–Seidel sweep of a block of four-particle constraints (dihedral or
+//! isometric bending) through its lane kernel ([`super::dihedral_lanes`],
+//! [`super::isometric_lanes`]), decomposed by particle ranges (see [`super::parts`]): every
 //! part's constraints colour by colour, the parts in parallel on their own slices of the
 //! positions, then the straddlers colour by colour; the backward half in the reverse order.
 //! One fork–join per half sweep instead of one per colour, and the order depends on the mesh
@@ -11,11 +12,80 @@ use glam::DVec3;
 use pulp::{Scalar, Scalar128b, Simd, WithSimd};
 use rayon::prelude::*;
 
-use super::dihedral_lanes::{self, Quads};
 use super::lanes::{Coef, Coefs};
-use super::{Block, Dihedral, Rule};
+use super::{Block, Dihedral, Isometric, Rule, Shape, dihedral_lanes, isometric_lanes};
 use crate::domains::SimdPath;
 use crate::params::FamilyParams;
+
+/// Positions of the four particles of `L` constraints, `[particle][axis][lane]`, in the
+/// order `[wing_a, wing_b, edge_0, edge_1]` of [`Dihedral`] and [`Isometric`].
+pub(crate) type Quads<const L: usize> = [[[f64; L]; 3]; 4];
+
+/// A four-particle shape with a kernel projecting `L` independent constraints at once in the
+/// vectors of a [`Simd`], every lane with the same IEEE operations (the same bits on every
+/// path and width).
+pub(crate) trait QuadLanes: Shape<4> {
+    /// Projects the constraints `shapes` (one per lane) on `x` in place, with their
+    /// multipliers `lambda` (constraint `l`'s at `l * MULTIPLIERS ..`); `prev` is read only
+    /// when `DAMPED`.
+    #[allow(clippy::too_many_arguments)]
+    fn project_lanes<S: Simd, const L: usize, const DAMPED: bool>(
+        s: S,
+        x: &mut Quads<L>,
+        prev: &Quads<L>,
+        w: &[[f64; L]; 4],
+        shapes: &[Self; L],
+        coef: &Coefs<L>,
+        lambda: &mut [f64],
+    );
+}
+
+impl QuadLanes for Dihedral {
+    #[inline(always)]
+    fn project_lanes<S: Simd, const L: usize, const DAMPED: bool>(
+        s: S,
+        x: &mut Quads<L>,
+        prev: &Quads<L>,
+        w: &[[f64; L]; 4],
+        shapes: &[Self; L],
+        coef: &Coefs<L>,
+        lambda: &mut [f64],
+    ) {
+        let rest: [f64; L] = std::array::from_fn(|l| shapes[l].rest);
+        let lambda: &mut [f64; L] = match lambda.try_into() {
+            Ok(a) => a,
+            Err(_) => return,
+        };
+        dihedral_lanes::project::<S, L, DAMPED>(s, x, prev, w, &rest, coef, lambda);
+    }
+}
+
+impl QuadLanes for Isometric {
+    #[inline(always)]
+    fn project_lanes<S: Simd, const L: usize, const DAMPED: bool>(
+        s: S,
+        x: &mut Quads<L>,
+        prev: &Quads<L>,
+        w: &[[f64; L]; 4],
+        shapes: &[Self; L],
+        coef: &Coefs<L>,
+        lambda: &mut [f64],
+    ) {
+        let k: [[f64; L]; 4] =
+            std::array::from_fn(|v| std::array::from_fn(|l| shapes[l].weights[v]));
+        if lambda.len() != 3 * L {
+            return;
+        }
+        let mut lam: [[f64; L]; 3] =
+            std::array::from_fn(|a| std::array::from_fn(|l| lambda[3 * l + a]));
+        isometric_lanes::project::<S, L, DAMPED>(s, x, prev, w, &k, coef, &mut lam);
+        for l in 0..L {
+            for a in 0..3 {
+                lambda[3 * l + a] = lam[a][l];
+            }
+        }
+    }
+}
 
 /// The per-group coefficients of `rule` ([`Coef::of`]), and whether any group is damped; under
 /// PBD each half of the symmetric sweep uses k' = 1 − (1 − k)^(1/2) (see
@@ -53,15 +123,15 @@ struct Sweep<'a> {
 }
 
 /// One run of constraints projected on one slice of the positions.
-struct Segment<'a> {
+struct Segment<'a, Q> {
     /// The positions of particles `base ..`.
     x: &'a mut [DVec3],
     /// Global index of `x[0]`.
     base: usize,
     /// The constraints' particles (global indices, all in `base .. base + x.len()`).
     idx: &'a [[u32; 4]],
-    /// Their rest angles.
-    shapes: &'a [Dihedral],
+    /// Their rest data.
+    shapes: &'a [Q],
     /// Their parameter groups.
     groups: &'a [u32],
     /// Their multipliers.
@@ -74,12 +144,12 @@ struct Segment<'a> {
 /// `lambda`, already sliced to `r`) on the positions `x` of particles `base ..`, on the
 /// sweep's kernel path (every path gives the same bits).
 #[allow(clippy::too_many_arguments)]
-fn project_run(
+fn project_run<Q: QuadLanes>(
     sweep: &Sweep,
     x: &mut [DVec3],
     base: usize,
     particles: &[[u32; 4]],
-    shapes: &[Dihedral],
+    shapes: &[Q],
     groups: &[u32],
     r: Range<usize>,
     lambda: &mut [f64],
@@ -96,16 +166,16 @@ fn project_run(
     match sweep.path {
         #[cfg(target_arch = "x86_64")]
         SimdPath::Avx512 => match (pulp::x86::V4::try_new(), pulp::x86::V3::try_new()) {
-            (Some(v4), _) => Simd::vectorize(v4, Run::<8>(seg)),
-            (None, Some(v3)) => Simd::vectorize(v3, Run::<4>(seg)),
-            (None, None) => Run::<2>(seg).with_simd(Scalar128b),
+            (Some(v4), _) => Simd::vectorize(v4, Run::<Q, 8>(seg)),
+            (None, Some(v3)) => Simd::vectorize(v3, Run::<Q, 4>(seg)),
+            (None, None) => Run::<Q, 2>(seg).with_simd(Scalar128b),
         },
         #[cfg(target_arch = "x86_64")]
         SimdPath::Avx2 => match pulp::x86::V3::try_new() {
-            Some(v3) => Simd::vectorize(v3, Run::<4>(seg)),
-            None => Run::<2>(seg).with_simd(Scalar128b),
+            Some(v3) => Simd::vectorize(v3, Run::<Q, 4>(seg)),
+            None => Run::<Q, 2>(seg).with_simd(Scalar128b),
         },
-        _ => Run::<2>(seg).with_simd(Scalar128b),
+        _ => Run::<Q, 2>(seg).with_simd(Scalar128b),
     }
 }
 
@@ -118,37 +188,41 @@ fn project_run(
 /// arrays compiled to scalar divisions and branches once inlined into the sweep (T-shirt,
 /// solve only, 2 threads: 22.8 ms against 12.9 ms with `V3`; `V4` against `V3` alternated:
 /// 12.1, 12.1, 12.5 against 13.1, 13.3, 14.3 ms).
-struct Run<'s, 'a, const L: usize>(&'s mut Segment<'a>);
+struct Run<'s, 'a, Q, const L: usize>(&'s mut Segment<'a, Q>);
 
-impl<const L: usize> WithSimd for Run<'_, '_, L> {
+impl<Q: QuadLanes, const L: usize> WithSimd for Run<'_, '_, Q, L> {
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, s: S) {
         if self.0.sweep.damped {
-            run_with::<S, L, true>(s, self.0);
+            run_with::<S, Q, L, true>(s, self.0);
         } else {
-            run_with::<S, L, false>(s, self.0);
+            run_with::<S, Q, L, false>(s, self.0);
         }
     }
 }
 
 /// Full chunks of `L` constraints through the `L`-lane kernel, the rest one at a time.
 #[inline(always)]
-fn run_with<S: Simd, const L: usize, const DAMPED: bool>(s: S, seg: &mut Segment) {
+fn run_with<S: Simd, Q: QuadLanes, const L: usize, const DAMPED: bool>(s: S, seg: &mut Segment<Q>) {
     let n = seg.idx.len();
     let full = n / L * L;
     for start in (0..full).step_by(L) {
-        chunk::<S, L, DAMPED>(s, seg, start);
+        chunk::<S, Q, L, DAMPED>(s, seg, start);
     }
     for k in full..n {
-        chunk::<Scalar, 1, DAMPED>(Scalar, seg, k);
+        chunk::<Scalar, Q, 1, DAMPED>(Scalar, seg, k);
     }
 }
 
 /// Gathers constraints `start .. start + L`, projects them, scatters the positions back.
 #[inline(always)]
-fn chunk<S: Simd, const L: usize, const DAMPED: bool>(s: S, seg: &mut Segment, start: usize) {
+fn chunk<S: Simd, Q: QuadLanes, const L: usize, const DAMPED: bool>(
+    s: S,
+    seg: &mut Segment<Q>,
+    start: usize,
+) {
     let idx: &[[u32; 4]; L] = match seg.idx[start..start + L].try_into() {
         Ok(a) => a,
         Err(_) => return,
@@ -185,18 +259,21 @@ fn chunk<S: Simd, const L: usize, const DAMPED: bool>(s: S, seg: &mut Segment, s
             w[v][l] = mass[(at[v][l] + seg.base).min(mass.len().saturating_sub(1))];
         }
     }
-    let rest: [f64; L] = std::array::from_fn(|l| seg.shapes[start + l].rest);
+    let shapes: &[Q; L] = match seg.shapes[start..start + L].try_into() {
+        Ok(a) => a,
+        Err(_) => return,
+    };
     // One parameter group (one cloth) is the common case: its coefficients in every lane
     // without a per-lane lookup.
     let coef = match seg.sweep.coef {
         [one] => Coefs::splat(*one),
         all => Coefs::from_fn(|l| all[seg.groups[start + l] as usize]),
     };
-    let lambda: &mut [f64; L] = match (&mut seg.lambda[start..start + L]).try_into() {
-        Ok(a) => a,
-        Err(_) => return,
+    let m = Q::MULTIPLIERS;
+    let Some(lambda) = seg.lambda.get_mut(start * m..(start + L) * m) else {
+        return;
     };
-    dihedral_lanes::project::<S, L, DAMPED>(s, &mut x, &prev, &w, &rest, &coef, lambda);
+    Q::project_lanes::<S, L, DAMPED>(s, &mut x, &prev, &w, shapes, &coef, lambda);
     for v in 0..4 {
         for l in 0..L {
             seg.x[at[v][l]] = DVec3::new(x[v][0][l], x[v][1][l], x[v][2][l]);
@@ -204,7 +281,7 @@ fn chunk<S: Simd, const L: usize, const DAMPED: bool>(s: S, seg: &mut Segment, s
     }
 }
 
-impl Block<4, Dihedral> {
+impl<Q: QuadLanes> Block<4, Q> {
     /// One symmetric Gauss–Seidel sweep through the lane kernel on kernel path `path`: forward,
     /// every part's constraints colour by colour (the parts in parallel, each on its own
     /// particles), then the straddlers colour by colour; backward, the same in reverse. The
@@ -262,12 +339,13 @@ impl Block<4, Dihedral> {
         let mut runs: Vec<Vec<(Range<usize>, &mut [f64])>> = (0..parts)
             .map(|_| Vec::with_capacity(segments.len()))
             .collect();
+        let m = Q::MULTIPLIERS;
         let (mut rest, mut offset) = (&mut lambda[..], 0);
         for seg in segments.iter() {
             for (p, part_runs) in runs.iter_mut().enumerate() {
                 let r = seg[p]..seg[p + 1];
-                let (_, tail) = rest.split_at_mut(r.start - offset);
-                let (mine, tail) = tail.split_at_mut(r.len());
+                let (_, tail) = rest.split_at_mut((r.start - offset) * m);
+                let (mine, tail) = tail.split_at_mut(r.len() * m);
                 part_runs.push((r.clone(), mine));
                 (rest, offset) = (tail, r.end);
             }
@@ -308,7 +386,8 @@ impl Block<4, Dihedral> {
         let parts = self.part_bounds.len() - 1;
         let mut colour = |c: usize| {
             let r = self.segments[c][parts]..self.segments[c][parts + 1];
-            let lambda = &mut self.lambda[r.clone()];
+            let m = Q::MULTIPLIERS;
+            let lambda = &mut self.lambda[r.start * m..r.end * m];
             project_run(
                 sweep,
                 x,
