@@ -49,13 +49,13 @@ const Q: [f64; 5] = [
 
 /// The lanes of `a` as one vector of `S` (`L` = `S`'s f64 lanes).
 #[inline(always)]
-fn load<S: Simd, const L: usize>(a: [f64; L]) -> S::f64s {
+pub(crate) fn load<S: Simd, const L: usize>(a: [f64; L]) -> S::f64s {
     bytemuck::cast(a)
 }
 
 /// The lanes of `v` as an array.
 #[inline(always)]
-fn store<S: Simd, const L: usize>(v: S::f64s) -> [f64; L] {
+pub(crate) fn store<S: Simd, const L: usize>(v: S::f64s) -> [f64; L] {
     bytemuck::cast(v)
 }
 

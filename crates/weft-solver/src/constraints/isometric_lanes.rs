@@ -9,20 +9,9 @@
 
 use pulp::Simd;
 
+use super::dihedral_lanes::{load, store};
 use super::lanes::Coefs;
 use super::quad_sweep::Quads;
-
-/// The lanes of `a` as one vector of `S` (`L` = `S`'s f64 lanes).
-#[inline(always)]
-fn load<S: Simd, const L: usize>(a: [f64; L]) -> S::f64s {
-    bytemuck::cast(a)
-}
-
-/// The lanes of `v` as an array.
-#[inline(always)]
-fn store<S: Simd, const L: usize>(v: S::f64s) -> [f64; L] {
-    bytemuck::cast(v)
-}
 
 /// Projects `L` independent isometric-bending constraints in place, `L` being the f64 lanes
 /// of `S`: the vector constraint C = v = Σᵢ kᵢ xᵢ, one row per axis with the same gradient

@@ -2,31 +2,12 @@
 //! with no gravity and no damping, never holds more kinetic plus bending energy than it started
 //! with. (A forward-only Gauss–Seidel sweep of the dihedrals gained 30× here.)
 
-use std::collections::HashMap;
-
+use crate::common::hinges;
 use weft_solver::constraints::Dihedral;
 use weft_solver::glam::DVec3;
 use weft_solver::{
     ClothParams, Family, Forces, GridDesc, Mass, Method, Orientation, Settings, SolverBuilder,
 };
-
-/// Every interior edge of `triangles` as `[wing_a, wing_b, edge_0, edge_1]`.
-fn hinges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
-    let mut open: HashMap<(u32, u32), (u32, u32, u32)> = HashMap::new();
-    let mut out = Vec::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b, opposite) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-            match open.remove(&(a.min(b), a.max(b))) {
-                Some((wing, e0, e1)) => out.push([wing, opposite, e0, e1]),
-                None => {
-                    open.insert((a.min(b), a.max(b)), (opposite, a, b));
-                }
-            }
-        }
-    }
-    out
-}
 
 #[test]
 fn stiff_dihedral_bending_does_not_gain_energy_in_a_free_bent_cloth() {

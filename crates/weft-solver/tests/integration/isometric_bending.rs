@@ -3,31 +3,12 @@
 //! direction; a weighted hinge rests where its compliance says at any substep count (XPBD),
 //! and PBD's does not; a free bent sheet does not gain energy in the soft regime.
 
-use std::collections::HashMap;
-
+use crate::common::hinges;
 use weft_solver::constraints::Isometric;
 use weft_solver::glam::{DVec2, DVec3};
 use weft_solver::{
     ClothMesh, ClothParams, Family, Forces, Mass, Method, Settings, Solver, SolverBuilder,
 };
-
-/// Every interior edge of `triangles` as `[wing_a, wing_b, edge_0, edge_1]`.
-fn hinges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
-    let mut open: HashMap<(u32, u32), (u32, u32, u32)> = HashMap::new();
-    let mut out = Vec::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b, opposite) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-            match open.remove(&(a.min(b), a.max(b))) {
-                Some((wing, e0, e1)) => out.push([wing, opposite, e0, e1]),
-                None => {
-                    open.insert((a.min(b), a.max(b)), (opposite, a, b));
-                }
-            }
-        }
-    }
-    out
-}
 
 /// A flat sheet in the z = 0 plane: `cols × rows` vertices of spacing `h`, equilateral
 /// triangles (odd rows shifted by h/2) or right triangles of a square grid.

@@ -3,6 +3,8 @@
 
 pub mod flag;
 
+use std::collections::HashMap;
+
 use weft_solver::glam::DVec3;
 use weft_solver::{
     ClothMesh, ClothParams, Corner, Edge, Family, Forces, GridDesc, Mass, Method, Orientation, Pin,
@@ -102,4 +104,22 @@ pub fn lowest_y(s: &Solver) -> f64 {
         .iter()
         .map(|p| p.y)
         .fold(f64::INFINITY, f64::min)
+}
+
+/// Every interior edge of `triangles` as `[wing_a, wing_b, edge_0, edge_1]`.
+pub fn hinges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
+    let mut open: HashMap<(u32, u32), (u32, u32, u32)> = HashMap::new();
+    let mut out = Vec::new();
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b, opposite) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            match open.remove(&(a.min(b), a.max(b))) {
+                Some((wing, e0, e1)) => out.push([wing, opposite, e0, e1]),
+                None => {
+                    open.insert((a.min(b), a.max(b)), (opposite, a, b));
+                }
+            }
+        }
+    }
+    out
 }
