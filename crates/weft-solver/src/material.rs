@@ -139,7 +139,7 @@ impl Material {
             stretch: median(stretch),
             shear: median(shear),
             bending: median(bending),
-            isometric: (!isometric_hinges(mesh).is_empty()).then_some(self.bending),
+            isometric: (!topo.wings.is_empty()).then_some(self.bending),
         }
     }
 
