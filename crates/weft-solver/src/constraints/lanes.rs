@@ -1,18 +1,22 @@
 //! The distance-constraint projection written over `L` independent lanes at once.
 //!
-//! One generic function serves the SIMD chunks (`L = LANES`, loaded with unit-stride, paired or
-//! gathered loads) and the scalar remainder (`L = 1`). Every lane runs the same IEEE operations in
-//! the same order, so a constraint gets bit-identical results whichever path projects it; that is
-//! what keeps runs independent of the thread count and of how constraints fall into chunks.
+//! One generic step ([`scale`]) serves the SIMD chunks of a domain's sweep (f32 lanes on rebased
+//! positions, loaded with unit-stride, paired or gathered loads), its scalar remainder (`L = 1`)
+//! and the links between domains ([`project`], f64). Every lane runs the same IEEE operations
+//! in the same order, so a constraint gets bit-identical results whichever path projects it;
+//! that is what keeps runs independent of the thread count and of how constraints fall into
+//! chunks.
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
 #![allow(clippy::needless_range_loop)]
 
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
+
 use super::Rule;
 use crate::params::FamilyParams;
 
-/// Lanes per SIMD chunk (8 × f64: one AVX-512 register, two AVX2 ones, four SSE2 ones).
+/// Constraints per SIMD chunk (8 × f32: one AVX2 register, two SSE2 or NEON ones).
 pub(crate) const LANES: usize = 8;
 
 /// Per-group coefficients of the unified multiplier step (see [`project`]).
@@ -53,25 +57,84 @@ impl Coef {
     }
 }
 
-/// [`Coef`] for `L` lanes, struct-of-arrays.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Coefs<const L: usize> {
-    /// k per lane.
-    pub k: [f64; L],
-    /// α̃ per lane.
-    pub alpha: [f64; L],
-    /// γ per lane.
-    pub gamma: [f64; L],
+/// The lane type of the distance kernel: f64 (global positions, links) or f32 (a domain's
+/// rebased positions, see `domains::sweep`). Both are IEEE types whose `+ − × ÷ √` round
+/// correctly, so every vector width gives the same bits.
+pub(crate) trait Real:
+    Copy
+    + Default
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// Lengths below this (1e-9 m) leave a constraint alone.
+    const MIN_LEN: Self;
+    /// The smallest positive normal value.
+    const MIN_POSITIVE: Self;
+    /// Correctly rounded square root.
+    fn sqrt(self) -> Self;
+    /// The nearest value to `v`.
+    fn of(v: f64) -> Self;
 }
 
-impl<const L: usize> Coefs<L> {
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const MIN_LEN: Self = 1e-9;
+    const MIN_POSITIVE: Self = f64::MIN_POSITIVE;
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn of(v: f64) -> Self {
+        v
+    }
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const MIN_LEN: Self = 1e-9;
+    const MIN_POSITIVE: Self = f32::MIN_POSITIVE;
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn of(v: f64) -> Self {
+        v as f32
+    }
+}
+
+/// [`Coef`] for `L` lanes, struct-of-arrays, in lane type `T`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Coefs<const L: usize, T = f64> {
+    /// k per lane.
+    pub k: [T; L],
+    /// α̃ per lane.
+    pub alpha: [T; L],
+    /// γ per lane.
+    pub gamma: [T; L],
+}
+
+impl<const L: usize, T: Real> Coefs<L, T> {
     /// The same coefficients in every lane.
     #[inline(always)]
     pub fn splat(c: Coef) -> Self {
         Self {
-            k: [c.k; L],
-            alpha: [c.alpha; L],
-            gamma: [c.gamma; L],
+            k: [T::of(c.k); L],
+            alpha: [T::of(c.alpha); L],
+            gamma: [T::of(c.gamma); L],
         }
     }
 
@@ -80,9 +143,9 @@ impl<const L: usize> Coefs<L> {
     pub fn from_fn(f: impl Fn(usize) -> Coef) -> Self {
         let c: [Coef; L] = std::array::from_fn(f);
         Self {
-            k: std::array::from_fn(|l| c[l].k),
-            alpha: std::array::from_fn(|l| c[l].alpha),
-            gamma: std::array::from_fn(|l| c[l].gamma),
+            k: std::array::from_fn(|l| T::of(c[l].k)),
+            alpha: std::array::from_fn(|l| T::of(c[l].alpha)),
+            gamma: std::array::from_fn(|l| T::of(c[l].gamma)),
         }
     }
 }
@@ -96,22 +159,8 @@ pub(crate) struct Ends<const L: usize> {
     pub q: [[f64; L]; 3],
 }
 
-/// Projects `L` independent distance constraints C = |p − q| − d in place.
-///
-/// Δλ = (−k C − α̃ λ − γ ∇C·(x − x_prev)) / ((1 + γ)(w_p + w_q) + α̃), then
-/// Δp = +w_p n Δλ, Δq = −w_q n Δλ with n = (p − q)/|p − q|. For XPBD (k = 1) this is Macklin et
-/// al. 2016 eq. (18) with the damping of eq. (26); for PBD (α̃ = γ = 0) it is Müller et al. 2007
-/// eq. (10), −k C / (w_p + w_q). Degenerate lanes (|p − q| < 1e-9 or a zero denominator) are
-/// left alone. `prev` is read only when `DAMPED`.
-///
-/// Every step is a straight loop over lanes with selects instead of branches, so that it
-/// compiles to vector instructions; without damping the two divisions (by |p − q| and by the
-/// denominator) are folded into one, s = num / (denom |p − q|), Δp = w_p s (p − q).
-///
-/// Two terms can be left out where they cannot change a bit: without `LAMBDA` the caller
-/// passes λ = +0 in every lane and every α̃ is finite, so α̃ λ = +0 and −k C − (+0) = −k C for
-/// every value; with `UNIT_K` every lane has k = 1 (XPBD), and −1 · C = −C exactly. The
-/// general form (`LAMBDA`, not `UNIT_K`) is right for any coefficients.
+/// Projects `L` independent distance constraints C = |p − q| − d in place (f64 positions:
+/// links and single constraints); see [`scale`] for the step.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project<
@@ -129,63 +178,107 @@ pub(crate) fn project<
     lambda: &mut [f64; L],
 ) {
     let mut d = [[0.0; L]; 3];
+    let mut motion = [[0.0; L]; 3];
     for a in 0..3 {
         for l in 0..L {
             d[a][l] = x.p[a][l] - x.q[a][l];
         }
+        if DAMPED {
+            for l in 0..L {
+                motion[a][l] = (x.p[a][l] - prev.p[a][l]) - (x.q[a][l] - prev.q[a][l]);
+            }
+        }
     }
-    let mut len = [0.0; L];
+    let s = scale::<f64, L, DAMPED, LAMBDA, UNIT_K>(&d, &motion, wp, wq, rest, coef, lambda);
+    for a in 0..3 {
+        for l in 0..L {
+            x.p[a][l] += d[a][l] * (wp[l] * s[l]);
+            x.q[a][l] -= d[a][l] * (wq[l] * s[l]);
+        }
+    }
+}
+
+/// The multiplier step of `L` independent distance constraints C = |p − q| − d, given each
+/// lane's difference `d` = p − q and (read only when `DAMPED`) its relative motion
+/// (x_p − x_p,prev) − (x_q − x_q,prev); updates λ and returns the factor s of the corrections
+/// Δp = +w_p s (p − q), Δq = −w_q s (p − q).
+///
+/// Δλ = (−k C − α̃ λ − γ ∇C·(x − x_prev)) / ((1 + γ)(w_p + w_q) + α̃) and s = Δλ/|p − q|.
+/// For XPBD (k = 1) this is Macklin et al. 2016 eq. (18) with the damping of eq. (26); for
+/// PBD (α̃ = γ = 0) it is Müller et al. 2007 eq. (10), −k C / (w_p + w_q). Degenerate lanes
+/// (|p − q| < 1e-9 or a zero denominator) get s = 0.
+///
+/// Every step is a straight loop over lanes with selects instead of branches, so that it
+/// compiles to vector instructions; without damping the two divisions (by |p − q| and by the
+/// denominator) are folded into one, s = num / (denom |p − q|).
+///
+/// Two terms can be left out where they cannot change a bit: without `LAMBDA` the caller
+/// passes λ = +0 in every lane and every α̃ is finite, so α̃ λ = +0 and −k C − (+0) = −k C for
+/// every value; with `UNIT_K` every lane has k = 1 (XPBD), and −1 · C = −C exactly. The
+/// general form (`LAMBDA`, not `UNIT_K`) is right for any coefficients.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn scale<
+    T: Real,
+    const L: usize,
+    const DAMPED: bool,
+    const LAMBDA: bool,
+    const UNIT_K: bool,
+>(
+    d: &[[T; L]; 3],
+    motion: &[[T; L]; 3],
+    wp: &[T; L],
+    wq: &[T; L],
+    rest: &[T; L],
+    coef: &Coefs<L, T>,
+    lambda: &mut [T; L],
+) -> [T; L] {
+    let mut len = [T::ZERO; L];
     for l in 0..L {
         len[l] = (d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l]).sqrt();
     }
-    // Per lane: the factor s with Δp = w_p s (p − q), Δq = −w_q s (p − q).
-    let mut scale = [0.0; L];
+    let mut scale = [T::ZERO; L];
     if DAMPED {
-        let mut grad_dx = [0.0; L];
+        let mut grad_dx = [T::ZERO; L];
         for a in 0..3 {
             for l in 0..L {
-                grad_dx[l] += d[a][l] * ((x.p[a][l] - prev.p[a][l]) - (x.q[a][l] - prev.q[a][l]));
+                grad_dx[l] += d[a][l] * motion[a][l];
             }
         }
         for l in 0..L {
-            let inv = 1.0 / len[l];
+            let inv = T::ONE / len[l];
             let c = len[l] - rest[l];
-            let denom = (1.0 + coef.gamma[l]) * (wp[l] + wq[l]) + coef.alpha[l];
-            let num = stiffness_term::<LAMBDA, UNIT_K>(c, coef.k[l], coef.alpha[l], lambda[l])
+            let denom = (T::ONE + coef.gamma[l]) * (wp[l] + wq[l]) + coef.alpha[l];
+            let num = stiffness_term::<T, LAMBDA, UNIT_K>(c, coef.k[l], coef.alpha[l], lambda[l])
                 - coef.gamma[l] * (grad_dx[l] * inv);
-            let ok = (len[l] >= 1e-9) & (denom > f64::MIN_POSITIVE);
-            let dl = if ok { num / denom } else { 0.0 };
+            let ok = (len[l] >= T::MIN_LEN) & (denom > T::MIN_POSITIVE);
+            let dl = if ok { num / denom } else { T::ZERO };
             lambda[l] += dl;
-            scale[l] = if ok { dl * inv } else { 0.0 };
+            scale[l] = if ok { dl * inv } else { T::ZERO };
         }
     } else {
         for l in 0..L {
             let c = len[l] - rest[l];
             let denom = (wp[l] + wq[l]) + coef.alpha[l];
-            let num = stiffness_term::<LAMBDA, UNIT_K>(c, coef.k[l], coef.alpha[l], lambda[l]);
-            let ok = (len[l] >= 1e-9) & (denom > f64::MIN_POSITIVE);
+            let num = stiffness_term::<T, LAMBDA, UNIT_K>(c, coef.k[l], coef.alpha[l], lambda[l]);
+            let ok = (len[l] >= T::MIN_LEN) & (denom > T::MIN_POSITIVE);
             let s = num / (denom * len[l]);
-            scale[l] = if ok { s } else { 0.0 };
+            scale[l] = if ok { s } else { T::ZERO };
             lambda[l] += scale[l] * len[l];
         }
     }
-    for a in 0..3 {
-        for l in 0..L {
-            x.p[a][l] += d[a][l] * (wp[l] * scale[l]);
-            x.q[a][l] -= d[a][l] * (wq[l] * scale[l]);
-        }
-    }
+    scale
 }
 
 /// −k C − α̃ λ, the numerator of Δλ before damping, with the terms [`project`]'s `LAMBDA`
 /// and `UNIT_K` leave out.
 #[inline(always)]
-fn stiffness_term<const LAMBDA: bool, const UNIT_K: bool>(
-    c: f64,
-    k: f64,
-    alpha: f64,
-    lambda: f64,
-) -> f64 {
+fn stiffness_term<T: Real, const LAMBDA: bool, const UNIT_K: bool>(
+    c: T,
+    k: T,
+    alpha: T,
+    lambda: T,
+) -> T {
     let kc = if UNIT_K { -c } else { -k * c };
     if LAMBDA { kc - alpha * lambda } else { kc }
 }

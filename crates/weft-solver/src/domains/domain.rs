@@ -16,26 +16,27 @@ use crate::constraints::lanes::Coef;
 use crate::forces::Forces;
 use crate::hook::{Contacts, ParticleContacts, ParticleRun};
 
-/// Distance constraints as struct-of-arrays.
+/// Distance constraints as struct-of-arrays; rest lengths and multipliers in f32, the lane
+/// type of the domain sweep (see `sweep`).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Pairs {
     /// First end (local index).
     pub p: Vec<u32>,
     /// Second end (local index).
     pub q: Vec<u32>,
-    /// Rest length (m).
-    pub rest: Vec<f64>,
+    /// Rest length (m), rounded to f32.
+    pub rest: Vec<f32>,
     /// Parameter group.
     pub group: Vec<u32>,
     /// XPBD multiplier.
-    pub lambda: Vec<f64>,
+    pub lambda: Vec<f32>,
 }
 
 impl Pairs {
     pub(super) fn push(&mut self, p: u32, q: u32, rest: f64, group: u32) {
         self.p.push(p);
         self.q.push(q);
-        self.rest.push(rest);
+        self.rest.push(rest as f32);
         self.group.push(group);
         self.lambda.push(0.0);
     }
@@ -54,6 +55,8 @@ pub(crate) struct Domain {
     pub(super) v: [Vec<f64>; 3],
     /// Inverse masses (1/kg).
     pub(super) w: Vec<f64>,
+    /// The sweep's working state (see [`Rebased`]).
+    pub(super) work: Rebased,
     /// Interior constraints in local indices, sorted by colour, group and particle.
     pub(super) pairs: Pairs,
     /// Range of each colour in `pairs`.
@@ -64,6 +67,25 @@ pub(crate) struct Domain {
     pub(super) plan: Vec<(Range<usize>, usize)>,
     /// The kernel path its sweep and integration run on.
     pub(super) path: SimdPath,
+}
+
+/// A domain's positions as the sweep sees them, in f32: each particle at `base + disp`
+/// relative to the domain's origin (its first particle's position when the sweep starts).
+/// `base` is rounded once per sweep and never changes during it; the sweep's corrections
+/// accumulate in `disp`, small numbers kept to f32's relative precision, and are added to the
+/// f64 positions when it ends. So f32 rounding moves where a constraint is evaluated by at most
+/// half an ulp of the particle's distance from the origin, but never the f64 state the
+/// integration reads (f32 positions would bias XPBD's equilibrium: see the README).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Rebased {
+    /// Position at the sweep's start relative to the origin, per axis, rounded to f32.
+    pub base: [Vec<f32>; 3],
+    /// Displacement accumulated by the sweep, per axis.
+    pub disp: [Vec<f32>; 3],
+    /// x − x_prev at the sweep's start, per axis (filled only for damped sweeps).
+    pub motion: [Vec<f32>; 3],
+    /// Inverse masses rounded to f32.
+    pub w: Vec<f32>,
 }
 
 /// A domain's share of the global particle arrays.
@@ -97,8 +119,12 @@ impl Domain {
             self.x[a].resize(n, 0.0);
             self.prev[a].resize(n, 0.0);
             self.v[a].resize(n, 0.0);
+            self.work.base[a].resize(n, 0.0);
+            self.work.disp[a].resize(n, 0.0);
+            self.work.motion[a].resize(n, 0.0);
         }
         self.w.resize(n, 0.0);
+        self.work.w.resize(n, 0.0);
     }
 
     /// Copies positions, velocities and inverse masses in from the global arrays.

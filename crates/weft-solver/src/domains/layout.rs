@@ -44,18 +44,18 @@ pub(super) struct Chunk {
     pub q0: u32,
     /// The first lane's parameter group.
     pub group: u32,
-    /// The first lane's rest length (m).
-    pub rest: f64,
+    /// The first lane's rest length (m, f32 like the sweep's arithmetic).
+    pub rest: f32,
 }
 
 /// Loads one end of lanes `off..off + W` of a chunk: `idx` gives each lane's particle.
 #[inline(always)]
-fn gather<const W: usize>(src: &[f64], idx: &[u32], off: usize) -> [f64; W] {
+fn gather<T: Copy, const W: usize>(src: &[T], idx: &[u32], off: usize) -> [T; W] {
     std::array::from_fn(|l| src[idx[off + l] as usize])
 }
 
 #[inline(always)]
-fn scatter<const W: usize>(dst: &mut [f64], idx: &[u32], off: usize, val: &[f64; W]) {
+fn scatter<T: Copy, const W: usize>(dst: &mut [T], idx: &[u32], off: usize, val: &[T; W]) {
     for l in 0..W {
         dst[idx[off + l] as usize] = val[l];
     }
@@ -65,17 +65,17 @@ fn scatter<const W: usize>(dst: &mut [f64], idx: &[u32], off: usize, val: &[f64;
 /// or inverse masses). `W` divides [`LANES`] and `off` is a multiple of `W`: a kernel path
 /// projects a chunk in parts as wide as its vector registers, read straight from the layout.
 #[inline(always)]
-pub(super) fn load_ends<const LAYOUT: u8, const W: usize>(
-    src: &[f64],
+pub(super) fn load_ends<const LAYOUT: u8, const W: usize, T: Copy + Default>(
+    src: &[T],
     p: &[u32],
     q: &[u32],
     off: usize,
-) -> ([f64; W], [f64; W]) {
+) -> ([T; W], [T; W]) {
     match layout_of(LAYOUT) {
         Layout::Contiguous => {
             let (p0, q0) = (p[0] as usize + off, q[0] as usize + off);
-            let mut a = [0.0; W];
-            let mut b = [0.0; W];
+            let mut a = [T::default(); W];
+            let mut b = [T::default(); W];
             a.copy_from_slice(&src[p0..p0 + W]);
             b.copy_from_slice(&src[q0..q0 + W]);
             (a, b)
@@ -128,13 +128,13 @@ pub(super) const STRIDED: usize = 2 * LANES - 1;
 
 /// Stores both ends of lanes `off..off + W` of a chunk (see [`load_ends`]).
 #[inline(always)]
-pub(super) fn store_ends<const LAYOUT: u8, const W: usize>(
-    dst: &mut [f64],
+pub(super) fn store_ends<const LAYOUT: u8, const W: usize, T: Copy + Default>(
+    dst: &mut [T],
     p: &[u32],
     q: &[u32],
     off: usize,
-    a: &[f64; W],
-    b: &[f64; W],
+    a: &[T; W],
+    b: &[T; W],
 ) {
     match layout_of(LAYOUT) {
         Layout::Contiguous => {
@@ -162,7 +162,7 @@ pub(super) fn store_ends<const LAYOUT: u8, const W: usize>(
             // Read, replace the part's slots, write back: the other slots (odd offsets) are
             // particles no lane of this chunk touches, so they keep their values.
             let p0 = p[0] as usize + 4 * off;
-            let mut win = [0.0; SPACED];
+            let mut win = [T::default(); SPACED];
             let win = &mut win[..4 * W - 1];
             win.copy_from_slice(&dst[p0..p0 + 4 * W - 1]);
             for l in 0..W {
@@ -176,7 +176,7 @@ pub(super) fn store_ends<const LAYOUT: u8, const W: usize>(
             for (start, v) in [(p0, a), (q0, b)] {
                 // Read, replace the even slots, write the window back: the odd slots are
                 // particles no other lane of this chunk touches, so they keep their values.
-                let mut win = [0.0; STRIDED];
+                let mut win = [T::default(); STRIDED];
                 let win = &mut win[..2 * W - 1];
                 win.copy_from_slice(&dst[start..start + 2 * W - 1]);
                 for l in 0..W {

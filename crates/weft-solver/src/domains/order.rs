@@ -104,7 +104,7 @@ impl Domain {
             let pairs = &mut self.pairs;
             let take = |v: &Vec<u32>| order.iter().map(|&k| v[k]).collect::<Vec<u32>>();
             let (p, q, group) = (take(&pairs.p), take(&pairs.q), take(&pairs.group));
-            let rest: Vec<f64> = order.iter().map(|&k| pairs.rest[k]).collect();
+            let rest: Vec<f32> = order.iter().map(|&k| pairs.rest[k]).collect();
             pairs.p[colour.clone()].copy_from_slice(&p);
             pairs.q[colour.clone()].copy_from_slice(&q);
             pairs.group[colour.clone()].copy_from_slice(&group);

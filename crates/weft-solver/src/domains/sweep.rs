@@ -1,5 +1,7 @@
 //! One Gauss–Seidel sweep over a domain's interior constraints: full chunks through the lane
-//! kernel, each colour's remainder and the links one at a time through the one-lane kernel.
+//! kernel, each colour's remainder one at a time through the one-lane kernel, all in f32 on the
+//! domain's rebased positions (see `Rebased`); the links between domains run in f64
+//! ([`project_one`]).
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
@@ -7,7 +9,7 @@
 
 use multiversion::multiversion;
 
-use super::domain::{Domain, Mode, Pairs};
+use super::domain::{Domain, Mode, Pairs, Rebased};
 use super::layout::{Chunk, Layout, layout_of, load_ends, store_ends};
 use super::simd::SimdPath;
 use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
@@ -32,19 +34,19 @@ fn sweep_avx512(dom: &mut Domain, coef: &[Coef], mode: Mode) {
 /// [`sweep`] compiled for AVX2 and FMA.
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn sweep_avx2(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes::<4>(dom, coef, mode);
+    sweep_modes::<8>(dom, coef, mode);
 }
 
 /// [`sweep`] compiled for NEON.
 #[multiversion(targets("aarch64+neon"))]
 fn sweep_neon(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes::<2>(dom, coef, mode);
+    sweep_modes::<4>(dom, coef, mode);
 }
 
 /// [`sweep`] compiled for the baseline target.
 #[inline(never)]
 fn sweep_scalar(dom: &mut Domain, coef: &[Coef], mode: Mode) {
-    sweep_modes::<2>(dom, coef, mode);
+    sweep_modes::<4>(dom, coef, mode);
 }
 
 /// The sweep with its optional terms chosen at compile time.
@@ -67,10 +69,9 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
     dom: &mut Domain,
     coef: &[Coef],
 ) {
+    rebase::<DAMPED>(dom);
     let Domain {
-        x,
-        prev,
-        w,
+        work,
         pairs,
         chunks,
         plan,
@@ -79,25 +80,67 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
     } = dom;
     for (c, (chunk_range, tail)) in plan.iter().enumerate() {
         for chunk in &chunks[chunk_range.clone()] {
-            project_chunk::<DAMPED, LAMBDA, UNIT_K, W>(chunk, pairs, x, prev, w, coef);
+            project_chunk::<DAMPED, LAMBDA, UNIT_K, W>(chunk, pairs, work, coef);
         }
         for k in *tail..colours[c].end {
-            let (p, q) = (pairs.p[k] as usize, pairs.q[k] as usize);
-            let mut lambda = if LAMBDA { pairs.lambda[k] } else { 0.0 };
-            let (xp, xq) = project_one::<DAMPED>(
-                End::of(x, prev, w, p),
-                End::of(x, prev, w, q),
-                pairs.rest[k],
-                coef[pairs.group[k] as usize],
-                &mut lambda,
+            let (p, q) = ([pairs.p[k]], [pairs.q[k]]);
+            let rest = [pairs.rest[k]];
+            let k_coef = Coefs::splat(coef[pairs.group[k] as usize]);
+            project_part::<DAMPED, LAMBDA, UNIT_K, GATHERED, 1>(
+                work,
+                &mut pairs.lambda[k..k + 1],
+                (&p, &q, 0),
+                &rest,
+                &k_coef,
             );
-            if LAMBDA {
-                pairs.lambda[k] = lambda;
+        }
+    }
+    fold(dom);
+}
+
+/// The layout number of [`Layout::Gathered`] (one load per lane), as `project_part` takes it.
+const GATHERED: u8 = 5;
+
+/// Starts a sweep: the domain's positions rebased to f32 (see [`Rebased`]), relative to its
+/// first particle, with no displacement yet; for a damped sweep also x − x_prev.
+#[inline(always)]
+fn rebase<const DAMPED: bool>(dom: &mut Domain) {
+    let n = dom.len();
+    let Rebased {
+        base,
+        disp,
+        motion,
+        w,
+    } = &mut dom.work;
+    for a in 0..3 {
+        let x = &dom.x[a][..n];
+        let origin = x.first().copied().unwrap_or(0.0);
+        let (b, d) = (&mut base[a][..n], &mut disp[a][..n]);
+        for i in 0..n {
+            b[i] = (x[i] - origin) as f32;
+            d[i] = 0.0;
+        }
+        if DAMPED {
+            let (prev, m) = (&dom.prev[a][..n], &mut motion[a][..n]);
+            for i in 0..n {
+                m[i] = (x[i] - prev[i]) as f32;
             }
-            for a in 0..3 {
-                x[a][p] = xp[a];
-                x[a][q] = xq[a];
-            }
+        }
+    }
+    for (w32, &w) in w[..n].iter_mut().zip(&dom.w[..n]) {
+        *w32 = w as f32;
+    }
+}
+
+/// Ends a sweep: the displacement it accumulated added to the f64 positions (each f32 widens
+/// exactly; the sum rounds in f64 like any position update).
+#[inline(always)]
+fn fold(dom: &mut Domain) {
+    let n = dom.len();
+    for a in 0..3 {
+        let (x, d) = (&mut dom.x[a][..n], &dom.work.disp[a][..n]);
+        for i in 0..n {
+            x[i] += f64::from(d[i]);
         }
     }
 }
@@ -106,9 +149,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
 fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const W: usize>(
     chunk: &Chunk,
     pairs: &mut Pairs,
-    x: &mut [Vec<f64>; 3],
-    prev: &[Vec<f64>; 3],
-    w: &[f64],
+    work: &mut Rebased,
     coef: &[Coef],
 ) {
     // One specialised body per layout keeps every lane array in registers (a layout
@@ -116,27 +157,25 @@ fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, con
     // masked loads, which cannot forward from the stores).
     match chunk.layout {
         Layout::Contiguous => {
-            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 0, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 0, W>(chunk, pairs, work, coef)
         }
         Layout::Paired => {
-            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 1, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 1, W>(chunk, pairs, work, coef)
         }
-        Layout::Quad => {
-            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 2, W>(chunk, pairs, x, prev, w, coef)
-        }
+        Layout::Quad => project_laid_out::<DAMPED, LAMBDA, UNIT_K, 2, W>(chunk, pairs, work, coef),
         Layout::Strided => {
-            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 3, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 3, W>(chunk, pairs, work, coef)
         }
         Layout::Spaced => {
-            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 4, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 4, W>(chunk, pairs, work, coef)
         }
         Layout::Gathered => {
-            project_laid_out::<DAMPED, LAMBDA, UNIT_K, 5, W>(chunk, pairs, x, prev, w, coef)
+            project_laid_out::<DAMPED, LAMBDA, UNIT_K, GATHERED, W>(chunk, pairs, work, coef)
         }
     }
 }
 
-/// Projects a chunk in parts of `W` lanes (the path's vector width in f64), each loaded
+/// Projects a chunk in parts of `W` lanes (the path's vector width in f32), each loaded
 /// straight from the layout, projected and stored before the next: the lanes of a chunk share
 /// no particle, so the parts' order changes no bit.
 #[inline(always)]
@@ -149,60 +188,92 @@ fn project_laid_out<
 >(
     chunk: &Chunk,
     pairs: &mut Pairs,
-    x: &mut [Vec<f64>; 3],
-    prev: &[Vec<f64>; 3],
-    w: &[f64],
+    work: &mut Rebased,
     coef: &[Coef],
 ) {
+    let Pairs {
+        p: all_p,
+        q: all_q,
+        rest: all_rest,
+        group,
+        lambda,
+    } = pairs;
     // A structured layout needs the first lane's particles only, kept in the chunk.
     let (p0, q0) = ([chunk.p0], [chunk.q0]);
-    let r = chunk.start..chunk.start + LANES;
+    let lanes = chunk.start..chunk.start + LANES;
     let (p, q): (&[u32], &[u32]) = if matches!(layout_of(LAYOUT), Layout::Gathered) {
-        (&pairs.p[r.clone()], &pairs.q[r])
+        (&all_p[lanes.clone()], &all_q[lanes])
     } else {
         (&p0, &q0)
     };
-    let [x0, x1, x2] = x;
     for off in (0..LANES).step_by(W) {
         let r = chunk.start + off..chunk.start + off + W;
-        let mut e = Ends {
-            p: [[0.0; W]; 3],
-            q: [[0.0; W]; 3],
-        };
-        (e.p[0], e.q[0]) = load_ends::<LAYOUT, W>(x0, p, q, off);
-        (e.p[1], e.q[1]) = load_ends::<LAYOUT, W>(x1, p, q, off);
-        (e.p[2], e.q[2]) = load_ends::<LAYOUT, W>(x2, p, q, off);
-        let pr = if DAMPED {
-            let mut pr = e;
-            for a in 0..3 {
-                (pr.p[a], pr.q[a]) = load_ends::<LAYOUT, W>(&prev[a], p, q, off);
-            }
-            pr
-        } else {
-            e
-        };
-        let (wp, wq) = load_ends::<LAYOUT, W>(w, p, q, off);
         let mut rest = [chunk.rest; W];
         if !chunk.same_rest {
-            rest.copy_from_slice(&pairs.rest[r.clone()]);
+            rest.copy_from_slice(&all_rest[r.clone()]);
         }
         let k = if chunk.uniform {
             Coefs::splat(coef[chunk.group as usize])
         } else {
-            let groups = &pairs.group[r.clone()];
+            let groups = &group[r.clone()];
             Coefs::from_fn(|l| coef[groups[l] as usize])
         };
-        let mut lambda = [0.0; W];
-        if LAMBDA {
-            lambda.copy_from_slice(&pairs.lambda[r.clone()]);
+        let lambda = &mut lambda[r];
+        project_part::<DAMPED, LAMBDA, UNIT_K, LAYOUT, W>(work, lambda, (p, q, off), &rest, &k);
+    }
+}
+
+/// Projects `W` lanes in f32 on the rebased positions: `ends` are the particle indices (or the
+/// first lane's, for a structured layout) and the lanes' offset in them, `lambda` the lanes'
+/// multipliers. Each end sits at base + disp; C and the step come from [`lanes::scale`], and
+/// the corrections go into disp.
+#[inline(always)]
+fn project_part<
+    const DAMPED: bool,
+    const LAMBDA: bool,
+    const UNIT_K: bool,
+    const LAYOUT: u8,
+    const W: usize,
+>(
+    work: &mut Rebased,
+    lambda_out: &mut [f32],
+    (p, q, off): (&[u32], &[u32], usize),
+    rest: &[f32; W],
+    k: &Coefs<W, f32>,
+) {
+    let mut d = [[0.0f32; W]; 3];
+    let mut motion = [[0.0f32; W]; 3];
+    let mut pd = [[0.0f32; W]; 3];
+    let mut qd = [[0.0f32; W]; 3];
+    for a in 0..3 {
+        let (pb, qb) = load_ends::<LAYOUT, W, f32>(&work.base[a], p, q, off);
+        (pd[a], qd[a]) = load_ends::<LAYOUT, W, f32>(&work.disp[a], p, q, off);
+        for l in 0..W {
+            d[a][l] = (pb[l] + pd[a][l]) - (qb[l] + qd[a][l]);
         }
-        lanes::project::<W, DAMPED, LAMBDA, UNIT_K>(&mut e, &pr, &wp, &wq, &rest, &k, &mut lambda);
-        if LAMBDA {
-            pairs.lambda[r].copy_from_slice(&lambda);
+        if DAMPED {
+            let (pm, qm) = load_ends::<LAYOUT, W, f32>(&work.motion[a], p, q, off);
+            for l in 0..W {
+                motion[a][l] = (pm[l] + pd[a][l]) - (qm[l] + qd[a][l]);
+            }
         }
-        store_ends::<LAYOUT, W>(x0, p, q, off, &e.p[0], &e.q[0]);
-        store_ends::<LAYOUT, W>(x1, p, q, off, &e.p[1], &e.q[1]);
-        store_ends::<LAYOUT, W>(x2, p, q, off, &e.p[2], &e.q[2]);
+    }
+    let (wp, wq) = load_ends::<LAYOUT, W, f32>(&work.w, p, q, off);
+    let mut lambda = [0.0f32; W];
+    if LAMBDA {
+        lambda.copy_from_slice(lambda_out);
+    }
+    let s =
+        lanes::scale::<f32, W, DAMPED, LAMBDA, UNIT_K>(&d, &motion, &wp, &wq, rest, k, &mut lambda);
+    if LAMBDA {
+        lambda_out.copy_from_slice(&lambda);
+    }
+    for a in 0..3 {
+        for l in 0..W {
+            pd[a][l] += d[a][l] * (wp[l] * s[l]);
+            qd[a][l] -= d[a][l] * (wq[l] * s[l]);
+        }
+        store_ends::<LAYOUT, W, f32>(&mut work.disp[a], p, q, off, &pd[a], &qd[a]);
     }
 }
 
