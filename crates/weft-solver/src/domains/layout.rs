@@ -117,6 +117,31 @@ pub(super) fn load_ends<const LAYOUT: u8, const W: usize, T: Copy + Default>(
     }
 }
 
+/// Whether every particle lanes `off..off + W` of a chunk reach lies below `n`, in the same
+/// terms as [`load_ends`] and [`store_ends`] index: checked once per part, it lets the
+/// compiler drop the per-array bounds checks of arrays `n` long.
+#[inline(always)]
+pub(super) fn window_fits<const LAYOUT: u8, const W: usize>(
+    p: &[u32],
+    q: &[u32],
+    off: usize,
+    n: usize,
+) -> bool {
+    match layout_of(LAYOUT) {
+        Layout::Contiguous => {
+            let (p0, q0) = (p[0] as usize + off, q[0] as usize + off);
+            p0 + W <= n && q0 + W <= n
+        }
+        Layout::Paired | Layout::Quad => p[0] as usize + 2 * off + 2 * W <= n,
+        Layout::Spaced => p[0] as usize + 4 * off + 4 * W - 1 <= n,
+        Layout::Strided => {
+            let (p0, q0) = (p[0] as usize + 2 * off, q[0] as usize + 2 * off);
+            p0 + 2 * W - 1 <= n && q0 + 2 * W - 1 <= n
+        }
+        Layout::Gathered => (0..W).all(|l| (p[off + l] as usize) < n && (q[off + l] as usize) < n),
+    }
+}
+
 /// Offsets of the first ends in a [`Layout::Quad`] chunk.
 pub(super) const QUAD: [usize; LANES] = [0, 1, 4, 5, 8, 9, 12, 13];
 
@@ -222,5 +247,30 @@ pub(super) fn structured_layout(p: &[u32], q: &[u32]) -> Option<Layout> {
         Some(Layout::Strided)
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_window_fits_exactly_when_its_last_particle_does() {
+        // Contiguous ends 0..8 and 8..16 need 16 particles.
+        assert!(window_fits::<0, 8>(&[0], &[8], 0, 16));
+        assert!(!window_fits::<0, 8>(&[0], &[8], 0, 15));
+        // Paired lanes 4..8 read particles 8..16.
+        assert!(window_fits::<1, 4>(&[0], &[1], 4, 16));
+        assert!(!window_fits::<1, 4>(&[0], &[1], 4, 15));
+        // Spaced: the last second end is p₀ + 4·7 + 2 = 30.
+        assert!(window_fits::<4, 8>(&[0], &[2], 0, 31));
+        assert!(!window_fits::<4, 8>(&[0], &[2], 0, 30));
+        // Strided: the second end's window is q₀..q₀ + 15.
+        assert!(window_fits::<3, 8>(&[0], &[20], 0, 35));
+        assert!(!window_fits::<3, 8>(&[0], &[20], 0, 34));
+        // Gathered: every lane's own particles.
+        let (p, q) = ([0, 2, 4, 6], [1, 3, 5, 9]);
+        assert!(window_fits::<5, 4>(&p, &q, 0, 10));
+        assert!(!window_fits::<5, 4>(&p, &q, 0, 9));
     }
 }

@@ -10,7 +10,7 @@
 use multiversion::multiversion;
 
 use super::domain::{Domain, Mode, Pairs, Rebased};
-use super::layout::{Chunk, Layout, layout_of, load_ends, store_ends};
+use super::layout::{Chunk, Layout, layout_of, load_ends, store_ends, window_fits};
 use super::simd::SimdPath;
 use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
 
@@ -70,6 +70,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
     coef: &[Coef],
 ) {
     rebase::<DAMPED>(dom);
+    let n = dom.len();
     let Domain {
         work,
         pairs,
@@ -78,6 +79,18 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
         colours,
         ..
     } = dom;
+    let Rebased {
+        base: [b0, b1, b2],
+        disp: [d0, d1, d2],
+        motion: [m0, m1, m2],
+        w,
+    } = work;
+    let work = &mut View {
+        base: [&b0[..n], &b1[..n], &b2[..n]],
+        disp: [&mut d0[..n], &mut d1[..n], &mut d2[..n]],
+        motion: [&m0[..n], &m1[..n], &m2[..n]],
+        w: &w[..n],
+    };
     for (c, (chunk_range, tail)) in plan.iter().enumerate() {
         for chunk in &chunks[chunk_range.clone()] {
             project_chunk::<DAMPED, LAMBDA, UNIT_K, W>(chunk, pairs, work, coef);
@@ -96,6 +109,15 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
         }
     }
     fold(dom);
+}
+
+/// A domain's [`Rebased`] arrays cut to its particle count: every slice has the same length,
+/// so the compiler checks an index once for all of them.
+struct View<'a> {
+    base: [&'a [f32]; 3],
+    disp: [&'a mut [f32]; 3],
+    motion: [&'a [f32]; 3],
+    w: &'a [f32],
 }
 
 /// The layout number of [`Layout::Gathered`] (one load per lane), as `project_part` takes it.
@@ -149,7 +171,7 @@ fn fold(dom: &mut Domain) {
 fn project_chunk<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const W: usize>(
     chunk: &Chunk,
     pairs: &mut Pairs,
-    work: &mut Rebased,
+    work: &mut View<'_>,
     coef: &[Coef],
 ) {
     // One specialised body per layout keeps every lane array in registers (a layout
@@ -188,7 +210,7 @@ fn project_laid_out<
 >(
     chunk: &Chunk,
     pairs: &mut Pairs,
-    work: &mut Rebased,
+    work: &mut View<'_>,
     coef: &[Coef],
 ) {
     let Pairs {
@@ -235,30 +257,34 @@ fn project_part<
     const LAYOUT: u8,
     const W: usize,
 >(
-    work: &mut Rebased,
+    work: &mut View<'_>,
     lambda_out: &mut [f32],
     (p, q, off): (&[u32], &[u32], usize),
     rest: &[f32; W],
     k: &Coefs<W, f32>,
 ) {
+    assert!(
+        window_fits::<LAYOUT, W>(p, q, off, work.w.len()),
+        "a chunk reaches past its domain"
+    );
     let mut d = [[0.0f32; W]; 3];
     let mut motion = [[0.0f32; W]; 3];
     let mut pd = [[0.0f32; W]; 3];
     let mut qd = [[0.0f32; W]; 3];
     for a in 0..3 {
-        let (pb, qb) = load_ends::<LAYOUT, W, f32>(&work.base[a], p, q, off);
-        (pd[a], qd[a]) = load_ends::<LAYOUT, W, f32>(&work.disp[a], p, q, off);
+        let (pb, qb) = load_ends::<LAYOUT, W, f32>(work.base[a], p, q, off);
+        (pd[a], qd[a]) = load_ends::<LAYOUT, W, f32>(work.disp[a], p, q, off);
         for l in 0..W {
             d[a][l] = (pb[l] + pd[a][l]) - (qb[l] + qd[a][l]);
         }
         if DAMPED {
-            let (pm, qm) = load_ends::<LAYOUT, W, f32>(&work.motion[a], p, q, off);
+            let (pm, qm) = load_ends::<LAYOUT, W, f32>(work.motion[a], p, q, off);
             for l in 0..W {
                 motion[a][l] = (pm[l] + pd[a][l]) - (qm[l] + qd[a][l]);
             }
         }
     }
-    let (wp, wq) = load_ends::<LAYOUT, W, f32>(&work.w, p, q, off);
+    let (wp, wq) = load_ends::<LAYOUT, W, f32>(work.w, p, q, off);
     let mut lambda = [0.0f32; W];
     if LAMBDA {
         lambda.copy_from_slice(lambda_out);
@@ -273,7 +299,7 @@ fn project_part<
             pd[a][l] += d[a][l] * (wp[l] * s[l]);
             qd[a][l] -= d[a][l] * (wq[l] * s[l]);
         }
-        store_ends::<LAYOUT, W, f32>(&mut work.disp[a], p, q, off, &pd[a], &qd[a]);
+        store_ends::<LAYOUT, W, f32>(work.disp[a], p, q, off, &pd[a], &qd[a]);
     }
 }
 
