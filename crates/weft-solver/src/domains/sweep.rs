@@ -267,20 +267,25 @@ fn project_part<
         window_fits::<LAYOUT, W>(p, q, off, work.w.len()),
         "a chunk reaches past its domain"
     );
+    // Every load first, written out per axis: as a loop over the axes, the gathered layout's
+    // body was too large for the compiler to unroll, and it went lane by lane through the stack.
+    let ld = |src: &[f32]| load_ends::<LAYOUT, W, f32>(src, p, q, off);
+    let base = [ld(work.base[0]), ld(work.base[1]), ld(work.base[2])];
+    let disp = [ld(work.disp[0]), ld(work.disp[1]), ld(work.disp[2])];
+    let mut pd = disp.map(|(p, _)| p);
+    let mut qd = disp.map(|(_, q)| q);
     let mut d = [[0.0f32; W]; 3];
-    let mut motion = [[0.0f32; W]; 3];
-    let mut pd = [[0.0f32; W]; 3];
-    let mut qd = [[0.0f32; W]; 3];
     for a in 0..3 {
-        let (pb, qb) = load_ends::<LAYOUT, W, f32>(work.base[a], p, q, off);
-        (pd[a], qd[a]) = load_ends::<LAYOUT, W, f32>(work.disp[a], p, q, off);
         for l in 0..W {
-            d[a][l] = (pb[l] + pd[a][l]) - (qb[l] + qd[a][l]);
+            d[a][l] = (base[a].0[l] + pd[a][l]) - (base[a].1[l] + qd[a][l]);
         }
-        if DAMPED {
-            let (pm, qm) = load_ends::<LAYOUT, W, f32>(work.motion[a], p, q, off);
+    }
+    let mut motion = [[0.0f32; W]; 3];
+    if DAMPED {
+        let m = [ld(work.motion[0]), ld(work.motion[1]), ld(work.motion[2])];
+        for a in 0..3 {
             for l in 0..W {
-                motion[a][l] = (pm[l] + pd[a][l]) - (qm[l] + qd[a][l]);
+                motion[a][l] = (m[a].0[l] + pd[a][l]) - (m[a].1[l] + qd[a][l]);
             }
         }
     }
