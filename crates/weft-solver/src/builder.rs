@@ -244,6 +244,7 @@ impl SolverBuilder {
             tethers: self.tethers.finish(&free),
             seams: self.seams.finish(&free),
             seam_params: self.seam_params,
+            isometric_forward: false,
         };
         let n = self.particles.len();
         Solver::assemble(

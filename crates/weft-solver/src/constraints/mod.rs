@@ -90,6 +90,9 @@ pub struct ConstraintSet {
     pub(crate) seams: Block<2, Seam>,
     /// Parameters of each set of seams (one per [`crate::SolverBuilder::add_seams`]).
     pub(crate) seam_params: Vec<FamilyParams>,
+    /// Whether the isometric block is soft per substep this frame, so that its sweep runs
+    /// forward only (see [`Block::project_symmetric_lanes`]).
+    pub(crate) isometric_forward: bool,
 }
 
 /// Max and root-mean-square of |C| over a set of constraints.
@@ -154,6 +157,13 @@ impl ConstraintSet {
         out.into_iter().map(|(_, d)| d).collect()
     }
 
+    /// Decides, once per frame, how the bending blocks sweep under `rule` with inverse masses
+    /// `w` and parameters `params`: the isometric block forward only when it is soft per
+    /// substep ([`Block::soft_per_substep`]).
+    pub(crate) fn prepare_sweeps(&mut self, w: &[f64], params: &[FamilyParams], rule: Rule) {
+        self.isometric_forward = self.isometric.soft_per_substep(w, params, rule);
+    }
+
     /// Clears the XPBD multipliers (at the start of each substep).
     pub(crate) fn reset_multipliers(&mut self) {
         // The distance constraints' multipliers live in `Domains`, which clears its own.
@@ -176,9 +186,10 @@ impl ConstraintSet {
         path: SimdPath,
     ) {
         self.dihedral
-            .project_symmetric_lanes(x, prev, w, params, rule, path);
+            .project_symmetric_lanes(x, prev, w, params, rule, path, false);
+        let forward = self.isometric_forward;
         self.isometric
-            .project_symmetric_lanes(x, prev, w, params, rule, path);
+            .project_symmetric_lanes(x, prev, w, params, rule, path, forward);
         self.tethers.project(x, prev, w, params, rule);
         self.seams.project(x, prev, w, &self.seam_params, rule);
     }

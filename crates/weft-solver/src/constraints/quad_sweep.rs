@@ -1,5 +1,6 @@
-//! The symmetric Gauss–Seidel sweep of a block of four-particle constraints (dihedral or
-//! isometric bending) through its lane kernel ([`super::dihedral_lanes`],
+//! The symmetric Gauss–Seidel sweep (forward only where every constraint is soft per substep)
+//! of a block of four-particle constraints (dihedral or isometric bending) through its lane
+//! kernel ([`super::dihedral_lanes`],
 //! [`super::isometric_lanes`]), decomposed by particle ranges (see [`super::parts`]): every
 //! part's constraints colour by colour, the parts in parallel on their own slices of the
 //! positions, then the straddlers colour by colour; the backward half in the reverse order.
@@ -38,6 +39,12 @@ pub(crate) trait QuadLanes: Shape<4> {
         coef: &Coefs<L>,
         lambda: &mut [f64],
     );
+
+    /// Σᵢ wᵢ |∇ᵢC|² of the constraint on particles of inverse masses `w` where it does not
+    /// depend on the positions (per axis, for a vector constraint), else `None`.
+    fn constant_stiffness(&self, _w: [f64; 4]) -> Option<f64> {
+        None
+    }
 }
 
 impl QuadLanes for Dihedral {
@@ -61,6 +68,15 @@ impl QuadLanes for Dihedral {
 }
 
 impl QuadLanes for Isometric {
+    /// ∇ᵢCₐ = kᵢ on axis a for every configuration: Σᵢ wᵢ kᵢ².
+    fn constant_stiffness(&self, w: [f64; 4]) -> Option<f64> {
+        Some(
+            (0..4)
+                .map(|i| w[i] * self.weights[i] * self.weights[i])
+                .sum(),
+        )
+    }
+
     #[inline(always)]
     fn project_lanes<S: Simd, const L: usize, const DAMPED: bool>(
         s: S,
@@ -295,6 +311,13 @@ impl<Q: QuadLanes> Block<4, Q> {
     /// not. XPBD's multipliers carry over between the halves; under PBD each half uses
     /// k' = 1 − (1 − k)^(1/2), so that the two halves together correct an isolated constraint
     /// as one projection with k would (Müller et al. 2007, §3.3).
+    ///
+    /// With `forward_only` (XPBD only, for a block that [`Self::soft_per_substep`]), the
+    /// backward half is left out: there every projection's own term α̃ at least equals
+    /// Σ w|∇C|², so each constraint's step is at most half its error and the coupling through
+    /// shared particles at most the diagonal's, and the sweep's non-symmetric part is too weak
+    /// to feed energy (`tests/integration/isometric_bending.rs` checks a free bent sheet
+    /// both ways).
     #[allow(clippy::too_many_arguments)]
     pub fn project_symmetric_lanes(
         &mut self,
@@ -304,8 +327,24 @@ impl<Q: QuadLanes> Block<4, Q> {
         params: &[FamilyParams],
         rule: Rule,
         path: SimdPath,
+        forward_only: bool,
     ) {
         if self.len() == 0 {
+            return;
+        }
+        let forward_only = forward_only && matches!(rule, Rule::Xpbd { .. });
+        if forward_only {
+            let coef: Vec<Coef> = params.iter().map(|p| Coef::of(p, rule)).collect();
+            let damped = (params.iter().zip(&coef)).any(|(p, c)| p.enabled && c.gamma > 0.0);
+            let sweep = Sweep {
+                prev,
+                w,
+                coef: &coef,
+                damped,
+                path,
+            };
+            self.project_interiors(x, &sweep, false);
+            self.project_straddlers(x, &sweep, false);
             return;
         }
         let (coef, damped) = coefficients(params, rule);
@@ -320,6 +359,28 @@ impl<Q: QuadLanes> Block<4, Q> {
         self.project_straddlers(x, &sweep, false);
         self.project_straddlers(x, &sweep, true);
         self.project_interiors(x, &sweep, true);
+    }
+
+    /// Whether every enabled constraint is soft per substep under `rule`: XPBD, Σ w|∇C|²
+    /// independent of the positions ([`QuadLanes::constant_stiffness`]) and at most α̃ = α/h²
+    /// with inverse masses `w`. False for an empty block, PBD, or a shape whose gradient moves.
+    pub fn soft_per_substep(&self, w: &[f64], params: &[FamilyParams], rule: Rule) -> bool {
+        let Rule::Xpbd { h } = rule else {
+            return false;
+        };
+        self.len() > 0
+            && (self.particles.iter().zip(&self.shapes).zip(&self.group)).all(
+                |((idx, shape), &g)| {
+                    let Some(p) = params.get(g as usize) else {
+                        return false;
+                    };
+                    let (alpha, _) = Rule::xpbd_terms(p, h);
+                    !p.enabled
+                        || shape
+                            .constant_stiffness(idx.map(|i| w[i as usize]))
+                            .is_some_and(|s| s <= alpha)
+                },
+            )
     }
 
     /// Every part's constraints, colour by colour (backward: in reverse), one task per part on
@@ -465,6 +526,7 @@ mod tests {
                 params,
                 Rule::Xpbd { h: 1e-3 },
                 SimdPath::widest(),
+                false,
             );
         }
     }
@@ -504,6 +566,45 @@ mod tests {
             start > 0.2 && end < 3e-3,
             "largest |θ − θ₀|: {start} → {end}"
         );
+    }
+
+    #[test]
+    fn a_block_is_soft_per_substep_exactly_when_every_hinge_is() {
+        // One isometric hinge per group; Σ w k² against α/h² decides, hinge by hinge.
+        let rest = [
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, -1.0, 0.0),
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+        ];
+        let shape = Isometric::at_rest(&rest).expect("a hinge");
+        let w = [2.0, 1.0, 0.5, 0.0];
+        let s: f64 = (0..4)
+            .map(|i| w[i] * shape.weights[i] * shape.weights[i])
+            .sum();
+        let h = 1e-3;
+        let mut b = BlockBuilder::<4, Isometric>::default();
+        b.push([0, 1, 2, 3], 0, shape);
+        b.push([0, 1, 2, 3], 1, shape);
+        let block = b.finish(&[true, true, true, false]);
+        let at = |alpha: f64| FamilyParams {
+            compliance: alpha * h * h,
+            ..rigid()
+        };
+        let xpbd = Rule::Xpbd { h };
+        assert!(block.soft_per_substep(&w, &[at(1.001 * s), at(2.0 * s)], xpbd));
+        assert!(!block.soft_per_substep(&w, &[at(2.0 * s), at(0.9 * s)], xpbd));
+        // A disabled family does not count; PBD and the dihedral never sweep forward only.
+        let off = FamilyParams {
+            enabled: false,
+            ..at(0.0)
+        };
+        assert!(block.soft_per_substep(&w, &[at(1.001 * s), off], xpbd));
+        assert!(!block.soft_per_substep(&w, &[at(s), at(s)], Rule::Pbd));
+        let mut d = BlockBuilder::<4, Dihedral>::default();
+        d.push([0, 1, 2, 3], 0, Dihedral { rest: 0.0 });
+        let d = d.finish(&[true, true, true, false]);
+        assert!(!d.soft_per_substep(&w, &[at(1e9)], xpbd));
     }
 
     #[test]
@@ -550,9 +651,9 @@ mod tests {
     #[test]
     fn the_parted_isometric_sweep_carries_each_constraints_three_multipliers() {
         // Compliant isometric hinges on a crumpled sheet cut into parts and straddlers: one
-        // symmetric sweep through the parts in parallel equals the same sweep written out one
-        // constraint at a time in the block's order, each constraint's multipliers carried
-        // from the forward half into the backward one.
+        // sweep through the parts in parallel, symmetric or forward only, equals the same
+        // sweep written out one constraint at a time in the block's order, each constraint's
+        // multipliers carried from the forward half into the backward one.
         let n = 48;
         let (rest, tris) = crumpled(n, 0.0);
         let (mut x, _) = crumpled(n, 0.004);
@@ -573,20 +674,6 @@ mod tests {
             ..rigid()
         }];
         let w = vec![1.0; x.len()];
-        let mut want = x.clone();
-        let mut lambda = vec![DVec3::ZERO; block.len()];
-        let mut one = |k: usize, x: &mut [DVec3]| {
-            let (q, kw) = (block.particles[k], block.shapes[k].weights);
-            let p = q.map(|i| x[i as usize]);
-            let s: f64 = kw.iter().map(|k| k * k).sum();
-            let v = block.shapes[k].curvature(&p);
-            let alpha = 2500.0;
-            let dl = (-v - lambda[k] * alpha) * (1.0 / (s + alpha));
-            lambda[k] += dl;
-            for j in 0..4 {
-                x[q[j] as usize] += dl * kw[j];
-            }
-        };
         let colours = block.colors.len();
         let mut order: Vec<usize> = Vec::new();
         // Every part's colours (parts are disjoint: their order is free), then the straddlers'.
@@ -595,24 +682,48 @@ mod tests {
                 order.extend(block.segments[c][p]..block.segments[c][p + 1]);
             }
         }
-        for &k in order.iter().chain(order.iter().rev()) {
-            one(k, &mut want);
+        let start = x.clone();
+        // Forward and backward, and (as a soft block sweeps) forward only.
+        for forward_only in [false, true] {
+            let mut want = start.clone();
+            let mut lambda = vec![DVec3::ZERO; block.len()];
+            let mut one = |k: usize, x: &mut [DVec3]| {
+                let (q, kw) = (block.particles[k], block.shapes[k].weights);
+                let p = q.map(|i| x[i as usize]);
+                let s: f64 = kw.iter().map(|k| k * k).sum();
+                let v = block.shapes[k].curvature(&p);
+                let alpha = 2500.0;
+                let dl = (-v - lambda[k] * alpha) * (1.0 / (s + alpha));
+                lambda[k] += dl;
+                for j in 0..4 {
+                    x[q[j] as usize] += dl * kw[j];
+                }
+            };
+            let backward = if forward_only { &[][..] } else { &order[..] };
+            for &k in order.iter().chain(backward.iter().rev()) {
+                one(k, &mut want);
+            }
+            x.copy_from_slice(&start);
+            let prev = x.clone();
+            block.reset_multipliers();
+            block.project_symmetric_lanes(
+                &mut x,
+                &prev,
+                &w,
+                &params,
+                Rule::Xpbd { h },
+                SimdPath::widest(),
+                forward_only,
+            );
+            let worst = x
+                .iter()
+                .zip(&want)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0, f64::max);
+            assert!(
+                worst < 1e-12,
+                "forward only {forward_only}: largest difference {worst} m"
+            );
         }
-        let prev = x.clone();
-        block.reset_multipliers();
-        block.project_symmetric_lanes(
-            &mut x,
-            &prev,
-            &w,
-            &params,
-            Rule::Xpbd { h },
-            SimdPath::widest(),
-        );
-        let worst = x
-            .iter()
-            .zip(&want)
-            .map(|(a, b)| (*a - *b).length())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-12, "largest difference {worst} m");
     }
 }

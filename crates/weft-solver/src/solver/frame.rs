@@ -127,6 +127,8 @@ impl Solver {
         let rule = strategy.rule(h);
         if let Some(rule) = rule {
             self.domains.prepare(&self.params, rule);
+            let w = &self.particles.inv_masses;
+            self.constraints.prepare_sweeps(w, &self.params, rule);
         }
         let path = self.domains.path();
         let mut whole = true;

@@ -185,6 +185,12 @@ impl Solver {
         self.domains.stats()
     }
 
+    /// Whether the last frame swept the isometric bending forward only (every hinge soft per
+    /// substep, α/h² ≥ Σ w|∇C|²) rather than forward and backward.
+    pub fn bending_forward_only(&self) -> bool {
+        self.constraints.isometric_forward
+    }
+
     /// Current settings.
     pub fn settings(&self) -> &Settings {
         &self.settings

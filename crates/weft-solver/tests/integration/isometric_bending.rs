@@ -233,6 +233,8 @@ fn a_free_bent_sheet_does_not_gain_energy_in_the_soft_regime() {
             (most, least) = (most.max(e), least.min(e));
         }
         println!("B = {b}: bending energy {start:.3e} J, KE + bending {least:.3e}..{most:.3e} J");
+        // Soft per substep at every hinge: the sweep ran forward only.
+        assert!(s.bending_forward_only(), "B = {b}");
         // It unrolls (energy moves into motion), and never holds more than it started with.
         assert!(
             least < 0.9 * start && most <= 1.02 * start,
