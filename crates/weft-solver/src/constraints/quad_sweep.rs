@@ -332,21 +332,8 @@ impl<Q: QuadLanes> Block<4, Q> {
         if self.len() == 0 {
             return;
         }
+        // Forward only under XPBD alone: PBD's per-half stiffness assumes both halves.
         let forward_only = forward_only && matches!(rule, Rule::Xpbd { .. });
-        if forward_only {
-            let coef: Vec<Coef> = params.iter().map(|p| Coef::of(p, rule)).collect();
-            let damped = (params.iter().zip(&coef)).any(|(p, c)| p.enabled && c.gamma > 0.0);
-            let sweep = Sweep {
-                prev,
-                w,
-                coef: &coef,
-                damped,
-                path,
-            };
-            self.project_interiors(x, &sweep, false);
-            self.project_straddlers(x, &sweep, false);
-            return;
-        }
         let (coef, damped) = coefficients(params, rule);
         let sweep = Sweep {
             prev,
@@ -357,8 +344,10 @@ impl<Q: QuadLanes> Block<4, Q> {
         };
         self.project_interiors(x, &sweep, false);
         self.project_straddlers(x, &sweep, false);
-        self.project_straddlers(x, &sweep, true);
-        self.project_interiors(x, &sweep, true);
+        if !forward_only {
+            self.project_straddlers(x, &sweep, true);
+            self.project_interiors(x, &sweep, true);
+        }
     }
 
     /// Whether every enabled constraint is soft per substep under `rule`: XPBD, Σ w|∇C|²
