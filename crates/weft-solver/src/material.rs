@@ -158,11 +158,7 @@ impl Material {
         let rest_isometric = median(
             isometric_hinges(mesh)
                 .iter()
-                .map(|(idx, shape)| {
-                    (0..4)
-                        .map(|k| w[idx[k] as usize] * shape.weights[k] * shape.weights[k])
-                        .sum()
-                })
+                .map(|(idx, shape)| shape.stiffness(idx.map(|i| w[i as usize])))
                 .collect(),
         );
         let rest_distance = |pairs: &[[u32; 2]]| {

@@ -25,6 +25,14 @@ pub struct Isometric {
 }
 
 impl Isometric {
+    /// Σᵢ wᵢ kᵢ² for particles of inverse masses `w`: the multiplier step's Σ w|∇C|² on each
+    /// axis, the same in every configuration (∇ᵢCₐ = kᵢ).
+    pub fn stiffness(&self, w: [f64; 4]) -> f64 {
+        (0..4)
+            .map(|i| w[i] * self.weights[i] * self.weights[i])
+            .sum()
+    }
+
     /// The weights of the hinge at its rest positions `p`, or `None` when a triangle or the
     /// hinge is degenerate (area below 1e-24 m² or edge below 1e-9 m).
     ///

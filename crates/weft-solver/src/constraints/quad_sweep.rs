@@ -68,13 +68,9 @@ impl QuadLanes for Dihedral {
 }
 
 impl QuadLanes for Isometric {
-    /// ∇ᵢCₐ = kᵢ on axis a for every configuration: Σᵢ wᵢ kᵢ².
+    /// ∇ᵢCₐ = kᵢ on axis a for every configuration: [`Isometric::stiffness`].
     fn constant_stiffness(&self, w: [f64; 4]) -> Option<f64> {
-        Some(
-            (0..4)
-                .map(|i| w[i] * self.weights[i] * self.weights[i])
-                .sum(),
-        )
+        Some(self.stiffness(w))
     }
 
     #[inline(always)]
