@@ -50,6 +50,7 @@ impl RigidTransform {
     };
 
     /// Applies the transform to a point.
+    #[inline]
     pub fn apply(&self, p: DVec3) -> DVec3 {
         self.rotation * p + self.translation
     }

@@ -38,6 +38,7 @@ pub struct RoundCone {
 }
 
 /// Signed distance and contact for a sphere; `fallback` is the normal at the centre.
+#[inline]
 pub fn sphere_contact(center: DVec3, radius: f64, p: DVec3, fallback: DVec3) -> Contact {
     let d = p - center;
     let len = d.length();
@@ -136,6 +137,7 @@ pub struct PreparedCone {
 
 impl PreparedCone {
     /// Signed distance, closest point and normal for the point `p` (see the module's text).
+    #[inline]
     pub fn contact(&self, p: DVec3) -> Contact {
         if self.sphere {
             return sphere_contact(self.a, self.ra, p, DVec3::Y);
