@@ -79,7 +79,7 @@ pub struct SelfCollisionParams {
     /// the motion.
     pub search_margin: f64,
     /// Whether the skin adapts to the motion: thin at rest, thick while the cloth folds or
-    /// slides, one step at a time between 0.25 and 1.0 (see `skin.rs`). Like the skin itself,
+    /// slides, one step at a time between 0.25 and 4.0 (see `skin.rs`). Like the skin itself,
     /// it changes only the cost.
     pub adaptive_margin: bool,
 }

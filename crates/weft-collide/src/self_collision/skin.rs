@@ -11,8 +11,10 @@
 //! counts, not clocks, decide, so the choice is the same on every run; and the skin changes
 //! only the cost, never a result.
 
-/// The skins the list may take, as fractions of the thickness.
-pub(crate) const STEPS: [f64; 5] = [0.25, 0.35, 0.5, 0.7, 1.0];
+/// The skins the list may take, as fractions of the thickness: up to four thicknesses, for a
+/// single layer carried by a moving body (a garment on a walking character), whose list holds
+/// few pairs at any skin while its members stray from their anchors all the time.
+pub(crate) const STEPS: [f64; 9] = [0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 2.8, 4.0];
 
 /// Sweeps per epoch: the skin may change once per epoch.
 const EPOCH: u32 = 32;
@@ -145,26 +147,30 @@ mod tests {
         let mut skin = Skin::new(0.45, true);
         assert_eq!(skin.margin(), 0.5, "starts at the nearest step");
         // Rebuilt every sweep with few pairs: one step thicker per epoch, up to the last.
-        for sweep in 1..=4 * EPOCH {
+        let (up, last) = (STEPS.len() as u32 - 3, STEPS.len() as u32 - 1);
+        for sweep in 1..=(up + 2) * EPOCH {
             skin.built(100, 10);
             let change = skin.record(10);
             assert_eq!(
                 change == Change::Grow,
-                sweep % EPOCH == 0 && sweep <= 2 * EPOCH
+                sweep % EPOCH == 0 && sweep <= up * EPOCH
             );
             assert_ne!(change, Change::Shrink);
         }
         assert_eq!(skin.margin(), STEPS[STEPS.len() - 1]);
         // Many pairs, nothing rebuilt: one step thinner per epoch, down to the first.
-        for sweep in 1..=6 * EPOCH {
+        for sweep in 1..=(last + 2) * EPOCH {
             let change = skin.record(100_000);
             assert_eq!(
                 change == Change::Shrink,
-                sweep % EPOCH == 0 && sweep <= 4 * EPOCH
+                sweep % EPOCH == 0 && sweep <= last * EPOCH
             );
             assert_ne!(change, Change::Grow);
         }
-        assert_eq!((skin.margin(), skin.changes()), (STEPS[0], 6));
+        assert_eq!(
+            (skin.margin(), skin.changes()),
+            (STEPS[0], u64::from(up + last))
+        );
         // Upkeep between the thresholds keeps it: here equal to the filtering.
         for _ in 0..4 * EPOCH {
             skin.reanchored(1);
