@@ -45,6 +45,12 @@ pub(crate) trait QuadLanes: Shape<4> {
     fn constant_stiffness(&self, _w: [f64; 4]) -> Option<f64> {
         None
     }
+
+    /// Whether the kernel pays for its lanes: when its arithmetic outweighs moving twelve
+    /// coordinates per constraint between the particles and the lanes and back. Where it does
+    /// not, every kernel path projects one constraint at a time (the one-lane kernel, the
+    /// same bits).
+    const WIDE: bool = true;
 }
 
 impl QuadLanes for Dihedral {
@@ -68,6 +74,11 @@ impl QuadLanes for Dihedral {
 }
 
 impl QuadLanes for Isometric {
+    /// A dozen flops per axis against twelve gathered and twelve scattered coordinates: one
+    /// lane at a time is the quicker (T-shirt, solve only, 1 thread, AVX-512: 8.0 ms per
+    /// frame with eight lanes, 8.1–8.5 with four, 8.8 with two, 7.2 with one).
+    const WIDE: bool = false;
+
     /// ∇ᵢCₐ = kᵢ on axis a for every configuration: [`Isometric::stiffness`].
     fn constant_stiffness(&self, w: [f64; 4]) -> Option<f64> {
         Some(self.stiffness(w))
@@ -175,6 +186,9 @@ fn project_run<Q: QuadLanes>(
         lambda,
         sweep,
     };
+    if !Q::WIDE {
+        return Run::<Q, 1>(seg).with_simd(Scalar);
+    }
     match sweep.path {
         #[cfg(target_arch = "x86_64")]
         SimdPath::Avx512 => match (pulp::x86::V4::try_new(), pulp::x86::V3::try_new()) {
