@@ -93,17 +93,28 @@ impl Forces {
         }
     }
 
+    /// Whether every particle's external acceleration depends on its own velocity alone
+    /// ([`Forces::acceleration_of`]): no aerodynamic forces on triangles.
+    pub(crate) fn per_particle(&self) -> bool {
+        self.wind.aero.is_none()
+    }
+
+    /// Gravity and linear drag on a particle moving at `v`: g + c_d (v_wind − v) (m/s²).
+    #[inline(always)]
+    pub(crate) fn acceleration_of(&self, v: DVec3) -> DVec3 {
+        self.gravity + self.wind.drag * (self.wind.velocity - v)
+    }
+
     /// Writes every particle's external acceleration (m/s²) into `accel`.
     pub(crate) fn accelerations(&self, p: &Particles, triangles: &[[u32; 3]], accel: &mut [DVec3]) {
         let wind = self.wind;
-        let gravity = self.gravity;
         // Per particle, in parallel (each result depends on that particle alone).
         accel
             .par_chunks_mut(CHUNK)
             .zip(p.velocities.par_chunks(CHUNK))
             .for_each(|(a, v)| {
                 for (a, v) in a.iter_mut().zip(v) {
-                    *a = gravity + wind.drag * (wind.velocity - *v);
+                    *a = self.acceleration_of(*v);
                 }
             });
         if let Some(aero) = wind.aero {

@@ -37,7 +37,8 @@ pub trait SubstepHook: Send {
         0
     }
 
-    /// After velocities are derived from positions: velocity-level corrections.
+    /// After velocities are derived from positions (and the global damping applied):
+    /// velocity-level corrections.
     fn end_substep(&mut self, _ctx: &SubstepContext, _particles: &mut Particles) {}
 
     /// Whether the hook does anything; an inactive hook lets the solver fuse a substep's phases.

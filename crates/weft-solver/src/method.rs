@@ -106,6 +106,13 @@ pub(crate) trait Strategy: Sync {
     ) {
     }
 
+    /// Whether [`Strategy::add_internal_forces`] adds anything (the mass-spring methods); without
+    /// internal forces the general loop computes the external accelerations inside its
+    /// integration pass.
+    fn has_internal_forces(&self) -> bool {
+        false
+    }
+
     /// Starts a substep.
     fn begin_substep(&self, _constraints: &mut ConstraintSet) {}
 

@@ -31,6 +31,10 @@ pub(crate) const TOLERANCE: f64 = 1e-8;
 pub(crate) struct ImplicitMassSpring;
 
 impl Strategy for ImplicitMassSpring {
+    fn has_internal_forces(&self) -> bool {
+        true
+    }
+
     fn add_internal_forces(
         &self,
         constraints: &ConstraintSet,

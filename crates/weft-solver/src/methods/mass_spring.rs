@@ -11,6 +11,10 @@ use crate::particles::Particles;
 pub(crate) struct MassSpring;
 
 impl Strategy for MassSpring {
+    fn has_internal_forces(&self) -> bool {
+        true
+    }
+
     fn add_internal_forces(
         &self,
         constraints: &ConstraintSet,

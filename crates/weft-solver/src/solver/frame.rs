@@ -146,19 +146,25 @@ impl Solver {
                 h,
                 substep: k,
             };
-            // External and (mass-spring) internal accelerations at the start of the substep.
-            self.forces
-                .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
-            strategy.add_internal_forces(
-                &self.constraints,
-                &self.particles,
-                &self.params,
-                h,
-                &mut self.force,
-                &mut self.accel,
-            );
+            // External and (mass-spring) internal accelerations at the start of the substep;
+            // when each particle's depends on its own velocity alone, computed inside the
+            // integration pass instead (one parallel pass fewer, the same arithmetic).
+            let inline_accel = self.forces.per_particle() && !strategy.has_internal_forces();
+            if !inline_accel {
+                self.forces
+                    .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
+                strategy.add_internal_forces(
+                    &self.constraints,
+                    &self.particles,
+                    &self.params,
+                    h,
+                    &mut self.force,
+                    &mut self.accel,
+                );
+            }
             // Semi-implicit Euler: v ← v + h a, x ← x + h v (for PBD/XPBD, the prediction).
             let p = &mut self.particles;
+            let forces = &self.forces;
             p.positions
                 .par_chunks_mut(CHUNK)
                 .zip(p.prev_positions.par_chunks_mut(CHUNK))
@@ -169,7 +175,12 @@ impl Solver {
                     for j in 0..x.len() {
                         prev[j] = x[j];
                         if w[j] > 0.0 {
-                            v[j] += a[j] * h;
+                            let a = if inline_accel {
+                                forces.acceleration_of(v[j])
+                            } else {
+                                a[j]
+                            };
+                            v[j] += a * h;
                             x[j] += v[j] * h;
                         }
                     }
@@ -210,15 +221,23 @@ impl Solver {
                 None => stats.contacts = hook.project(&ctx, p),
             }
             // Velocities from positions (the PBD update; for mass-spring it equals v unless
-            // a contact moved the particle).
+            // a contact moved the particle), then the global damping v ← v·e^(−c h) of free
+            // particles, in one pass (the fused loop's order, `Domain::finish_velocities`).
             let inv_h = 1.0 / h;
+            let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
             p.velocities
                 .par_chunks_mut(CHUNK)
                 .zip(p.positions.par_chunks(CHUNK))
                 .zip(p.prev_positions.par_chunks(CHUNK))
-                .for_each(|((v, x), prev)| {
+                .zip(p.inv_masses.par_chunks(CHUNK))
+                .for_each(|(((v, x), prev), w)| {
                     for j in 0..v.len() {
                         v[j] = (x[j] - prev[j]) * inv_h;
+                        if let Some(keep) = keep
+                            && w[j] > 0.0
+                        {
+                            v[j] *= keep;
+                        }
                     }
                 });
             // Driven pins report the velocity of what carries them, not the chord.
@@ -226,19 +245,6 @@ impl Solver {
                 p.velocities[i] = v;
             }
             hook.end_substep(&ctx, p);
-            if self.forces.damping > 0.0 {
-                let keep = (-self.forces.damping * h).exp();
-                p.velocities
-                    .par_chunks_mut(CHUNK)
-                    .zip(p.inv_masses.par_chunks(CHUNK))
-                    .for_each(|(v, w)| {
-                        for (v, w) in v.iter_mut().zip(w) {
-                            if *w > 0.0 {
-                                *v *= keep;
-                            }
-                        }
-                    });
-            }
         }
         (stats, whole)
     }
