@@ -50,6 +50,30 @@ pub fn sphere_contact(center: DVec3, radius: f64, p: DVec3, fallback: DVec3) -> 
     }
 }
 
+/// [`sphere_contact`] if `p` lies within `reach` of the sphere or inside, else `None` (before
+/// the normal's division); the same bits.
+#[inline]
+fn sphere_within(
+    center: DVec3,
+    radius: f64,
+    p: DVec3,
+    fallback: DVec3,
+    reach: f64,
+) -> Option<Contact> {
+    let d = p - center;
+    let len = d.length();
+    let distance = len - radius;
+    if !(distance <= reach) {
+        return None;
+    }
+    let normal = if len > 0.0 { d / len } else { fallback };
+    Some(Contact {
+        distance,
+        point: center + normal * radius,
+        normal,
+    })
+}
+
 impl RoundCone {
     /// A round cone from its sphere centres and radii.
     pub fn new(a: DVec3, b: DVec3, ra: f64, rb: f64) -> Self {
@@ -171,7 +195,8 @@ impl PreparedCone {
 
     /// [`Self::contact`] if `p` lies within `reach` of the surface or inside, else `None`;
     /// points clearly farther (outside the slab of the axis or the cylinder around it, grown by
-    /// `reach`) are rejected before any square root.
+    /// `reach`) are rejected before any square root, and points beyond `reach` before the
+    /// normal's division. The same arithmetic as [`Self::contact`], so the same bits.
     #[inline]
     pub fn contact_within(&self, p: DVec3, reach: f64) -> Option<Contact> {
         let pa = p - self.a;
@@ -180,17 +205,41 @@ impl PreparedCone {
             if pa.length_squared() > rmax * rmax {
                 return None;
             }
-        } else {
-            let y = pa.dot(self.u);
-            if y < -self.ra - reach || y > self.l + self.rb + reach {
-                return None;
-            }
-            if pa.length_squared() - y * y > rmax * rmax {
-                return None;
-            }
+            return sphere_within(self.a, self.ra, p, DVec3::Y, reach);
         }
-        let c = self.contact(p);
-        (c.distance <= reach).then_some(c)
+        let u = self.u;
+        let y = pa.dot(u);
+        if y < -self.ra - reach || y > self.l + self.rb + reach {
+            return None;
+        }
+        if pa.length_squared() - y * y > rmax * rmax {
+            return None;
+        }
+        let radial = pa - u * y;
+        let x = radial.length();
+        let (sin, cos) = (self.sin, self.cos);
+        let s = -sin * x + cos * y;
+        if s < 0.0 {
+            return sphere_within(self.a, self.ra, p, -u, reach);
+        }
+        if s > self.l * cos {
+            return sphere_within(self.b, self.rb, p, u, reach);
+        }
+        let distance = cos * x + sin * y - self.ra;
+        if !(distance <= reach) {
+            return None;
+        }
+        let e = if x > 0.0 {
+            radial / x
+        } else {
+            u.any_orthonormal_vector()
+        };
+        let normal = e * cos + u * sin;
+        Some(Contact {
+            distance,
+            point: p - normal * distance,
+            normal,
+        })
     }
 
     /// The cone's spheres: (centre a, r_a, centre b, r_b); a == b for a sphere.
@@ -242,5 +291,62 @@ impl PreparedCone {
         } else {
             None
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rand::rand;
+
+    /// On points around spheres, capsules and tapered cones (inside, near and far, on the axis
+    /// and on the centres), `contact_within` is `contact` kept where its distance is within
+    /// the reach, to the bit.
+    #[test]
+    fn contact_within_is_contact_filtered_by_reach() {
+        let mut s = 0x0c0e_5eed_u64;
+        let cones = [
+            RoundCone::sphere(DVec3::new(0.1, 0.2, -0.3), 0.05),
+            RoundCone::new(DVec3::ZERO, DVec3::new(0.0, 0.3, 0.0), 0.04, 0.04),
+            RoundCone::new(
+                DVec3::new(0.1, 0.0, 0.0),
+                DVec3::new(0.2, 0.25, 0.1),
+                0.06,
+                0.03,
+            ),
+            RoundCone::new(DVec3::ZERO, DVec3::new(0.01, 0.0, 0.0), 0.05, 0.02),
+        ];
+        let (mut kept, mut dropped) = (0, 0);
+        for cone in cones {
+            let prepared = cone.prepare();
+            let (a, ra, b, rb) = prepared.ends();
+            let mut points: Vec<DVec3> = vec![a, b, (a + b) * 0.5];
+            for _ in 0..4000 {
+                let t = 0.5 + 0.8 * rand(&mut s);
+                let off = DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s));
+                points.push(a.lerp(b, t) + off * (ra.max(rb) * 2.5));
+            }
+            for p in points {
+                for reach in [0.0, 0.004, 0.02] {
+                    let full = prepared.contact(p);
+                    let want = (full.distance <= reach).then_some(full);
+                    let got = prepared.contact_within(p, reach);
+                    assert_eq!(
+                        got.map(|c| (c.distance.to_bits(), c.point, c.normal)),
+                        want.map(|c| (c.distance.to_bits(), c.point, c.normal)),
+                        "{cone:?} at {p}, reach {reach}"
+                    );
+                    if want.is_some() {
+                        kept += 1;
+                    } else {
+                        dropped += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            kept > 1000 && dropped > 1000,
+            "{kept} kept, {dropped} dropped"
+        );
     }
 }
