@@ -255,21 +255,19 @@ impl Domains {
     pub fn project_global(&mut self, x: &mut [DVec3], prev: &[DVec3], w: &[f64], fresh: bool) {
         let size = self.size;
         let damped = self.mode.damped;
-        self.list
-            .par_iter_mut()
-            .zip(x.par_chunks(size))
-            .zip(prev.par_chunks(size))
-            .zip(w.par_chunks(size))
-            .for_each(|(((d, x), prev), w)| {
-                d.load_positions(x, damped.then_some(prev), w);
-                if fresh {
-                    d.pairs.lambda.fill(0.0);
-                }
-            });
         if fresh {
             self.reset_link_multipliers();
         }
-        self.project();
+        // Each domain copies its particles in at its leaf of the fork–join tree, just before
+        // its sweep: one parallel pass fewer.
+        let (xs, n) = (&*x, x.len());
+        self.project_with(|d, index| {
+            let r = index * size..((index + 1) * size).min(n);
+            d.load_positions(&xs[r.clone()], damped.then_some(&prev[r.clone()]), &w[r]);
+            if fresh {
+                d.pairs.lambda.fill(0.0);
+            }
+        });
         self.list
             .par_iter_mut()
             .zip(x.par_chunks_mut(size))
