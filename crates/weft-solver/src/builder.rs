@@ -245,6 +245,7 @@ impl SolverBuilder {
             seams: self.seams.finish(&free),
             seam_params: self.seam_params,
             isometric_forward: false,
+            isometric_constants: Default::default(),
         };
         let n = self.particles.len();
         Solver::assemble(

@@ -7,7 +7,7 @@
 // that each compiles to one vector operation per axis.
 #![allow(clippy::needless_range_loop)]
 
-use pulp::Simd;
+use pulp::{Scalar, Simd};
 
 use super::dihedral_lanes::{load, store};
 use super::lanes::Coefs;
@@ -36,17 +36,23 @@ pub(crate) fn project<S: Simd, const L: usize, const DAMPED: bool>(
     lambda: &mut [[f64; L]; 3],
 ) {
     debug_assert_eq!(L, S::F64_LANES);
+    let (steps, inv) = constants::<S, L>(s, w, weights, coef);
+    apply::<S, L, DAMPED>(s, x, prev, weights, &steps, inv, coef, lambda);
+}
+
+/// The part of [`project`] that depends on the inverse masses and coefficients alone, not on
+/// the positions: each particle's step wᵢkᵢ and the inverse of the denominator
+/// (1 + γ) Σ wᵢkᵢ² + α̃, or 0 where the hinge is left alone.
+#[inline(always)]
+pub(crate) fn constants<S: Simd, const L: usize>(
+    s: S,
+    w: &[[f64; L]; 4],
+    weights: &[[f64; L]; 4],
+    coef: &Coefs<L>,
+) -> ([S::f64s; 4], S::f64s) {
     let zero = s.splat_f64s(0.0);
-    let mut xs = [[zero; 3]; 4];
-    let mut kv = [zero; 4];
-    let mut wv = [zero; 4];
-    for v in 0..4 {
-        kv[v] = load::<S, L>(weights[v]);
-        wv[v] = load::<S, L>(w[v]);
-        for a in 0..3 {
-            xs[v][a] = load::<S, L>(x[v][a]);
-        }
-    }
+    let kv: [_; 4] = std::array::from_fn(|v| load::<S, L>(weights[v]));
+    let wv: [_; 4] = std::array::from_fn(|v| load::<S, L>(w[v]));
     let (mut w_grad2, mut k2_sum, mut w_max) = (zero, zero, zero);
     for v in 0..4 {
         let k2 = s.mul_f64s(kv[v], kv[v]);
@@ -54,7 +60,7 @@ pub(crate) fn project<S: Simd, const L: usize, const DAMPED: bool>(
         k2_sum = s.add_f64s(k2_sum, k2);
         w_max = s.select_f64s(s.greater_than_f64s(wv[v], w_max), wv[v], w_max);
     }
-    let (k, alpha) = (load::<S, L>(coef.k), load::<S, L>(coef.alpha));
+    let alpha = load::<S, L>(coef.alpha);
     let gamma = load::<S, L>(coef.gamma);
     let one = s.splat_f64s(1.0);
     let denom = s.add_f64s(s.mul_f64s(s.add_f64s(one, gamma), w_grad2), alpha);
@@ -67,7 +73,35 @@ pub(crate) fn project<S: Simd, const L: usize, const DAMPED: bool>(
         s.not_m64s(singular),
     );
     let inv = s.select_f64s(live, s.div_f64s(one, s.select_f64s(live, denom, one)), zero);
-    let steps: [_; 4] = std::array::from_fn(|v| s.mul_f64s(wv[v], kv[v]));
+    let steps = std::array::from_fn(|v| s.mul_f64s(wv[v], kv[v]));
+    (steps, inv)
+}
+
+/// The part of [`project`] that moves the particles, given [`constants`]' steps and inverse
+/// denominator.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn apply<S: Simd, const L: usize, const DAMPED: bool>(
+    s: S,
+    x: &mut Quads<L>,
+    prev: &Quads<L>,
+    weights: &[[f64; L]; 4],
+    steps: &[S::f64s; 4],
+    inv: S::f64s,
+    coef: &Coefs<L>,
+    lambda: &mut [[f64; L]; 3],
+) {
+    let zero = s.splat_f64s(0.0);
+    let mut xs = [[zero; 3]; 4];
+    let mut kv = [zero; 4];
+    for v in 0..4 {
+        kv[v] = load::<S, L>(weights[v]);
+        for a in 0..3 {
+            xs[v][a] = load::<S, L>(x[v][a]);
+        }
+    }
+    let (k, alpha) = (load::<S, L>(coef.k), load::<S, L>(coef.alpha));
+    let gamma = load::<S, L>(coef.gamma);
     for a in 0..3 {
         let term = |v: usize, p: S::f64s| s.mul_f64s(kv[v], p);
         let curv = s.add_f64s(
@@ -89,6 +123,50 @@ pub(crate) fn project<S: Simd, const L: usize, const DAMPED: bool>(
         for v in 0..4 {
             x[v][a] = store::<S, L>(s.add_f64s(xs[v][a], s.mul_f64s(steps[v], dl)));
         }
+    }
+}
+
+/// An isometric hinge's [`constants`] for a frame, on one lane: kept while the inverse masses
+/// and coefficients stay the same, they leave the sweep the positions' part of the projection.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Prepared {
+    /// wᵢkᵢ per particle.
+    pub steps: [f64; 4],
+    /// 1 / ((1 + γ) Σ wᵢkᵢ² + α̃), or 0 where the hinge is left alone.
+    pub inv: f64,
+}
+
+impl Prepared {
+    /// The constants of a hinge of weights `k` on particles of inverse masses `w`.
+    pub fn new(w: [f64; 4], k: [f64; 4], coef: &Coefs<1>) -> Self {
+        let (steps, inv) = constants::<Scalar, 1>(Scalar, &w.map(|v| [v]), &k.map(|v| [v]), coef);
+        Self {
+            steps: steps.map(|v| v),
+            inv,
+        }
+    }
+
+    /// [`project`] of one hinge of weights `k` with these constants: the same operations, so
+    /// the same bits.
+    #[inline(always)]
+    pub fn project<const DAMPED: bool>(
+        &self,
+        x: &mut Quads<1>,
+        prev: &Quads<1>,
+        k: [f64; 4],
+        coef: &Coefs<1>,
+        lambda: &mut [[f64; 1]; 3],
+    ) {
+        apply::<Scalar, 1, DAMPED>(
+            Scalar,
+            x,
+            prev,
+            &k.map(|v| [v]),
+            &self.steps,
+            self.inv,
+            coef,
+            lambda,
+        );
     }
 }
 

@@ -23,6 +23,8 @@ pub use tether::Tether;
 
 use glam::DVec3;
 
+pub(crate) use quad_sweep::FrameConstants;
+
 use crate::domains::SimdPath;
 use crate::params::FamilyParams;
 
@@ -93,6 +95,8 @@ pub struct ConstraintSet {
     /// Whether the isometric block is soft per substep this frame, so that its sweep runs
     /// forward only (see [`Block::project_symmetric_lanes`]).
     pub(crate) isometric_forward: bool,
+    /// The isometric block's frame constants (see [`FrameConstants`]).
+    pub(crate) isometric_constants: FrameConstants<isometric_lanes::Prepared>,
 }
 
 /// Max and root-mean-square of |C| over a set of constraints.
@@ -162,6 +166,8 @@ impl ConstraintSet {
     /// substep ([`Block::soft_per_substep`]).
     pub(crate) fn prepare_sweeps(&mut self, w: &[f64], params: &[FamilyParams], rule: Rule) {
         self.isometric_forward = self.isometric.soft_per_substep(w, params, rule);
+        self.isometric
+            .prepare_constants(&mut self.isometric_constants, w, params, rule);
     }
 
     /// Clears the XPBD multipliers (at the start of each substep).
@@ -185,11 +191,13 @@ impl ConstraintSet {
         rule: Rule,
         path: SimdPath,
     ) {
+        let none = FrameConstants::default();
         self.dihedral
-            .project_symmetric_lanes(x, prev, w, params, rule, path, false);
+            .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
         let forward = self.isometric_forward;
+        let constants = &self.isometric_constants;
         self.isometric
-            .project_symmetric_lanes(x, prev, w, params, rule, path, forward);
+            .project_symmetric_lanes(x, prev, w, params, rule, path, forward, constants);
         self.tethers.project(x, prev, w, params, rule);
         self.seams.project(x, prev, w, &self.seam_params, rule);
     }
