@@ -66,19 +66,21 @@ impl PartGrid {
             );
             let ab = b - a;
             let l2 = ab.length_squared();
-            let keep = r + half_diag;
+            // One division per part rather than per cell; the radius grown by a relative 1e-12
+            // so that rounding never drops a cell at the boundary.
+            let inv_l2 = if l2 > 0.0 { 1.0 / l2 } else { 0.0 };
+            let keep = (r + half_diag) * (1.0 + 1e-12);
+            let keep2 = keep * keep;
             for z in cl[2]..=ch[2] {
                 for y in cl[1]..=ch[1] {
+                    let row = (z * self.dims[1] + y) * self.dims[0];
+                    let cy = lo.y + (y as f64 + 0.5) * edge;
+                    let cz = lo.z + (z as f64 + 0.5) * edge;
                     for x in cl[0]..=ch[0] {
-                        let c = lo + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * edge;
-                        let t = if l2 > 0.0 {
-                            ((c - a).dot(ab) / l2).clamp(0.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        if (c - (a + ab * t)).length_squared() <= keep * keep {
-                            let id = (z * self.dims[1] + y) * self.dims[0] + x;
-                            self.pairs.push((id as u32, k as u16));
+                        let c = DVec3::new(lo.x + (x as f64 + 0.5) * edge, cy, cz);
+                        let t = ((c - a).dot(ab) * inv_l2).clamp(0.0, 1.0);
+                        if (c - (a + ab * t)).length_squared() <= keep2 {
+                            self.pairs.push(((row + x) as u32, k as u16));
                         }
                     }
                 }
@@ -96,11 +98,16 @@ impl PartGrid {
         }
         self.parts.clear();
         self.parts.resize(self.pairs.len(), 0);
-        let mut next = self.offsets.clone();
+        // Each pair goes to its cell's next free slot, counted in `offsets[c]` (the cell's
+        // start, advanced as it fills); each start then sits where the next cell's was, so the
+        // starts are restored by shifting them one cell up.
         for &(c, k) in &self.pairs {
-            self.parts[next[c as usize] as usize] = k;
-            next[c as usize] += 1;
+            let slot = &mut self.offsets[c as usize];
+            self.parts[*slot as usize] = k;
+            *slot += 1;
         }
+        self.offsets.copy_within(0..cells, 1);
+        self.offsets[0] = 0;
     }
 
     /// The cell holding `p`, clamped into the grid.
