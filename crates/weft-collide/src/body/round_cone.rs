@@ -63,14 +63,14 @@ fn sphere_within(
     let d = p - center;
     let len = d.length();
     let distance = len - radius;
-    if !(distance <= reach) {
-        return None;
-    }
-    let normal = if len > 0.0 { d / len } else { fallback };
-    Some(Contact {
-        distance,
-        point: center + normal * radius,
-        normal,
+    // Written so that a NaN distance is no contact, as in `contact_within`'s filter.
+    (distance <= reach).then(|| {
+        let normal = if len > 0.0 { d / len } else { fallback };
+        Contact {
+            distance,
+            point: center + normal * radius,
+            normal,
+        }
     })
 }
 
@@ -226,19 +226,18 @@ impl PreparedCone {
             return sphere_within(self.b, self.rb, p, u, reach);
         }
         let distance = cos * x + sin * y - self.ra;
-        if !(distance <= reach) {
-            return None;
-        }
-        let e = if x > 0.0 {
-            radial / x
-        } else {
-            u.any_orthonormal_vector()
-        };
-        let normal = e * cos + u * sin;
-        Some(Contact {
-            distance,
-            point: p - normal * distance,
-            normal,
+        (distance <= reach).then(|| {
+            let e = if x > 0.0 {
+                radial / x
+            } else {
+                u.any_orthonormal_vector()
+            };
+            let normal = e * cos + u * sin;
+            Contact {
+                distance,
+                point: p - normal * distance,
+                normal,
+            }
         })
     }
 
