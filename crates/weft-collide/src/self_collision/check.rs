@@ -80,7 +80,7 @@ impl SelfCollision {
         thickness: &[f64],
         clamp: Option<Clamp<'_>>,
     ) {
-        match self.skin.record(self.pair_count()) {
+        match self.skin.record(self.pair_count(), self.members.len()) {
             Change::Keep => {}
             Change::Grow => self.list.built_for = None,
             Change::Shrink => self.shrink(),

@@ -79,8 +79,8 @@ pub struct SelfCollisionParams {
     /// the motion.
     pub search_margin: f64,
     /// Whether the skin adapts to the motion: thin at rest, thick while the cloth folds or
-    /// slides, one step at a time between 0.25 and 4.0 (see `skin.rs`). Like the skin itself,
-    /// it changes only the cost.
+    /// slides, one step at a time between 0.25 and 4.0, past 1.0 only while the list is
+    /// sparse (see `skin.rs`). Like the skin itself, it changes only the cost.
     pub adaptive_margin: bool,
 }
 

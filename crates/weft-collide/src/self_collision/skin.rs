@@ -11,10 +11,19 @@
 //! counts, not clocks, decide, so the choice is the same on every run; and the skin changes
 //! only the cost, never a result.
 
-/// The skins the list may take, as fractions of the thickness: up to four thicknesses, for a
-/// single layer carried by a moving body (a garment on a walking character), whose list holds
-/// few pairs at any skin while its members stray from their anchors all the time.
+/// The skins the list may take, as fractions of the thickness. Those beyond one thickness are
+/// for a single layer carried by a moving body (a garment on a walking character), whose list
+/// holds few pairs at any skin while its members stray from their anchors all the time: the
+/// skin grows past one thickness only while the list holds fewer than one pair per
+/// [`SPARSE`] members.
 pub(crate) const STEPS: [f64; 9] = [0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0, 2.8, 4.0];
+
+/// Members per listed pair, at least, for the skin to grow past one thickness. Where layers
+/// lie on each other (a sheet folded on a sphere: 901 pairs for 16,384 members at one
+/// thickness) a thicker skin lists tens of thousands of pairs, which the work model below,
+/// fitted at skins up to one thickness, does not price: self-collision then cost more, not
+/// less (1.9 → 2.5–4.3 ms per frame with steps up to 1.4–2.8).
+const SPARSE: usize = 64;
 
 /// Sweeps per epoch: the skin may change once per epoch.
 const EPOCH: u32 = 32;
@@ -101,29 +110,43 @@ impl Skin {
         self.upkeep += REANCHOR_PER_MEMBER * movers as u64;
     }
 
-    /// Counts one sweep over `listed` pairs; at the end of an epoch, moves the skin one step
-    /// towards the balance of upkeep and filtering, and says how it moved.
-    pub(crate) fn record(&mut self, listed: usize) -> Change {
+    /// Counts one sweep over `listed` pairs of a list of `members` members; at the end of an
+    /// epoch, moves the skin one step towards the balance of upkeep and filtering, and says
+    /// how it moved.
+    pub(crate) fn record(&mut self, listed: usize, members: usize) -> Change {
         self.filtered += listed as u64;
         self.sweeps += 1;
         let Some(step) = self.step else {
             return Change::Keep;
         };
+        let sparse = listed.saturating_mul(SPARSE) < members;
+        // A skin past one thickness is for a sparse list only: once the list fills (layers
+        // landing on each other), back to one thickness at once, a new epoch begun.
+        if STEPS[step] > 1.0 && !sparse {
+            let one = STEPS.iter().rposition(|&m| m <= 1.0).unwrap_or(0);
+            (self.sweeps, self.filtered, self.upkeep) = (0, 0, 0);
+            return self.take(step, one, Change::Shrink);
+        }
         if self.sweeps < EPOCH {
             return Change::Keep;
         }
         let ratio = self.upkeep as f64 / self.filtered.max(1) as f64;
         (self.sweeps, self.filtered, self.upkeep) = (0, 0, 0);
-        let (next, change) = if ratio > GROW_ABOVE && step + 1 < STEPS.len() {
-            (step + 1, Change::Grow)
+        let thicker = step + 1 < STEPS.len() && (STEPS[step + 1] <= 1.0 || sparse);
+        if ratio > GROW_ABOVE && thicker {
+            self.take(step, step + 1, Change::Grow)
         } else if ratio < SHRINK_BELOW && step > 0 {
-            (step - 1, Change::Shrink)
+            self.take(step, step - 1, Change::Shrink)
         } else {
-            (step, Change::Keep)
-        };
-        self.step = Some(next);
-        self.margin = STEPS[next];
-        self.changes += u64::from(next != step);
+            Change::Keep
+        }
+    }
+
+    /// Moves from step `from` to step `to`, which `change` describes.
+    fn take(&mut self, from: usize, to: usize, change: Change) -> Change {
+        self.step = Some(to);
+        self.margin = STEPS[to];
+        self.changes += u64::from(to != from);
         change
     }
 }
@@ -137,7 +160,7 @@ mod tests {
         let mut skin = Skin::new(0.3, false);
         for _ in 0..10 * EPOCH {
             skin.built(1000, 0);
-            assert_eq!(skin.record(1), Change::Keep);
+            assert_eq!(skin.record(1, 1000), Change::Keep);
         }
         assert_eq!((skin.margin(), skin.changes()), (0.3, 0));
     }
@@ -150,7 +173,7 @@ mod tests {
         let (up, last) = (STEPS.len() as u32 - 3, STEPS.len() as u32 - 1);
         for sweep in 1..=(up + 2) * EPOCH {
             skin.built(100, 10);
-            let change = skin.record(10);
+            let change = skin.record(10, 1000);
             assert_eq!(
                 change == Change::Grow,
                 sweep % EPOCH == 0 && sweep <= up * EPOCH
@@ -160,7 +183,7 @@ mod tests {
         assert_eq!(skin.margin(), STEPS[STEPS.len() - 1]);
         // Many pairs, nothing rebuilt: one step thinner per epoch, down to the first.
         for sweep in 1..=(last + 2) * EPOCH {
-            let change = skin.record(100_000);
+            let change = skin.record(100_000, 10_000_000);
             assert_eq!(
                 change == Change::Shrink,
                 sweep % EPOCH == 0 && sweep <= last * EPOCH
@@ -174,14 +197,42 @@ mod tests {
         // Upkeep between the thresholds keeps it: here equal to the filtering.
         for _ in 0..4 * EPOCH {
             skin.reanchored(1);
-            assert_eq!(skin.record(REANCHOR_PER_MEMBER as usize), Change::Keep);
+            assert_eq!(
+                skin.record(REANCHOR_PER_MEMBER as usize, 1_000_000),
+                Change::Keep
+            );
         }
         // Just above the growth threshold grows it.
         for sweep in 1..=EPOCH {
             skin.reanchored(5);
-            let change = skin.record(REANCHOR_PER_MEMBER as usize);
+            let change = skin.record(REANCHOR_PER_MEMBER as usize, 1_000_000);
             assert_eq!(change == Change::Grow, sweep == EPOCH);
         }
         assert_eq!(skin.margin(), STEPS[1]);
+    }
+
+    #[test]
+    fn only_a_sparse_list_grows_past_one_thickness() {
+        // The same upkeep, rebuilt every sweep: a list of one pair per 10 members stops at one
+        // thickness, one of one pair per 100 members goes on to the thickest step.
+        for (listed, top) in [(100, 1.0), (10, STEPS[STEPS.len() - 1])] {
+            let mut skin = Skin::new(0.5, true);
+            for _ in 0..2 * STEPS.len() as u32 * EPOCH {
+                skin.built(100, listed);
+                skin.record(listed, 1000);
+            }
+            assert_eq!(skin.margin(), top, "{listed} pairs for 1000 members");
+        }
+        // At the thickest step, a list that fills goes back to one thickness at the next
+        // sweep, and stays there while full.
+        let mut skin = Skin::new(STEPS[STEPS.len() - 1], true);
+        assert_eq!(skin.record(10, 1000), Change::Keep);
+        assert_eq!(skin.record(100, 1000), Change::Shrink);
+        assert_eq!(skin.margin(), 1.0);
+        for _ in 0..4 * EPOCH {
+            skin.built(100, 100);
+            assert_ne!(skin.record(100, 1000), Change::Grow);
+        }
+        assert_eq!(skin.margin(), 1.0);
     }
 }
