@@ -367,20 +367,23 @@ fn chunk<S: Simd, Q: QuadLanes, const L: usize, const DAMPED: bool>(
     gathered::<Q, L, DAMPED>(seg, start, Lanes(s));
 }
 
+/// A chunk of `L` constraints gathered into lanes: positions and previous positions
+/// `[particle][axis][lane]`, inverse masses, shapes, coefficients and multipliers.
+struct Gather<'a, Q, const L: usize> {
+    x: Quads<L>,
+    prev: Quads<L>,
+    w: [[f64; L]; 4],
+    shapes: &'a [Q; L],
+    coef: Coefs<L>,
+    lambda: &'a mut [f64],
+}
+
 /// What [`gathered`] hands a chunk to. A trait rather than a closure: a closure compiles as a
 /// function without the kernel path's target features, into which the kernel's intrinsics do
 /// not inline (the dihedral sweep ran seven times slower through one).
 trait Projector<Q: QuadLanes, const L: usize, const DAMPED: bool> {
     /// Projects the gathered constraints in place.
-    fn project(
-        self,
-        x: &mut Quads<L>,
-        prev: &Quads<L>,
-        w: &[[f64; L]; 4],
-        shapes: &[Q; L],
-        coef: &Coefs<L>,
-        lambda: &mut [f64],
-    );
+    fn project(self, g: &mut Gather<'_, Q, L>);
 }
 
 /// The lane kernel on the vectors of `S`.
@@ -390,16 +393,10 @@ impl<S: Simd, Q: QuadLanes, const L: usize, const DAMPED: bool> Projector<Q, L, 
     for Lanes<S>
 {
     #[inline(always)]
-    fn project(
-        self,
-        x: &mut Quads<L>,
-        prev: &Quads<L>,
-        w: &[[f64; L]; 4],
-        shapes: &[Q; L],
-        coef: &Coefs<L>,
-        lambda: &mut [f64],
-    ) {
-        Q::project_lanes::<S, L, DAMPED>(self.0, x, prev, w, shapes, coef, lambda);
+    fn project(self, g: &mut Gather<'_, Q, L>) {
+        Q::project_lanes::<S, L, DAMPED>(
+            self.0, &mut g.x, &g.prev, &g.w, g.shapes, &g.coef, g.lambda,
+        );
     }
 }
 
@@ -408,16 +405,8 @@ struct WithConstants<P>(P);
 
 impl<Q: QuadLanes, const DAMPED: bool> Projector<Q, 1, DAMPED> for WithConstants<Q::Prepared> {
     #[inline(always)]
-    fn project(
-        self,
-        x: &mut Quads<1>,
-        prev: &Quads<1>,
-        _w: &[[f64; 1]; 4],
-        shapes: &[Q; 1],
-        coef: &Coefs<1>,
-        lambda: &mut [f64],
-    ) {
-        shapes[0].project_prepared::<DAMPED>(&self.0, x, prev, coef, lambda);
+    fn project(self, g: &mut Gather<'_, Q, 1>) {
+        g.shapes[0].project_prepared::<DAMPED>(&self.0, &mut g.x, &g.prev, &g.coef, g.lambda);
     }
 }
 
@@ -480,7 +469,16 @@ fn gathered<Q: QuadLanes, const L: usize, const DAMPED: bool>(
     let Some(lambda) = seg.lambda.get_mut(start * m..(start + L) * m) else {
         return;
     };
-    projector.project(&mut x, &prev, &w, shapes, &coef, lambda);
+    let mut g = Gather {
+        x,
+        prev,
+        w,
+        shapes,
+        coef,
+        lambda,
+    };
+    projector.project(&mut g);
+    let x = g.x;
     for v in 0..4 {
         for l in 0..L {
             seg.x[at[v][l]] = DVec3::new(x[v][0][l], x[v][1][l], x[v][2][l]);
