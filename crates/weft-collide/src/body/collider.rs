@@ -20,6 +20,31 @@ const CELL: f64 = 0.05;
 /// Below this many contact planes a substep's projections run on the calling thread.
 const SERIAL_PLANES: usize = 4096;
 
+/// Substeps one broad phase serves at most (see [`Window`]).
+const WINDOW_SUBSTEPS: usize = 10;
+
+/// The span of time the broad phase holds for: every part listed in every cell it could touch
+/// at any time from `from` to `until`, for contacts within `reach`. Built at the window's start
+/// pose with each part grown by a bound on how far it travels over the window (the sum of its
+/// substeps' travel bounds, at most [`CELL`]), so one build serves up to [`WINDOW_SUBSTEPS`]
+/// substeps instead of one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Window {
+    from: f64,
+    until: f64,
+    reach: f64,
+}
+
+impl Window {
+    /// Whether the window holds for the substep `t0 → t1` (to rounding of the substep times).
+    fn covers(&self, t0: f64, t1: f64, reach: f64) -> bool {
+        let tol = |t: f64| 1e-12 * t.abs().max(1.0);
+        self.reach == reach
+            && t0 >= self.from - tol(self.from)
+            && t1 <= self.until + tol(self.until)
+    }
+}
+
 /// A body in the world.
 #[derive(Clone, Debug)]
 pub(crate) struct BodyCollider {
@@ -32,6 +57,12 @@ pub(crate) struct BodyCollider {
     end_time: Option<f64>,
     moving: Vec<MovingPart>,
     grid: PartGrid,
+    /// What the grid holds for, if anything.
+    window: Option<Window>,
+    /// Scratch of a window's build: poses ahead, each part's travel so far, the grown parts.
+    ahead: [Vec<BodyPart>; 2],
+    travel: Vec<f64>,
+    grown: Vec<MovingPart>,
     /// Per chunk of particles, the contact planes of this substep, in particle order.
     chunks: Vec<Vec<Plane>>,
     /// Contact planes found this substep.
@@ -51,6 +82,10 @@ impl BodyCollider {
             end_time: Some(t),
             moving: Vec::new(),
             grid: PartGrid::default(),
+            window: None,
+            ahead: [Vec::new(), Vec::new()],
+            travel: Vec::new(),
+            grown: Vec::new(),
             chunks: Vec::new(),
             plane_count: 0,
         }
@@ -71,8 +106,8 @@ impl BodyCollider {
         self.plane_count
     }
 
-    /// Moves the body to its poses at `t0` and `t1` (the substep's ends) and rebuilds the
-    /// broad phase for contacts within `reach` (m).
+    /// Moves the body to its poses at `t0` and `t1` (the substep's ends) and, unless its window
+    /// still holds, builds the broad phase for contacts within `reach` (m) anew.
     pub fn set_time(&mut self, t0: f64, t1: f64, reach: f64) {
         // The last substep's end is this one's start (to rounding of the substep times).
         let reuse = self
@@ -93,7 +128,55 @@ impl BodyCollider {
                 .zip(&self.end)
                 .map(|(a, b)| MovingPart::new(a, b, extent)),
         );
-        self.grid.build(&self.moving, reach, CELL);
+        if !self.window.is_some_and(|w| w.covers(t0, t1, reach)) {
+            self.build_window(t0, t1, reach);
+        }
+    }
+
+    /// Builds the broad phase for substeps of `t1 − t0` from `t0` on, as many as
+    /// [`WINDOW_SUBSTEPS`] while no part's summed travel bound exceeds [`CELL`] (at least this
+    /// substep), at the start pose with each part grown by its bound: a material point of a
+    /// part moves at most its bound over the window, so every cell a part can touch then is
+    /// listed. The poses ahead depend on time alone ([`KinematicBody`]).
+    fn build_window(&mut self, t0: f64, t1: f64, reach: f64) {
+        let extent = reach + CELL;
+        let h = t1 - t0;
+        self.travel.clear();
+        self.travel.extend(self.moving.iter().map(|m| m.travel));
+        let [before, after] = &mut self.ahead;
+        before.clone_from(&self.end);
+        let mut substeps = 1;
+        while substeps < WINDOW_SUBSTEPS && h > 0.0 {
+            self.body.parts_at(t0 + (substeps + 1) as f64 * h, after);
+            let grows = before
+                .iter()
+                .zip(after.iter())
+                .zip(&self.travel)
+                .map(|((a, b), t)| t + MovingPart::new(a, b, extent).travel);
+            let next: Vec<f64> = grows.collect();
+            if next.iter().any(|&t| t > CELL) {
+                break;
+            }
+            self.travel = next;
+            std::mem::swap(before, after);
+            substeps += 1;
+        }
+        self.grown.clear();
+        self.grown.extend(
+            self.start
+                .iter()
+                .zip(&self.travel)
+                .map(|(p, &t)| MovingPart {
+                    travel: t,
+                    ..MovingPart::new(p, p, extent)
+                }),
+        );
+        self.grid.build(&self.grown, reach, CELL);
+        self.window = Some(Window {
+            from: t0,
+            until: t0 + substeps as f64 * h,
+            reach,
+        });
     }
 
     /// Once per substep, before self-collision: sweeps every free particle's substep path
@@ -180,5 +263,86 @@ impl BodyCollider {
                 .map(|(k, (xs, list))| chunk(k, xs, list))
                 .reduce(|| (0, 0.0), combine)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DQuat;
+
+    use super::*;
+    use crate::body::RoundCone;
+    use crate::test_rand::rand;
+
+    /// A tapered limb 0.4 m long turning at `spin` rad/s about an axis through one end while it
+    /// translates at `speed` m/s.
+    struct Limb {
+        spin: f64,
+        speed: f64,
+    }
+
+    impl KinematicBody for Limb {
+        fn part_count(&self) -> usize {
+            1
+        }
+
+        fn parts_at(&self, t: f64, out: &mut Vec<BodyPart>) {
+            let rotation = DQuat::from_rotation_z(self.spin * t);
+            let translation = DVec3::new(self.speed * t, 0.0, 0.0);
+            let at = |p: DVec3| rotation * p + translation;
+            out.clear();
+            out.push(BodyPart {
+                shape: RoundCone::new(at(DVec3::ZERO), at(DVec3::new(0.4, 0.0, 0.0)), 0.06, 0.04),
+                rotation,
+                translation,
+            });
+        }
+    }
+
+    /// Over 60 substeps of 1/600 s, every point within `reach` of the limb at a substep's start
+    /// or end (sampled around both poses) has the limb among its grid candidates; returns how
+    /// many broad phases were built.
+    fn windows(limb: Limb) -> usize {
+        let (h, reach) = (1.0 / 600.0, 0.008);
+        let body: Arc<dyn KinematicBody> = Arc::new(limb);
+        let mut c = BodyCollider::new(body.clone(), Friction::default(), 0.0);
+        let (mut s, mut builds, mut last, mut near) = (7u64, 0, None, 0);
+        let mut parts = Vec::new();
+        for k in 0..60 {
+            let (t0, t1) = (k as f64 * h, (k + 1) as f64 * h);
+            c.set_time(t0, t1, reach);
+            builds += usize::from(c.window != last);
+            last = c.window;
+            for t in [t0, t1] {
+                body.parts_at(t, &mut parts);
+                let cone = parts[0].shape;
+                for _ in 0..2000 {
+                    let mid = cone.a.lerp(cone.b, 0.5 + 0.7 * rand(&mut s));
+                    let p = mid + DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s)) * 0.08;
+                    if cone.signed_distance(p) <= reach {
+                        near += 1;
+                        assert!(c.grid.candidates(p).contains(&0), "{p} at {t} s");
+                    }
+                }
+            }
+        }
+        assert!(near > 50_000, "{near} points near the limb");
+        builds
+    }
+
+    #[test]
+    fn a_window_lists_the_limb_wherever_it_reaches_and_spans_several_substeps() {
+        // A walking limb (tip at 3 m/s): a few broad phases for 60 substeps.
+        let slow = windows(Limb {
+            spin: 5.0,
+            speed: 1.0,
+        });
+        assert!(slow <= 12, "{slow} builds");
+        // A limb 10 cm a substep: a broad phase every substep, still listing it everywhere.
+        let fast = windows(Limb {
+            spin: 40.0,
+            speed: 60.0,
+        });
+        assert_eq!(fast, 60);
     }
 }

@@ -1,12 +1,13 @@
-//! The body's broad phase: a uniform grid over the parts, rebuilt every substep, listing in
-//! each cell the parts that a particle anywhere in the cell could touch (or be crossed by)
-//! this substep.
+//! The body's broad phase: a uniform grid over the parts, listing in each cell the parts that
+//! a particle anywhere in the cell could touch (or be crossed by) over the span of substeps it
+//! is built for.
 //!
 //! A part is listed in a cell when the cell's centre lies within R + (half the cell's
-//! diagonal) of its axis segment, R being its larger radius plus the contact reach plus how
-//! far it travels in the substep; that covers every point of the cell. Rebuilt from scratch
-//! each substep (tens of µs for a 20-part body), it has no stale state, so a limb of any speed
-//! is found; a particle outside the grid's box has no candidate at all.
+//! diagonal) of its axis segment, R being its larger radius plus the contact reach plus a bound
+//! on how far it travels over that span; that covers every point of the cell. Rebuilt from
+//! scratch for each span (tens of µs for a 20-part body; the collider picks spans of up to ten
+//! substeps over which no part travels more than a cell), it has no stale state, so a limb of
+//! any speed is found; a particle outside the grid's box has no candidate at all.
 
 use glam::DVec3;
 

@@ -4,8 +4,9 @@
 //!
 //! A body is its own kind of collider (not a [`crate::ShapeDesc`]): it tells the world, through
 //! [`KinematicBody`], where its parts are at any time, and the world does the rest: a broad
-//! phase rebuilt every substep (`grid.rs`), swept contact in each part's moving frame and
-//! contact planes with Coulomb friction against the part's own motion (`contact.rs`).
+//! phase built for a few substeps at a time (`grid.rs`), swept contact in each part's moving
+//! frame and contact planes with Coulomb friction against the part's own motion
+//! (`contact.rs`).
 
 mod collider;
 mod contact;
