@@ -491,6 +491,11 @@ fn query(c: &Collider, parry: bool, x: DVec3, max_dist: f64) -> Option<crate::Su
 }
 
 impl SubstepHook for CollisionWorld {
+    /// Contacts read positions and previous positions alone, and `end_substep` does nothing.
+    fn uses_velocities(&self) -> bool {
+        false
+    }
+
     /// A world with no collider and no self-collision does nothing, so the solver may fuse.
     fn is_active(&self) -> bool {
         !self.colliders.is_empty() || !self.bodies.is_empty() || self.self_collision.is_some()

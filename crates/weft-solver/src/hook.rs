@@ -41,6 +41,15 @@ pub trait SubstepHook: Send {
     /// velocity-level corrections.
     fn end_substep(&mut self, _ctx: &SubstepContext, _particles: &mut Particles) {}
 
+    /// Whether the hook reads particle velocities (in `begin_substep` or `project`) or does
+    /// anything in `end_substep`. One that does not lets the general loop leave each substep's
+    /// velocity update to the next substep's integration pass (one pass over the particles
+    /// instead of two): in between, the velocities are the last update's, and `end_substep` is
+    /// called only after the frame's last substep. The default says it does.
+    fn uses_velocities(&self) -> bool {
+        true
+    }
+
     /// Whether the hook does anything; an inactive hook lets the solver fuse a substep's phases.
     fn is_active(&self) -> bool {
         true

@@ -1,15 +1,22 @@
 //! Closed-form colliders inside the solver's fused frame (`SubstepHook::particle_contacts`)
-//! give the same bits, contact counts and statistics as the general loop, on 1 and 2 threads.
+//! give the same bits, contact counts and statistics as the general loop, on 1 and 2 threads;
+//! and the general loop gives the same bits whether or not it leaves each substep's velocity
+//! update to the next integration pass (`SubstepHook::uses_velocities`).
 
 use weft_collide::scenarios::{ground, sphere_drop};
 use weft_collide::{ColliderDesc, CollisionWorld, ContactStats, Friction, ShapeDesc};
 use weft_solver::glam::{DQuat, DVec3};
 use weft_solver::{Method, Motion, Particles, Solver, SubstepContext, SubstepHook};
 
-/// `CollisionWorld` without its per-particle contacts: forces the general loop.
-struct General<'a>(&'a mut CollisionWorld);
+/// `CollisionWorld` without its per-particle contacts: forces the general loop; the flag is
+/// what it answers to `uses_velocities` (the world answers false).
+struct General<'a>(&'a mut CollisionWorld, bool);
 
 impl SubstepHook for General<'_> {
+    fn uses_velocities(&self) -> bool {
+        self.1
+    }
+
     fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
         self.0.begin_substep(ctx, particles);
     }
@@ -65,23 +72,38 @@ fn scene(substeps: u32, iterations: u32) -> (Solver, CollisionWorld) {
 /// Bits of every position and velocity, then the contacts and statistics of each frame.
 type Run = (Vec<[u64; 6]>, Vec<usize>, Vec<ContactStats>);
 
-fn run(threads: usize, (substeps, iterations): (u32, u32), general: bool) -> Run {
+/// How a run steps its world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Loop {
+    /// The world as it is: the fused frame.
+    Fused,
+    /// The general loop, each substep's velocities updated in a pass of their own.
+    General,
+    /// The general loop, each substep's velocities updated in the next integration pass.
+    Deferred,
+}
+
+fn run(threads: usize, (substeps, iterations): (u32, u32), how: Loop) -> Run {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("thread pool")
         .install(|| {
             let (mut solver, mut world) = scene(substeps, iterations);
+            // Global damping too: the deferred velocity update applies it.
+            let mut forces = *solver.forces();
+            forces.damping = 0.4;
+            solver.set_forces(forces).expect("valid forces");
             assert!(
                 world.particle_contacts().is_some(),
                 "closed-form shapes only"
             );
             let (mut contacts, mut stats) = (Vec::new(), Vec::new());
             for _ in 0..45 {
-                let step = if general {
-                    solver.step_with(&mut General(&mut world))
-                } else {
-                    solver.step_with(&mut world)
+                let step = match how {
+                    Loop::Fused => solver.step_with(&mut world),
+                    Loop::General => solver.step_with(&mut General(&mut world, true)),
+                    Loop::Deferred => solver.step_with(&mut General(&mut world, false)),
                 };
                 contacts.push(step.expect("stable").contacts);
                 stats.push(world.stats());
@@ -106,19 +128,22 @@ fn closed_form_colliders_in_the_fused_frame_match_the_general_loop() {
     // One substep per frame shows every substep's statistics (they are kept per substep).
     let mut swept = 0;
     for steps in [(10, 1), (4, 2), (1, 2)] {
-        let general = run(1, steps, true);
+        let general = run(1, steps, Loop::General);
         let touched: usize = general.1.iter().sum();
         assert!(touched > 2000, "the cloth reached the colliders: {touched}");
         assert!(general.2.iter().any(|s| s.max_depth > 0.0));
         swept += general.2.iter().map(|s| s.swept).sum::<usize>();
-        for threads in [1, 2] {
-            let fused = run(threads, steps, false);
+        for (threads, how) in [(1, Loop::Fused), (2, Loop::Fused), (2, Loop::Deferred)] {
+            let other = run(threads, steps, how);
             assert!(
-                fused.0 == general.0,
-                "positions or velocities differ: {steps:?}, {threads} thread(s)"
+                other.0 == general.0,
+                "positions or velocities differ: {how:?}, {steps:?}, {threads} thread(s)"
             );
-            assert_eq!(fused.1, general.1, "contacts per frame, {steps:?}");
-            assert_eq!(fused.2, general.2, "statistics of each frame, {steps:?}");
+            assert_eq!(other.1, general.1, "contacts per frame, {how:?}, {steps:?}");
+            assert_eq!(
+                other.2, general.2,
+                "statistics of each frame, {how:?}, {steps:?}"
+            );
         }
     }
     assert!(swept > 0, "some particle was swept");

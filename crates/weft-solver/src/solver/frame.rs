@@ -132,8 +132,21 @@ impl Solver {
         }
         let path = self.domains.path();
         let mut whole = true;
+        // External accelerations inside the integration pass when each particle's depends on
+        // its own velocity alone; and then, for a hook that never looks at velocities, each
+        // substep's velocity pass waits for the next substep's integration pass: one pass over
+        // the particles instead of two, the same arithmetic per particle.
+        let inline_accel = self.forces.per_particle() && !strategy.has_internal_forces();
+        let defer = inline_accel && !hook.uses_velocities();
+        let inv_h = 1.0 / h;
+        let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
+        // The last substep's velocities (and its driven pins') are still to be computed.
+        let mut pending = false;
         for k in 0..s.substeps {
             if self.stopping() {
+                if pending {
+                    self.finish_velocities(inv_h, keep);
+                }
                 whole = false;
                 break;
             }
@@ -146,10 +159,7 @@ impl Solver {
                 h,
                 substep: k,
             };
-            // External and (mass-spring) internal accelerations at the start of the substep;
-            // when each particle's depends on its own velocity alone, computed inside the
-            // integration pass instead (one parallel pass fewer, the same arithmetic).
-            let inline_accel = self.forces.per_particle() && !strategy.has_internal_forces();
+            // External and (mass-spring) internal accelerations at the start of the substep.
             if !inline_accel {
                 self.forces
                     .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
@@ -162,9 +172,11 @@ impl Solver {
                     &mut self.accel,
                 );
             }
-            // Semi-implicit Euler: v ← v + h a, x ← x + h v (for PBD/XPBD, the prediction).
+            // Semi-implicit Euler: v ← v + h a, x ← x + h v (for PBD/XPBD, the prediction), after
+            // the last substep's velocity update when it waited for this pass.
             let p = &mut self.particles;
             let forces = &self.forces;
+            let finish = std::mem::take(&mut pending);
             p.positions
                 .par_chunks_mut(CHUNK)
                 .zip(p.prev_positions.par_chunks_mut(CHUNK))
@@ -173,6 +185,9 @@ impl Solver {
                 .zip(self.accel.par_chunks(CHUNK))
                 .for_each(|((((x, prev), v), w), a)| {
                     for j in 0..x.len() {
+                        if finish {
+                            v[j] = end_velocity(x[j], prev[j], w[j], inv_h, keep);
+                        }
                         prev[j] = x[j];
                         if w[j] > 0.0 {
                             let a = if inline_accel {
@@ -220,32 +235,48 @@ impl Solver {
                 }
                 None => stats.contacts = hook.project(&ctx, p),
             }
-            // Velocities from positions (the PBD update; for mass-spring it equals v unless
-            // a contact moved the particle), then the global damping v ← v·e^(−c h) of free
-            // particles, in one pass (the fused loop's order, `Domain::finish_velocities`).
-            let inv_h = 1.0 / h;
-            let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
-            p.velocities
-                .par_chunks_mut(CHUNK)
-                .zip(p.positions.par_chunks(CHUNK))
-                .zip(p.prev_positions.par_chunks(CHUNK))
-                .zip(p.inv_masses.par_chunks(CHUNK))
-                .for_each(|(((v, x), prev), w)| {
-                    for j in 0..v.len() {
-                        v[j] = (x[j] - prev[j]) * inv_h;
-                        if let Some(keep) = keep
-                            && w[j] > 0.0
-                        {
-                            v[j] *= keep;
-                        }
-                    }
-                });
-            // Driven pins report the velocity of what carries them, not the chord.
-            for &(i, v) in &self.driven_velocities {
-                p.velocities[i] = v;
+            if defer && k + 1 < s.substeps {
+                // The hook looks at no velocity until the frame ends: the next integration
+                // pass computes these (its driven pins hold still in between, w = 0).
+                pending = true;
+                continue;
             }
-            hook.end_substep(&ctx, p);
+            self.finish_velocities(inv_h, keep);
+            hook.end_substep(&ctx, &mut self.particles);
         }
         (stats, whole)
+    }
+
+    /// Every particle's velocity from its substep's positions ([`end_velocity`]), in parallel,
+    /// then the driven pins' velocities.
+    fn finish_velocities(&mut self, inv_h: f64, keep: Option<f64>) {
+        let p = &mut self.particles;
+        p.velocities
+            .par_chunks_mut(CHUNK)
+            .zip(p.positions.par_chunks(CHUNK))
+            .zip(p.prev_positions.par_chunks(CHUNK))
+            .zip(p.inv_masses.par_chunks(CHUNK))
+            .for_each(|(((v, x), prev), w)| {
+                for j in 0..v.len() {
+                    v[j] = end_velocity(x[j], prev[j], w[j], inv_h, keep);
+                }
+            });
+        // Driven pins report the velocity of what carries them, not the chord.
+        for &(i, v) in &self.driven_velocities {
+            p.velocities[i] = v;
+        }
+    }
+}
+
+/// A particle's velocity at the end of a substep: from its positions (the PBD update; for
+/// mass-spring it equals v unless a contact moved the particle), then the global damping
+/// v ← v·e^(−c h) of a free particle (`keep`), the fused loop's order
+/// (`Domain::finish_velocities`).
+#[inline(always)]
+fn end_velocity(x: DVec3, prev: DVec3, w: f64, inv_h: f64, keep: Option<f64>) -> DVec3 {
+    let v = (x - prev) * inv_h;
+    match keep {
+        Some(keep) if w > 0.0 => v * keep,
+        _ => v,
     }
 }
