@@ -17,9 +17,11 @@ pub struct Settings {
     pub iterations: u32,
     /// A particle farther than this from the origin (m) means the simulation diverged.
     pub divergence_bound: f64,
-    /// Particles per parallel domain (rounded up to a multiple of 8). Domains solve their own
-    /// constraints concurrently; constraints across domains are solved after them, serially.
-    /// The split, and so the result, depends on this and the mesh, never on the thread count.
+    /// Most particles per parallel domain: the particles are cut into the fewest domains of
+    /// at most this many that number a power of two, all of one size (a multiple of 8), so
+    /// that the fork–join tree's halves hold equal work. Domains solve their own constraints
+    /// concurrently; constraints across domains are solved after them, serially. The split,
+    /// and so the result, depends on this and the mesh, never on the thread count.
     pub domain_size: usize,
     /// The kernel path of the constraint sweep: `None` takes `WEFT_SIMD` (`avx512`, `avx2`,
     /// `neon` or `scalar`, read once) or else the widest path the CPU runs; a path the CPU
