@@ -14,7 +14,7 @@ use super::skin::Change;
 const MOVERS_CAP: usize = 16;
 
 /// Members per rayon task in the per-member loops.
-const MEMBER_CHUNK: usize = 4096;
+const MEMBER_CHUNK: usize = 1024;
 
 /// What limits a substep's displacements (see [`SelfCollision::refresh`]).
 #[derive(Clone, Copy)]
