@@ -62,14 +62,19 @@ impl Friction {
     /// over the substep and d the penetration depth,
     /// Δx = Δx⊥ if |Δx⊥| < μs d (static: the slip is cancelled), else
     /// Δx = Δx⊥ · min(μk d / |Δx⊥|, 1) (dynamic: the slip is reduced by μk d).
+    ///
+    /// The static case, a resting contact's usual one, compares squares: no square root on
+    /// its path.
+    #[inline]
     pub fn correction(&self, tangential: DVec3, depth: f64) -> DVec3 {
-        let slip = tangential.length();
-        if depth <= 0.0 || slip <= 0.0 {
+        let slip2 = tangential.length_squared();
+        let grip = self.static_coefficient * depth;
+        if depth <= 0.0 || slip2 <= 0.0 {
             DVec3::ZERO
-        } else if slip < self.static_coefficient * depth {
+        } else if slip2 < grip * grip {
             tangential
         } else {
-            tangential * (self.dynamic_coefficient * depth / slip).min(1.0)
+            tangential * (self.dynamic_coefficient * depth / slip2.sqrt()).min(1.0)
         }
     }
 }

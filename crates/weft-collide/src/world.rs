@@ -268,10 +268,6 @@ impl CollisionWorld {
     /// collider's surface is stopped a thickness before it. In parallel over particles.
     fn sweep(&mut self, p: &mut Particles) {
         self.stats.swept = 0;
-        for b in &mut self.bodies {
-            self.stats.swept += b.find(p, &self.thickness);
-            self.stats.body_planes += b.plane_count();
-        }
         if self.colliders.is_empty() {
             return;
         }
@@ -527,8 +523,8 @@ impl SubstepHook for CollisionWorld {
     /// Closed-form colliders only (no mesh, no self-collision): each particle's sweep and
     /// push-out read that particle alone, so the solver may run them inside its domains.
     fn particle_contacts(&self) -> Option<&dyn ParticleContacts> {
-        // Kinematic bodies find contact planes per substep in `begin_substep`, outside the
-        // per-particle pass: a world with one keeps the general loop.
+        // Kinematic bodies run a pass of their own (`BodyCollider::contact`): a world with one
+        // keeps the general loop.
         let per_particle = self.self_collision.is_none()
             && self.bodies.is_empty()
             && !self.colliders.is_empty()
@@ -549,9 +545,10 @@ impl SubstepHook for CollisionWorld {
     }
 
     fn project(&mut self, _ctx: &SubstepContext, particles: &mut Particles) -> usize {
-        // Once per substep, before the first projection: the bodies' sweep and contact planes
-        // and the colliders' sweep, then the self-collision's clamp (a move back along a swept
-        // path stays clear of colliders).
+        // Once per substep, before the first projection: the colliders' sweep, then the
+        // self-collision's clamp (a move back along a swept path stays clear of colliders).
+        // Bodies come last, in one pass per body: each particle's sweep (first projection
+        // only), contact planes and projection.
         let fresh = std::mem::take(&mut self.fresh);
         if fresh {
             self.sweep(particles);
@@ -572,9 +569,13 @@ impl SubstepHook for CollisionWorld {
         };
         let (mut collider_contacts, swept) = self.resolve_colliders(particles, fresh);
         for b in &mut self.bodies {
-            let (contacts, deepest) = b.resolve(particles, &self.thickness);
-            collider_contacts += contacts;
-            self.stats.max_depth = self.stats.max_depth.max(deepest);
+            let c = b.contact(particles, &self.thickness, fresh);
+            collider_contacts += c.contacts;
+            self.stats.max_depth = self.stats.max_depth.max(c.deepest);
+            self.stats.swept += c.swept;
+            if fresh {
+                self.stats.body_planes += c.planes;
+            }
         }
         self.stats.swept += swept;
         self.stats.collider_contacts = collider_contacts;

@@ -1,9 +1,8 @@
 //! A kinematic body inside the collision world: its parts at the substep's start and end,
-//! the broad phase, and the per-chunk contact planes.
+//! the broad phase, and each particle's sweep, contact planes and projection.
 
 use std::sync::Arc;
 
-use glam::DVec3;
 use rayon::prelude::*;
 use weft_solver::Particles;
 
@@ -16,9 +15,6 @@ use crate::world::{CHUNK, moving_views};
 
 /// Preferred edge of the broad phase's cells (m): a few limb radii.
 const CELL: f64 = 0.05;
-
-/// Below this many contact planes a substep's projections run on the calling thread.
-const SERIAL_PLANES: usize = 4096;
 
 /// Substeps one broad phase serves at most (see [`Window`]).
 const WINDOW_SUBSTEPS: usize = 10;
@@ -63,10 +59,8 @@ pub(crate) struct BodyCollider {
     ahead: [Vec<BodyPart>; 2],
     travel: Vec<f64>,
     grown: Vec<MovingPart>,
-    /// Per chunk of particles, the contact planes of this substep, in particle order.
-    chunks: Vec<Vec<Plane>>,
-    /// Contact planes found this substep.
-    plane_count: usize,
+    /// Per chunk of particles, scratch for one particle's contact planes.
+    scratch: Vec<Vec<Plane>>,
 }
 
 impl BodyCollider {
@@ -86,8 +80,7 @@ impl BodyCollider {
             ahead: [Vec::new(), Vec::new()],
             travel: Vec::new(),
             grown: Vec::new(),
-            chunks: Vec::new(),
-            plane_count: 0,
+            scratch: Vec::new(),
         }
     }
 
@@ -99,11 +92,6 @@ impl BodyCollider {
     /// The friction coefficients.
     pub fn friction(&self) -> Friction {
         self.friction
-    }
-
-    /// Contact planes found at the last substep's first projection.
-    pub fn plane_count(&self) -> usize {
-        self.plane_count
     }
 
     /// Moves the body to its poses at `t0` and `t1` (the substep's ends) and, unless its window
@@ -179,28 +167,24 @@ impl BodyCollider {
         });
     }
 
-    /// Once per substep, before self-collision: sweeps every free particle's substep path
-    /// against the moving parts, then finds its contact planes (every part within twice its
-    /// thickness, or holding it) — one broad-phase lookup per particle for both. Returns how
-    /// many particles the sweep stopped. In parallel over fixed chunks, each particle on its
-    /// own: the same bits on any thread count.
-    ///
-    /// Self-collision then moves particles by a fraction of a thickness; the planes, supporting
-    /// planes of convex parts found within two thicknesses, still hold for them.
-    pub fn find(&mut self, p: &mut Particles, thickness: &[f64]) -> usize {
+    /// Each free particle against the body, after self-collision, in one pass: on the
+    /// substep's first projection (`fresh`) its substep path swept against the moving parts,
+    /// then the contact planes of every part within twice its thickness (or holding it),
+    /// projected on at once — one broad-phase lookup per particle for all of it. In parallel
+    /// over fixed chunks, each particle on its own: the same bits on any thread count.
+    pub fn contact(&mut self, p: &mut Particles, thickness: &[f64], fresh: bool) -> BodyContacts {
         let chunks = p.len().div_ceil(CHUNK);
-        if self.chunks.len() != chunks {
-            self.chunks = vec![Vec::new(); chunks];
+        if self.scratch.len() != chunks {
+            self.scratch = vec![Vec::new(); chunks];
         }
-        let (parts, grid) = (&self.moving, &self.grid);
+        let (parts, grid, friction) = (&self.moving, &self.grid, self.friction);
         let (positions, prev, inv) = moving_views(p);
-        let (swept, found) = positions
+        positions
             .par_chunks_mut(CHUNK)
-            .zip(self.chunks.par_iter_mut())
+            .zip(self.scratch.par_iter_mut())
             .enumerate()
-            .map(|(k, (xs, list))| {
-                list.clear();
-                let mut swept = 0;
+            .map(|(k, (xs, mine))| {
+                let mut out = BodyContacts::default();
                 for (j, x) in xs.iter_mut().enumerate() {
                     let i = k * CHUNK + j;
                     if inv[i] == 0.0 {
@@ -208,67 +192,57 @@ impl BodyCollider {
                     }
                     let r = thickness[i];
                     let mut here = grid.candidates(*x);
-                    let n = sweep(parts, grid, here, prev[i], x, r);
-                    if n > 0 {
-                        swept += n;
-                        here = grid.candidates(*x);
+                    if fresh {
+                        let n = sweep(parts, grid, here, prev[i], x, r);
+                        if n > 0 {
+                            out.swept += n;
+                            here = grid.candidates(*x);
+                        }
                     }
-                    planes(parts, here, j as u32, *x, 2.0 * r, list);
+                    mine.clear();
+                    planes(parts, here, *x, 2.0 * r, mine);
+                    if mine.is_empty() {
+                        continue;
+                    }
+                    out.planes += mine.len();
+                    let (c, d) = project(parts, mine, prev[i], x, r, friction);
+                    out.contacts += c;
+                    out.deepest = out.deepest.max(d);
                 }
-                (swept, list.len())
+                out
             })
-            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-        self.plane_count = found;
-        swept
+            .reduce(BodyContacts::default, BodyContacts::combine)
     }
+}
 
-    /// Projects free particles onto this substep's contact planes (see [`Self::find`]), to a
-    /// thickness outside, with friction. Returns (contacts, deepest overlap).
-    pub fn resolve(&mut self, p: &mut Particles, thickness: &[f64]) -> (usize, f64) {
-        if self.chunks.len() != p.len().div_ceil(CHUNK) {
-            return (0, 0.0);
-        }
-        let friction = self.friction;
-        let (positions, prev, _) = moving_views(p);
-        let chunk = |k: usize, xs: &mut [DVec3], list: &[Plane]| {
-            let (mut contacts, mut deepest) = (0, 0.0f64);
-            let mut rest = list;
-            while let Some(first) = rest.first() {
-                let j = first.particle;
-                let n = rest.iter().take_while(|q| q.particle == j).count();
-                let (mine, others) = rest.split_at(n);
-                rest = others;
-                let i = k * CHUNK + j as usize;
-                let (c, d) = project(mine, prev[i], &mut xs[j as usize], thickness[i], friction);
-                contacts += c;
-                deepest = deepest.max(d);
-            }
-            (contacts, deepest)
-        };
-        let combine = |a: (usize, f64), b: (usize, f64)| (a.0 + b.0, a.1.max(b.1));
-        // Each particle's projection depends on it alone, so the order (and the thread count)
-        // never changes the result: a few planes are cheaper projected here than handed out.
-        if self.plane_count < SERIAL_PLANES {
-            positions
-                .chunks_mut(CHUNK)
-                .zip(&self.chunks)
-                .enumerate()
-                .map(|(k, (xs, list))| chunk(k, xs, list))
-                .fold((0, 0.0), combine)
-        } else {
-            positions
-                .par_chunks_mut(CHUNK)
-                .zip(self.chunks.par_iter())
-                .enumerate()
-                .map(|(k, (xs, list))| chunk(k, xs, list))
-                .reduce(|| (0, 0.0), combine)
+/// What one pass of [`BodyCollider::contact`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct BodyContacts {
+    /// Particles stopped by the swept test.
+    pub swept: usize,
+    /// Contact planes found.
+    pub planes: usize,
+    /// Projections onto a plane.
+    pub contacts: usize,
+    /// Deepest overlap with the thickness shell (m).
+    pub deepest: f64,
+}
+
+impl BodyContacts {
+    /// Sums of counts, the larger depth: the same whatever the order.
+    fn combine(self, o: Self) -> Self {
+        Self {
+            swept: self.swept + o.swept,
+            planes: self.planes + o.planes,
+            contacts: self.contacts + o.contacts,
+            deepest: self.deepest.max(o.deepest),
         }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use glam::DQuat;
+    use glam::{DQuat, DVec3};
 
     use super::*;
     use crate::body::RoundCone;

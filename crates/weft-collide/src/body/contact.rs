@@ -1,5 +1,5 @@
 //! One particle against a body's parts: the swept test in each part's moving frame, and the
-//! contact planes found once per substep and projected on at every iteration.
+//! contact planes found at its current position and projected on.
 
 use glam::DVec3;
 
@@ -7,18 +7,15 @@ use super::grid::PartGrid;
 use super::motion::MovingPart;
 use crate::friction::Friction;
 
-/// A contact found at the substep's first projection: the part's tangent plane at the point
-/// nearest the particle, and how that surface point moved over the substep (for friction).
+/// A part near the particle: its tangent plane at the point nearest the particle.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Plane {
-    /// The particle's index within its chunk.
-    pub particle: u32,
     /// Closest surface point.
     pub point: DVec3,
     /// Outward unit normal there.
     pub normal: DVec3,
-    /// Displacement of that material point over the substep.
-    pub shift: DVec3,
+    /// The part (its motion over the substep gives the surface's displacement, for friction).
+    pub part: u16,
 }
 
 /// Steps of sphere tracing before a grazing path is given up.
@@ -77,36 +74,35 @@ pub(crate) fn sweep(
     swept
 }
 
-/// The contact planes of the particle at `x` (chunk index `j`): every part of `candidates`
-/// whose surface lies within `reach` of it, or which holds it.
+/// The contact planes of the particle at `x`: every part of `candidates` whose surface lies
+/// within `reach` of it, or which holds it.
 pub(crate) fn planes(
     parts: &[MovingPart],
     candidates: &[u16],
-    j: u32,
     x: DVec3,
     reach: f64,
     out: &mut Vec<Plane>,
 ) {
     for &k in candidates {
-        let part = &parts[k as usize];
-        if let Some(c) = part.cone.contact_within(x, reach) {
+        if let Some(c) = parts[k as usize].cone.contact_within(x, reach) {
             out.push(Plane {
-                particle: j,
                 point: c.point,
                 normal: c.normal,
-                shift: part.displacement_at(c.point),
+                part: k,
             });
         }
     }
 }
 
-/// Projects one particle (its planes `planes`) to a thickness `r` outside every plane, with
-/// Coulomb friction against each surface's motion (Macklin et al. 2014, eq. 24): the relative
-/// tangential displacement over the substep, (x − x_prev) − shift, is cancelled or reduced.
+/// Projects one particle (its planes `planes` of `parts`) to a thickness `r` outside every
+/// plane, with Coulomb friction against each surface's motion (Macklin et al. 2014, eq. 24):
+/// the relative tangential displacement over the substep, (x − x_prev) − shift, is cancelled
+/// or reduced, shift being how far the plane's surface point moved with its part.
 ///
 /// Each plane is a supporting plane of a convex part, so a particle `r` outside it is at least
 /// `r` from the part. Returns (contacts resolved, deepest overlap).
 pub(crate) fn project(
+    parts: &[MovingPart],
     planes: &[Plane],
     prev: DVec3,
     x: &mut DVec3,
@@ -123,7 +119,8 @@ pub(crate) fn project(
                 continue;
             }
             *x += p.normal * depth;
-            let rel = (*x - prev) - p.shift;
+            let shift = parts[usize::from(p.part)].displacement_at(p.point);
+            let rel = (*x - prev) - shift;
             let tangential = rel - p.normal * p.normal.dot(rel);
             *x -= friction.correction(tangential, depth);
             contacts += 1;
