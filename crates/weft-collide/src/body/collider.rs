@@ -274,8 +274,9 @@ mod tests {
     }
 
     /// Over 60 substeps of 1/600 s, every point within `reach` of the limb at a substep's start
-    /// or end (sampled around both poses) has the limb among its grid candidates; returns how
-    /// many broad phases were built.
+    /// or end (sampled around both poses) has the limb among its grid candidates, and at every
+    /// new window no material point near the limb moves farther over the window than the
+    /// travel the grid was grown by; returns how many broad phases were built.
     fn windows(limb: Limb) -> usize {
         let (h, reach) = (1.0 / 600.0, 0.008);
         let body: Arc<dyn KinematicBody> = Arc::new(limb);
@@ -285,7 +286,34 @@ mod tests {
         for k in 0..60 {
             let (t0, t1) = (k as f64 * h, (k + 1) as f64 * h);
             c.set_time(t0, t1, reach);
-            builds += usize::from(c.window != last);
+            if c.window != last
+                && let Some(w) = c.window
+            {
+                builds += 1;
+                // Material points within the travel bound's extent of the window's start pose,
+                // carried rigidly to each substep end in the window.
+                body.parts_at(w.from, &mut parts);
+                let start = parts[0];
+                let bound = c.grown[0].travel * (1.0 + 1e-9);
+                let mut points = Vec::new();
+                while points.len() < 200 {
+                    let mid = start.shape.a.lerp(start.shape.b, 0.5 + 0.7 * rand(&mut s));
+                    let p = mid + DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s)) * 0.1;
+                    if start.shape.signed_distance(p) <= reach + CELL {
+                        points.push(start.rotation.inverse() * (p - start.translation));
+                    }
+                }
+                let mut t = w.from + h;
+                while t <= w.until + 1e-12 {
+                    body.parts_at(t, &mut parts);
+                    for &local in &points {
+                        let moved = (parts[0].rotation * local + parts[0].translation)
+                            - (start.rotation * local + start.translation);
+                        assert!(moved.length() <= bound, "{moved} over {bound} at {t} s");
+                    }
+                    t += h;
+                }
+            }
             last = c.window;
             for t in [t0, t1] {
                 body.parts_at(t, &mut parts);
