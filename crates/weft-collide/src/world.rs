@@ -22,6 +22,7 @@ use crate::friction::Friction;
 use crate::reach::{Bounds, Reach};
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
+use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::deforming::MeshAnimation;
 
 /// What the last substep's contacts did.
@@ -63,6 +64,10 @@ pub struct CollisionWorld {
     stats: ContactStats,
     /// Per chunk of [`CHUNK`] particles, the candidate lists of each triangle-mesh collider.
     mesh_lists: Vec<Vec<ChunkLists>>,
+    /// Per collider, the thickness its contact grid was last sought for and the grid of a
+    /// still triangle mesh, built at its first contact for the largest thickness (`None`:
+    /// not a still mesh, or one too large for a grid).
+    mesh_grids: Vec<(f64, Option<Arc<ContactGrid>>)>,
     /// Triangle meshes go through parry's f32 queries, as before the f64 mesh path (kept
     /// for comparisons).
     parry_meshes: bool,
@@ -91,6 +96,7 @@ impl CollisionWorld {
             fresh: true,
             stats: ContactStats::default(),
             mesh_lists: Vec::new(),
+            mesh_grids: Vec::new(),
             parry_meshes: false,
         };
         world.sync_thickness(solver);
@@ -105,6 +111,7 @@ impl CollisionWorld {
         }
         self.max_thickness = self.thickness.iter().copied().fold(0.0, f64::max);
         self.mesh_lists.clear();
+        self.mesh_grids.clear();
         if let Some(sc) = &mut self.self_collision {
             sc.invalidate();
         }
@@ -282,6 +289,25 @@ impl CollisionWorld {
         );
     }
 
+    /// Builds the contact grid of every still triangle mesh of ours that has none for the
+    /// largest thickness (a mesh too large for one keeps the per-particle lists).
+    fn build_grids(&mut self, own: &[bool]) {
+        if self.mesh_grids.len() != self.colliders.len() {
+            self.mesh_grids = vec![(0.0, None); self.colliders.len()];
+        }
+        let reach = self.max_thickness;
+        for ((c, &own), (sought, grid)) in self.colliders.iter().zip(own).zip(&mut self.mesh_grids)
+        {
+            if own && !c.is_deforming() && *sought < reach {
+                *sought = reach;
+                *grid = c
+                    .mesh()
+                    .and_then(|m| ContactGrid::new(m, reach))
+                    .map(Arc::new);
+            }
+        }
+    }
+
     /// Pushes particles out of colliders to surface + thickness, with Coulomb friction. In
     /// parallel over fixed chunks of particles; each particle meets the colliders in their
     /// order. Triangle meshes go through each particle's candidate list (`trimesh/`), held
@@ -300,11 +326,13 @@ impl CollisionWorld {
                 .map(|k| vec![ChunkLists::new(CHUNK.min(p.len() - k * CHUNK)); meshes])
                 .collect();
         }
+        self.build_grids(&own);
         let frames: Vec<Option<MeshFrame<'_>>> = self
             .colliders
             .iter()
             .zip(&own)
-            .map(|(c, &own)| {
+            .zip(&self.mesh_grids)
+            .map(|((c, &own), (_, grid))| {
                 let geometry = c.mesh().filter(|_| own)?;
                 let (pose, prev_pose, still) = c.poses64();
                 let identity = |q: &crate::analytic::WorldPose| {
@@ -318,6 +346,7 @@ impl CollisionWorld {
                     still,
                     fresh,
                     friction: c.friction(),
+                    grid: grid.as_deref(),
                 })
             })
             .collect();

@@ -8,6 +8,7 @@ pub(crate) mod bvh;
 pub(crate) mod candidates;
 pub(crate) mod ccd;
 pub(crate) mod closest;
+pub(crate) mod contact_grid;
 pub(crate) mod deforming;
 pub(crate) mod normals;
 #[cfg(test)]
@@ -22,14 +23,11 @@ use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
 use normals::{Topology, face_normal, pseudo_normal};
 
-/// One triangle at the end of the substep: its f32 planes, corners and unit normal (what the
-/// contact loops read), in three adjacent cache lines: the bound first, then the corners that
-/// a triangle passing it needs.
+/// One triangle at the end of the substep: its corners and unit normal (what the contact
+/// loops read after a triangle passes its [`Planes`] bound), in adjacent cache lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
+#[repr(C, align(32))]
 pub(crate) struct Face {
-    /// The planes of the cheap distance bound.
-    pub planes: Planes,
     /// Corners a, b, c (m, the collider's frame).
     pub corners: [DVec3; 3],
     /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
@@ -37,13 +35,9 @@ pub(crate) struct Face {
 }
 
 impl Face {
-    fn new(corners: [DVec3; 3]) -> Self {
+    fn new(corners: [DVec3; 3]) -> (Self, Planes) {
         let normal = face_normal(corners[0], corners[1], corners[2]);
-        Self {
-            planes: Planes::new(corners, normal),
-            corners,
-            normal,
-        }
+        (Self { corners, normal }, Planes::new(corners, normal))
     }
 }
 
@@ -117,6 +111,8 @@ pub(crate) struct MeshGeometry {
     pub end: Vec<DVec3>,
     /// Faces at the end of the substep, in storage order.
     pub faces: Vec<Face>,
+    /// Their bounding planes, apart (a scan reads only these for most triangles).
+    pub planes: Vec<Planes>,
     /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
     pub margin: f32,
     /// The largest vertex coordinate, in absolute value (m).
@@ -151,6 +147,7 @@ impl MeshGeometry {
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         let mut geometry = Self {
             faces: Vec::new(),
+            planes: Vec::new(),
             margin: 0.0,
             extent: 0.0,
             triangles,
@@ -163,7 +160,7 @@ impl MeshGeometry {
             travel_before: 0.0,
             moving: false,
         };
-        geometry.faces = geometry.compute_faces();
+        (geometry.faces, geometry.planes) = geometry.compute_faces();
         geometry.set_margin(extent);
         geometry
     }
@@ -181,13 +178,13 @@ impl MeshGeometry {
         (1e-6 * (self.extent + x.abs().max_element() + 1.0)) as f32
     }
 
-    fn compute_faces(&self) -> Vec<Face> {
+    fn compute_faces(&self) -> (Vec<Face>, Vec<Planes>) {
         let end = &self.end;
         self.triangles
             .par_iter()
             .with_min_len(1024)
             .map(|t| Face::new(t.map(|i| end[i as usize])))
-            .collect()
+            .unzip()
     }
 
     /// Whether the mesh is closed and consistently wound.
@@ -213,7 +210,7 @@ impl MeshGeometry {
         if !self.moving {
             return;
         }
-        self.faces = self.compute_faces();
+        (self.faces, self.planes) = self.compute_faces();
         let extent = self
             .end
             .iter()
@@ -283,7 +280,7 @@ impl MeshGeometry {
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
         let (t, d2, c) = self.bvh.nearest(x, limit, |t, bound| {
             // Cheap reject: a lower bound no nearer than the best so far.
-            if f64::from(self.faces[t].planes.distance_squared_bound(x32, margin)) >= bound {
+            if f64::from(self.planes[t].distance_squared_bound(x32, margin)) >= bound {
                 return None;
             }
             let [a, b, cc] = faces[t].corners;
@@ -311,7 +308,7 @@ impl MeshGeometry {
         let mut limit = if beyond { f64::INFINITY } else { r2 };
         self.bvh.branch_and_bound(x, limit, |t| {
             // Cheap reject on the planes (one cache line) before the corners.
-            if f64::from(self.faces[t].planes.distance_squared_bound(x32, margin)) > limit {
+            if f64::from(self.planes[t].distance_squared_bound(x32, margin)) > limit {
                 return limit;
             }
             let [a, b, c] = faces[t].corners;

@@ -22,7 +22,7 @@ pub(super) fn bumpy_sphere() -> TriangleMesh {
 }
 
 /// An open mesh: a bumpy height field of 12 × 12 cells.
-fn bumpy_sheet() -> TriangleMesh {
+pub(super) fn bumpy_sheet() -> TriangleMesh {
     let n = 12u32;
     let mut rng = Rng(5);
     let mut vertices = Vec::new();
