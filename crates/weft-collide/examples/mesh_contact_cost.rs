@@ -4,8 +4,9 @@
 //! stepped after 30 frames from the same state, median over `REPS` frames.
 //!
 //! - static: a 128² cloth on `icosphere_drop`'s 20,480-triangle sphere mesh and the ground,
-//!   against the bare solve of the same state (fused, no hook), the ground alone, and the
-//!   cloth on `sphere_drop`'s analytic sphere of the same size and the ground;
+//!   against the bare solve of the same state (fused, no hook), the ground alone, the mesh
+//!   alone, and the cloth on `sphere_drop`'s analytic sphere of the same size, with the
+//!   ground and alone;
 //! - deforming: a 90² cloth on `breathing_drop`'s 5,120-triangle deforming ball, against its
 //!   bare solve.
 //!
@@ -20,8 +21,10 @@
 
 use std::time::Instant;
 
-use weft_collide::CollisionWorld;
-use weft_collide::scenarios::{breathing_drop, ground, icosphere_drop, sphere_drop};
+use weft_collide::scenarios::{
+    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, ground, icosphere_drop, sphere_drop,
+};
+use weft_collide::{ColliderDesc, CollisionWorld, Friction, ShapeDesc, TriangleMesh};
 use weft_solver::{Method, Solver};
 
 /// Nanoseconds on a CPU, summed over the process's threads, if the system tells.
@@ -123,8 +126,31 @@ fn main() {
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
     let mut ground_world = CollisionWorld::new(&solver);
     ground_world
-        .add_collider(&ground(-weft_collide::scenarios::SPHERE_RADIUS))
+        .add_collider(&ground(-SPHERE_RADIUS))
         .expect("ground");
+    // Each scene's own collider alone (as the scenarios build them): the mesh, the sphere.
+    // Stepped once on a copy of the state, so that the grid and the particles' contact state
+    // exist before timing.
+    let alone = |shape: ShapeDesc, solver: &Solver| {
+        let mut w = CollisionWorld::new(solver);
+        w.add_collider(&ColliderDesc::new(shape).with_friction(Friction::new(0.8, 0.6)))
+            .expect("collider");
+        solver.clone().step_with(&mut w).expect("stable");
+        w
+    };
+    let mesh_alone = alone(
+        ShapeDesc::TriMesh(TriangleMesh::icosphere(
+            SPHERE_RADIUS,
+            ICOSPHERE_SUBDIVISIONS,
+        )),
+        &solver,
+    );
+    let sphere_alone = alone(
+        ShapeDesc::Sphere {
+            radius: SPHERE_RADIUS,
+        },
+        &sphere_solver,
+    );
     println!(
         "solver kernel path: {} (WEFT_SIMD=avx512|avx2|scalar forces one)",
         solver.simd_path()
@@ -133,13 +159,17 @@ fn main() {
     let solve = bare(reps, &solver);
     let ground_only = with(reps, &solver, &ground_world);
     let mesh = with(reps, &solver, &mesh_world);
+    let mesh_only = with(reps, &solver, &mesh_alone);
     let sphere_solve = bare(reps, &sphere_solver);
     let sphere = with(reps, &sphere_solver, &sphere_world);
+    let sphere_only = with(reps, &sphere_solver, &sphere_alone);
     show("bare solve (mesh scene's state)", solve);
     show("ground only", ground_only);
     show("20,480-triangle mesh + ground", mesh);
+    show("20,480-triangle mesh alone", mesh_only);
     show("bare solve (sphere scene's state)", sphere_solve);
     show("analytic sphere + ground", sphere);
+    show("analytic sphere alone", sphere_only);
     println!("  frame with mesh / bare solve: {}", ratio(mesh, solve));
     println!("  mesh frame / sphere frame:    {}", ratio(mesh, sphere));
     let (solver, world) = in_contact(breathing_drop(Method::Xpbd, 90).expect("scene"));

@@ -15,6 +15,7 @@ use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 use weft_solver::{Contacts, ParticleContacts, Particles, Solver, SubstepContext, SubstepHook};
 
+use crate::analytic::WorldPose;
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
@@ -24,6 +25,7 @@ use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfColli
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::deforming::MeshAnimation;
+use crate::trimesh::grid_contacts::GridParticles;
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -64,10 +66,10 @@ pub struct CollisionWorld {
     stats: ContactStats,
     /// Per chunk of [`CHUNK`] particles, the candidate lists of each triangle-mesh collider.
     mesh_lists: Vec<Vec<ChunkLists>>,
-    /// Per collider, the thickness its contact grid was last sought for and the grid of a
-    /// still triangle mesh, built at its first contact for the largest thickness (`None`:
-    /// not a still mesh, or one too large for a grid).
-    mesh_grids: Vec<(f64, Option<Arc<ContactGrid>>)>,
+    /// Per collider, the thickness its contact grid was last sought for, and for a still
+    /// triangle mesh its grid (built at the first substep for the largest thickness) with the
+    /// particles' state on the grid path (`None`: not a still mesh, or too large for a grid).
+    mesh_grids: Vec<MeshGrid>,
     /// Triangle meshes go through parry's f32 queries, as before the f64 mesh path (kept
     /// for comparisons).
     parry_meshes: bool,
@@ -186,6 +188,7 @@ impl CollisionWorld {
     pub fn set_parry_meshes(&mut self, on: bool) {
         self.parry_meshes = on;
         self.mesh_lists.clear();
+        self.mesh_grids.clear();
     }
 
     /// Candidate lists built so far for triangle-mesh contacts (all mesh colliders).
@@ -291,21 +294,27 @@ impl CollisionWorld {
 
     /// Builds the contact grid of every still triangle mesh of ours that has none for the
     /// largest thickness (a mesh too large for one keeps the per-particle lists).
-    fn build_grids(&mut self, own: &[bool]) {
+    fn build_grids(&mut self) {
         if self.mesh_grids.len() != self.colliders.len() {
             self.mesh_grids = vec![(0.0, None); self.colliders.len()];
         }
-        let reach = self.max_thickness;
-        for ((c, &own), (sought, grid)) in self.colliders.iter().zip(own).zip(&mut self.mesh_grids)
-        {
-            if own && !c.is_deforming() && *sought < reach {
+        let (reach, n) = (self.max_thickness, self.thickness.len());
+        for (k, c) in self.colliders.iter().enumerate() {
+            let (sought, grid) = &mut self.mesh_grids[k];
+            let still_mesh = c.mesh().is_some() && !self.parry_meshes && !c.is_deforming();
+            if still_mesh && *sought < reach {
                 *sought = reach;
                 *grid = c
                     .mesh()
                     .and_then(|m| ContactGrid::new(m, reach))
-                    .map(Arc::new);
+                    .map(|g| (Arc::new(g), GridParticles::new(n)));
             }
         }
+    }
+
+    /// Collider `k`'s contact grid and its particles' state, if it has one.
+    fn grid(&self, k: usize) -> Option<GridRef<'_>> {
+        grid_at(&self.mesh_grids, k)
     }
 
     /// Pushes particles out of colliders to surface + thickness, with Coulomb friction. In
@@ -326,28 +335,14 @@ impl CollisionWorld {
                 .map(|k| vec![ChunkLists::new(CHUNK.min(p.len() - k * CHUNK)); meshes])
                 .collect();
         }
-        self.build_grids(&own);
-        let frames: Vec<Option<MeshFrame<'_>>> = self
+        let frames: Vec<Option<(MeshFrame<'_>, Option<GridRef<'_>>)>> = self
             .colliders
             .iter()
             .zip(&own)
-            .zip(&self.mesh_grids)
-            .map(|((c, &own), (_, grid))| {
-                let geometry = c.mesh().filter(|_| own)?;
-                let (pose, prev_pose, still) = c.poses64();
-                let identity = |q: &crate::analytic::WorldPose| {
-                    q.translation == DVec3::ZERO && q.rotation == DQuat::IDENTITY
-                };
-                Some(MeshFrame {
-                    geometry,
-                    pose,
-                    prev_pose,
-                    identity: identity(pose) && identity(prev_pose),
-                    still,
-                    fresh,
-                    friction: c.friction(),
-                    grid: grid.as_deref(),
-                })
+            .enumerate()
+            .map(|(k, (c, &own))| {
+                let frame = mesh_frame(c, fresh).filter(|_| own)?;
+                Some((frame, grid_at(&self.mesh_grids, k)))
             })
             .collect();
         let parry = self.parry_meshes;
@@ -367,8 +362,15 @@ impl CollisionWorld {
                     }
                     let mut slot = 0;
                     for ((c, reach), frame) in colliders.iter().zip(reach).zip(&frames) {
-                        if let Some(frame) = frame {
-                            let o = frame.resolve(&mut lists[slot], j, prev[i], x, thickness[i]);
+                        if let Some((frame, grid)) = frame {
+                            let o = match grid {
+                                Some(grid) => {
+                                    frame.resolve_in_grid(*grid, i, prev[i], x, thickness[i])
+                                }
+                                None => {
+                                    frame.resolve(&mut lists[slot], j, prev[i], x, thickness[i])
+                                }
+                            };
                             slot += 1;
                             contacts += o.contacts;
                             deepest = deepest.max(o.depth);
@@ -388,6 +390,37 @@ impl CollisionWorld {
         (contacts, swept)
     }
 }
+
+/// Collider `k`'s contact grid and its particles' state in `grids`, if it has one.
+fn grid_at(grids: &[MeshGrid], k: usize) -> Option<GridRef<'_>> {
+    grids
+        .get(k)
+        .and_then(|(_, g)| g.as_ref())
+        .map(|(grid, state)| (&**grid, state))
+}
+
+/// Triangle-mesh collider `c` as every particle sees it in this projection.
+fn mesh_frame(c: &Collider, fresh: bool) -> Option<MeshFrame<'_>> {
+    let geometry = c.mesh()?;
+    let (pose, prev_pose, still) = c.poses64();
+    let identity = |q: &WorldPose| q.translation == DVec3::ZERO && q.rotation == DQuat::IDENTITY;
+    Some(MeshFrame {
+        geometry,
+        pose,
+        prev_pose,
+        identity: identity(pose) && identity(prev_pose),
+        still,
+        fresh,
+        friction: c.friction(),
+    })
+}
+
+/// A collider's contact-grid slot: the thickness a grid was last sought for, and the grid of a
+/// still triangle mesh with its particles' state on the grid path.
+type MeshGrid = (f64, Option<(Arc<ContactGrid>, GridParticles)>);
+
+/// A still mesh's contact grid and its particles' state, as the grid path takes them.
+type GridRef<'a> = (&'a ContactGrid, &'a GridParticles);
 
 /// The particles' positions to move, with their previous positions and inverse masses to read.
 pub(crate) fn moving_views(p: &mut Particles) -> (&mut [DVec3], &[DVec3], &[f64]) {
@@ -527,6 +560,7 @@ impl SubstepHook for CollisionWorld {
     }
 
     fn begin_substep(&mut self, ctx: &SubstepContext, _particles: &Particles) {
+        self.build_grids();
         let t0 = ctx.time - ctx.h;
         let margin = self.search_margin();
         for ((c, b), reach) in (self.colliders.iter_mut())
@@ -554,10 +588,13 @@ impl SubstepHook for CollisionWorld {
     fn particle_contacts(&self) -> Option<&dyn ParticleContacts> {
         // Kinematic bodies run a pass of their own (`BodyCollider::contact`): a world with one
         // keeps the general loop.
+        // Triangle meshes join when they have a contact grid (whose particle state is kept
+        // per particle); the per-particle lists of the others are kept per chunk.
         let per_particle = self.self_collision.is_none()
             && self.bodies.is_empty()
             && !self.colliders.is_empty()
-            && self.colliders.iter().all(|c| c.mesh().is_none());
+            && (self.colliders.iter().enumerate())
+                .all(|(k, c)| c.mesh().is_none() || self.grid(k).is_some());
         per_particle.then_some(self as &dyn ParticleContacts)
     }
 
@@ -565,8 +602,10 @@ impl SubstepHook for CollisionWorld {
     fn fused_pass(&mut self, fresh: bool, totals: Contacts) -> usize {
         if fresh {
             self.fresh = false;
-            self.stats.swept = totals.swept;
+            self.stats.swept = 0;
         }
+        // A mesh sweeps the path since its last projection in every pass.
+        self.stats.swept += totals.swept;
         self.stats.collider_contacts = totals.contacts;
         self.stats.self_contacts = 0;
         self.stats.max_depth = self.stats.max_depth.max(totals.depth);
@@ -623,11 +662,18 @@ impl ParticleContacts for CollisionWorld {
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let (parry, r) = (self.parry_meshes, self.thickness[i]);
         let mut out = Contacts::default();
+        // Meshes (on their grids here) sweep in their own contacts.
+        let mesh = |k: usize| self.colliders[k].mesh().is_some();
         if fresh {
-            out.swept = sweep_one(&self.colliders, &self.bounds, |_| false, parry, prev, x, r);
+            out.swept = sweep_one(&self.colliders, &self.bounds, mesh, parry, prev, x, r);
         }
-        for (c, reach) in self.colliders.iter().zip(&self.reach) {
-            if reach.may_touch(*x, r) {
+        for (k, (c, reach)) in self.colliders.iter().zip(&self.reach).enumerate() {
+            if let (Some(frame), Some(grid)) = (mesh_frame(c, fresh), self.grid(k)) {
+                let o = frame.resolve_in_grid(grid, i, prev, x, r);
+                out.contacts += o.contacts;
+                out.depth = out.depth.max(o.depth);
+                out.swept += o.swept;
+            } else if reach.may_touch(*x, r) {
                 let (n, depth) = resolve_one(c, parry, prev, x, r);
                 out.contacts += n;
                 out.depth = out.depth.max(depth);

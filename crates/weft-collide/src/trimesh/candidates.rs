@@ -15,9 +15,7 @@
 
 use glam::DVec3;
 
-use super::closest::{Closest, Feature};
-use super::contact_grid::{ContactGrid, Side};
-use super::normals::NONE;
+use super::closest::Closest;
 use super::{MeshGeometry, MeshPoint};
 #[cfg(test)]
 #[path = "candidates_tests.rs"]
@@ -41,9 +39,6 @@ const NEAR: usize = 16;
 
 /// Triangles whose bounds a scan computes together.
 const SCAN_BLOCK: usize = 32;
-
-/// Triangles a particle's contact walks across from the one it touched last, at most.
-const WALK: usize = 4;
 
 /// The candidate lists of one mesh collider for one chunk of particles.
 #[derive(Clone, Debug, Default)]
@@ -72,8 +67,6 @@ pub(crate) struct ChunkLists {
     spare: Vec<u32>,
     /// Lists built so far.
     pub builds: u64,
-    /// Whether each particle was inside the closed mesh when last known (grid path).
-    side: Vec<Option<bool>>,
 }
 
 impl ChunkLists {
@@ -91,7 +84,6 @@ impl ChunkLists {
             live: 0,
             spare: Vec::new(),
             builds: 0,
-            side: vec![None; n],
         }
     }
 
@@ -134,8 +126,6 @@ pub(crate) struct MeshFrame<'a> {
     pub fresh: bool,
     /// Coulomb friction of the collider.
     pub friction: Friction,
-    /// The still mesh's contact grid, if it has one (else the per-particle lists).
-    pub grid: Option<&'a ContactGrid>,
 }
 
 /// What one particle's contacts with one mesh did.
@@ -150,7 +140,7 @@ pub(crate) struct Outcome {
 }
 
 impl MeshFrame<'_> {
-    fn to_local(&self, pose: &WorldPose, x: DVec3) -> DVec3 {
+    pub(super) fn to_local(&self, pose: &WorldPose, x: DVec3) -> DVec3 {
         if self.identity {
             x
         } else {
@@ -158,7 +148,7 @@ impl MeshFrame<'_> {
         }
     }
 
-    fn to_world_vector(&self, v: DVec3) -> DVec3 {
+    pub(super) fn to_world_vector(&self, v: DVec3) -> DVec3 {
         if self.identity {
             v
         } else {
@@ -295,9 +285,6 @@ impl MeshFrame<'_> {
         x: &mut DVec3,
         r: f64,
     ) -> Outcome {
-        if let Some(grid) = self.grid {
-            return self.resolve_in_grid(grid, lists, j, prev, x, r);
-        }
         let g = self.geometry;
         let mut out = Outcome::default();
         let mut xl = self.to_local(self.pose, *x);
@@ -382,175 +369,15 @@ impl MeshFrame<'_> {
         out
     }
 
-    /// [`Self::resolve`] through a still mesh's contact grid: the particle's cell lists every
-    /// triangle within r of it, so nothing is kept per particle but its path's end, the
-    /// triangle it touched last and, for a closed mesh, the side it was last known on.
-    ///
-    /// Where no triangle is within r, the side is the cell's when the surface does not pass
-    /// through the cell, else the one last known: the particle cannot have changed sides
-    /// unseen, since a crossing ends within r of the surface unless its path is r/2 or longer,
-    /// and such paths are swept.
-    fn resolve_in_grid(
-        &self,
-        grid: &ContactGrid,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        r: f64,
-    ) -> Outcome {
-        let g = self.geometry;
-        let mut out = Outcome::default();
-        let mut xl = self.to_local(self.pose, *x);
-        let from = if self.fresh {
-            self.to_local(self.prev_pose, prev)
-        } else {
-            lists.last[j]
-        };
-        // Continuous: a path shorter than r/2 cannot cross the surface from r away, where the
-        // last projection left the particle; a longer one is swept through the BVH.
-        let short = 0.5 * r;
-        if (xl - from).length_squared() > short * short
-            && let Some((t, n)) = g.sweep(from, xl)
-        {
-            let to = from + (xl - from) * t + n * r;
-            self.move_to(&mut xl, x, to);
-            lists.side[j] = Some(false);
-            out.swept += 1;
-        }
-        // The triangle touched last, or one a few edges across from it towards the particle,
-        // settles the contact alone where its face is nearest and no triangle in front of its
-        // plane is near (see `ContactGrid::clearance`).
-        let mut t = lists.hint[j] as usize;
-        for _ in 0..WALK {
-            let Some(f) = g.faces.get(t) else { break };
-            let [a, b, c] = f.corners;
-            let q = closest_on_triangle(xl, a, b, c);
-            let k = match q.feature {
-                Feature::Edge(k) | Feature::Vertex(k) => k,
-                Feature::Face => {
-                    let clear = grid.clearance(t);
-                    let delta = xl - q.point;
-                    let d2 = delta.length_squared();
-                    let d = d2.sqrt();
-                    if delta.dot(f.normal) <= 0.0 || d <= 1e-12 || d.max(r) + r > clear {
-                        break;
-                    }
-                    lists.side[j] = Some(false);
-                    lists.hint[j] = t as u32;
-                    if d < r {
-                        let hit = self.contact((d2, t, q), xl, from);
-                        if let Some((depth, slip)) = self.push(&hit, &mut xl, x, prev, r) {
-                            out.contacts += 1;
-                            out.depth = depth;
-                            // Pushed to r in front of the plane, then slipped along it:
-                            // still clear if within the clearance less r.
-                            if 2.0 * r + slip > clear {
-                                return self
-                                    .rounds_in_grid(grid, lists, j, prev, x, xl, from, r, out);
-                            }
-                        }
-                    }
-                    lists.last[j] = xl;
-                    return out;
-                }
-            };
-            // Across the edge (from a corner, across its first edge) towards the particle.
-            match g.topology.adjacent[t][usize::from(k)] {
-                NONE => break,
-                u => t = u as usize,
-            }
-        }
-        self.rounds_in_grid(grid, lists, j, prev, x, xl, from, r, out)
-    }
-
-    /// The contact rounds of [`Self::resolve_in_grid`] through the particle's cell, from
-    /// local position `xl` on the path from `from`, adding to `out`.
-    #[allow(clippy::too_many_arguments)]
-    fn rounds_in_grid(
-        &self,
-        grid: &ContactGrid,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        mut xl: DVec3,
-        from: DVec3,
-        r: f64,
-        mut out: Outcome,
-    ) -> Outcome {
-        let g = self.geometry;
-        let mut cell = grid.cell(xl);
-        for _ in 0..ROUNDS {
-            let list = cell.map_or(&[][..], |c| grid.list(c));
-            let side = grid.side(cell);
-            if list.is_empty() && side == Side::Outside {
-                lists.side[j] = Some(false);
-                break;
-            }
-            let scan = self.scan(list, lists.hint[j], xl, r);
-            let scanned_at = xl;
-            let hit = match scan.best {
-                Some(best) => self.contact(best, xl, from),
-                None => {
-                    let inside = g.closed()
-                        && match side {
-                            Side::Outside => false,
-                            Side::Inside => true,
-                            Side::Surface => lists.side[j].unwrap_or_else(|| {
-                                g.nearest(xl, f64::INFINITY)
-                                    .is_some_and(|p| p.distance < 0.0)
-                            }),
-                        };
-                    lists.side[j] = Some(inside);
-                    if !inside {
-                        // The nearest-looking triangle, where the next contact starts.
-                        lists.hint[j] = scan.least;
-                        break;
-                    }
-                    // Deep inside a closed mesh: out through the nearest surface.
-                    match g.nearest(xl, f64::INFINITY) {
-                        Some(p) if p.distance < r => p,
-                        _ => break,
-                    }
-                }
-            };
-            // Within r of the surface or pushed out of it: outside from here.
-            lists.side[j] = Some(false);
-            lists.hint[j] = hit.triangle as u32;
-            let Some((depth, slip)) = self.push(&hit, &mut xl, x, prev, r) else {
-                break;
-            };
-            out.contacts += 1;
-            out.depth = out.depth.max(depth);
-            let now = grid.cell(xl);
-            // In another cell, triangles this one did not list may be within r.
-            let mut again =
-                now != cell || !scan.along_closest(&hit) || scan.second.sqrt() - depth - slip < r;
-            if again && now == cell && scan.along_closest(&hit) {
-                let moved = (xl - scanned_at).length();
-                if scan.others.sqrt() - moved >= r {
-                    again = self.may_touch_again(&scan, hit.triangle, xl, moved, r);
-                }
-            }
-            if !again {
-                break;
-            }
-            cell = now;
-        }
-        lists.last[j] = xl;
-        out
-    }
-
     /// Moves the particle to `to` (local), its world position `x` along.
-    fn move_to(&self, xl: &mut DVec3, x: &mut DVec3, to: DVec3) {
+    pub(super) fn move_to(&self, xl: &mut DVec3, x: &mut DVec3, to: DVec3) {
         *x += self.to_world_vector(to - *xl);
         *xl = to;
     }
 
     /// The nearest of `list`'s triangles (and `hint`, tested first: it tightens the search)
     /// within r of `xl`, with bounds on the others.
-    fn scan(&self, list: &[u32], hint: u32, xl: DVec3, r: f64) -> Scan {
+    pub(super) fn scan(&self, list: &[u32], hint: u32, xl: DVec3, r: f64) -> Scan {
         let g = self.geometry;
         let mut best: Option<(f64, usize, Closest)> = None;
         let mut bound = r * r;
@@ -636,7 +463,12 @@ impl MeshFrame<'_> {
 
     /// The contact at the scan's nearest triangle (`d2`, `t`, `q`): signed on a closed mesh;
     /// on an open surface, a particle on it goes back to the side its path came from.
-    fn contact(&self, (d2, t, q): (f64, usize, Closest), xl: DVec3, from: DVec3) -> MeshPoint {
+    pub(super) fn contact(
+        &self,
+        (d2, t, q): (f64, usize, Closest),
+        xl: DVec3,
+        from: DVec3,
+    ) -> MeshPoint {
         let g = self.geometry;
         let mut p = g.signed(xl, t, q, d2);
         if !g.closed() && d2 <= 1e-24 {
@@ -649,7 +481,7 @@ impl MeshFrame<'_> {
     /// Pushes the particle (local `xl`, world `x`) out to distance r along `hit`'s normal,
     /// then slides it back by Coulomb friction against the surface's motion; returns the
     /// depth and the slip, or `None` if it was within rounding of r already.
-    fn push(
+    pub(super) fn push(
         &self,
         hit: &MeshPoint,
         xl: &mut DVec3,
@@ -682,7 +514,14 @@ impl MeshFrame<'_> {
     /// Whether a followed triangle other than `left` may be within r of `xl`, the particle
     /// having moved `moved` since the scan: a bound at the scan less the move, then a bound
     /// here, then the distance.
-    fn may_touch_again(&self, scan: &Scan, left: usize, xl: DVec3, moved: f64, r: f64) -> bool {
+    pub(super) fn may_touch_again(
+        &self,
+        scan: &Scan,
+        left: usize,
+        xl: DVec3,
+        moved: f64,
+        r: f64,
+    ) -> bool {
         let g = self.geometry;
         let x32 = xl.as_vec3();
         scan.near[..scan.n_near].iter().any(|&(t, was)| {
@@ -699,26 +538,26 @@ impl MeshFrame<'_> {
 }
 
 /// What one scan of a particle's candidates found.
-struct Scan {
+pub(super) struct Scan {
     /// The nearest triangle within r: squared distance, triangle, closest point.
-    best: Option<(f64, usize, Closest)>,
+    pub(super) best: Option<(f64, usize, Closest)>,
     /// The least lower bound on the others' squared distances.
-    second: f64,
+    pub(super) second: f64,
     /// The triangles within 2r (bound or distance) with that squared value, to follow
     /// after a push.
-    near: [(u32, f64); NEAR],
+    pub(super) near: [(u32, f64); NEAR],
     /// Entries of `near` in use.
-    n_near: usize,
+    pub(super) n_near: usize,
     /// The least squared bound of the triangles not followed (0 if too many to follow).
-    others: f64,
+    pub(super) others: f64,
     /// The triangle of least bound or distance (`u32::MAX` if none was scanned).
-    least: u32,
+    pub(super) least: u32,
 }
 
 impl Scan {
     /// Whether `hit` came from outside, along the closest direction (then the triangle left
     /// stays at distance r after the push).
-    fn along_closest(&self, hit: &MeshPoint) -> bool {
+    pub(super) fn along_closest(&self, hit: &MeshPoint) -> bool {
         self.best.is_some_and(|b| b.0 > 1e-24) && hit.distance > 0.0
     }
 }

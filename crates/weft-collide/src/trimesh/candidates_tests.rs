@@ -23,7 +23,6 @@ fn still_frame<'a>(g: &'a MeshGeometry, pose: &'a WorldPose, friction: Friction)
         still: true,
         fresh: true,
         friction,
-        grid: None,
     }
 }
 

@@ -12,6 +12,7 @@ use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
 use crate::trimesh::candidates::{ChunkLists, MeshFrame, ROUNDS};
 use crate::trimesh::closest::closest_on_triangle;
+use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
 
 fn geometry(m: &TriangleMesh) -> MeshGeometry {
@@ -148,11 +149,7 @@ fn clearance_is_a_lower_bound_on_the_distance_to_triangles_in_front() {
 }
 
 /// A mesh at rest at the origin, seen in a substep's first projection.
-fn frame<'a>(
-    g: &'a MeshGeometry,
-    pose: &'a WorldPose,
-    grid: Option<&'a ContactGrid>,
-) -> MeshFrame<'a> {
+fn frame<'a>(g: &'a MeshGeometry, pose: &'a WorldPose) -> MeshFrame<'a> {
     MeshFrame {
         geometry: g,
         pose,
@@ -161,7 +158,6 @@ fn frame<'a>(
         still: true,
         fresh: true,
         friction: Friction::new(0.8, 0.6),
-        grid,
     }
 }
 
@@ -176,7 +172,8 @@ fn grid_matches_lists(m: &TriangleMesh, seed: u64) {
     let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
     let r = 0.02;
     let grid = ContactGrid::new(&g, r).expect("small grid");
-    let (by_lists, by_grid) = (frame(&g, &pose, None), frame(&g, &pose, Some(&grid)));
+    let frame = frame(&g, &pose);
+    let state = GridParticles::new(600);
     let mut rng = Rng(seed);
     let n = 600;
     let start: Vec<DVec3> = (0..n)
@@ -189,7 +186,7 @@ fn grid_matches_lists(m: &TriangleMesh, seed: u64) {
         })
         .collect();
     let (mut a, mut b) = (start.clone(), start);
-    let (mut lists_a, mut lists_b) = (ChunkLists::new(n), ChunkLists::new(n));
+    let mut lists = ChunkLists::new(n);
     let (mut pushed, mut swept) = (0, 0);
     for step in 0..12 {
         for j in 0..n {
@@ -203,8 +200,8 @@ fn grid_matches_lists(m: &TriangleMesh, seed: u64) {
             let (pa, pb) = (a[j], b[j]);
             a[j] += drift;
             b[j] += drift;
-            let oa = by_lists.resolve(&mut lists_a, j, pa, &mut a[j], r);
-            let ob = by_grid.resolve(&mut lists_b, j, pb, &mut b[j], r);
+            let oa = frame.resolve(&mut lists, j, pa, &mut a[j], r);
+            let ob = frame.resolve_in_grid((&grid, &state), j, pb, &mut b[j], r);
             if ob.contacts < ROUNDS {
                 let d = (0..g.faces.len())
                     .map(|t| distance(&g, t, b[j]))

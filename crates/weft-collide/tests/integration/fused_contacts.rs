@@ -1,10 +1,11 @@
-//! Closed-form colliders inside the solver's fused frame (`SubstepHook::particle_contacts`)
-//! give the same bits, contact counts and statistics as the general loop, on 1 and 2 threads;
+//! Closed-form colliders and still triangle meshes (on their contact grids) inside the
+//! solver's fused frame (`SubstepHook::particle_contacts`) give the same bits, contact counts
+//! and statistics as the general loop, on 1 and 2 threads;
 //! and the general loop gives the same bits whether or not it leaves each substep's velocity
 //! update to the next integration pass (`SubstepHook::uses_velocities`).
 
-use weft_collide::scenarios::{ground, sphere_drop};
-use weft_collide::{ColliderDesc, CollisionWorld, ContactStats, Friction, ShapeDesc};
+use weft_collide::scenarios::{breathing_drop, ground, sphere_drop};
+use weft_collide::{ColliderDesc, CollisionWorld, ContactStats, Friction, ShapeDesc, TriangleMesh};
 use weft_solver::glam::{DQuat, DVec3};
 use weft_solver::{Method, Motion, Particles, Solver, SubstepContext, SubstepHook};
 
@@ -32,8 +33,9 @@ impl SubstepHook for General<'_> {
 
 /// The sphere drop at 40², plus a moving, tilted capsule and an oscillating box in the
 /// cloth's way (friction against moving surfaces, several closed-form shapes in order), with
-/// `substeps` × `iterations`.
-fn scene(substeps: u32, iterations: u32) -> (Solver, CollisionWorld) {
+/// `substeps` × `iterations`; with `meshes`, also a still, turned triangle-mesh ball and one
+/// moving as a rigid body.
+fn scene(substeps: u32, iterations: u32, meshes: bool) -> (Solver, CollisionWorld) {
     let (mut solver, mut world) = sphere_drop(Method::Xpbd, 40).expect("scenario");
     let mut settings = *solver.settings();
     settings.iterations = iterations;
@@ -65,6 +67,26 @@ fn scene(substeps: u32, iterations: u32) -> (Solver, CollisionWorld) {
             }),
         )
         .expect("box");
+    if meshes {
+        let ball = || ShapeDesc::TriMesh(TriangleMesh::icosphere(0.2, 3));
+        world
+            .add_collider(
+                &ColliderDesc::new(ball())
+                    .at(DVec3::new(0.3, 0.45, -0.35))
+                    .rotated(DQuat::from_rotation_y(0.7))
+                    .with_friction(Friction::new(0.6, 0.5)),
+            )
+            .expect("still mesh");
+        world
+            .add_collider(
+                &ColliderDesc::new(ball())
+                    .at(DVec3::new(-0.3, 0.35, 0.35))
+                    .moving(Motion::Linear {
+                        velocity: DVec3::new(0.1, 0.3, 0.0),
+                    }),
+            )
+            .expect("moving mesh");
+    }
     world.add_collider(&ground(-0.6)).expect("ground");
     (solver, world)
 }
@@ -83,21 +105,19 @@ enum Loop {
     Deferred,
 }
 
-fn run(threads: usize, (substeps, iterations): (u32, u32), how: Loop) -> Run {
+fn run(threads: usize, (substeps, iterations): (u32, u32), how: Loop, meshes: bool) -> Run {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("thread pool")
         .install(|| {
-            let (mut solver, mut world) = scene(substeps, iterations);
+            let (mut solver, mut world) = scene(substeps, iterations, meshes);
             // Global damping too: the deferred velocity update applies it.
             let mut forces = *solver.forces();
             forces.damping = 0.4;
             solver.set_forces(forces).expect("valid forces");
-            assert!(
-                world.particle_contacts().is_some(),
-                "closed-form shapes only"
-            );
+            // Meshes join once their grids are built (at the first substep).
+            assert_eq!(world.particle_contacts().is_some(), !meshes);
             let (mut contacts, mut stats) = (Vec::new(), Vec::new());
             for _ in 0..45 {
                 let step = match how {
@@ -107,6 +127,7 @@ fn run(threads: usize, (substeps, iterations): (u32, u32), how: Loop) -> Run {
                 };
                 contacts.push(step.expect("stable").contacts);
                 stats.push(world.stats());
+                assert!(world.particle_contacts().is_some(), "per-particle contacts");
             }
             let p = solver.particles();
             let bits = p
@@ -123,18 +144,19 @@ fn run(threads: usize, (substeps, iterations): (u32, u32), how: Loop) -> Run {
         })
 }
 
-#[test]
-fn closed_form_colliders_in_the_fused_frame_match_the_general_loop() {
+/// Fused runs on 1 and 2 threads and a deferred general run against the general loop, for
+/// several substep and iteration counts.
+fn fused_matches_general(meshes: bool) {
     // One substep per frame shows every substep's statistics (they are kept per substep).
     let mut swept = 0;
     for steps in [(10, 1), (4, 2), (1, 2)] {
-        let general = run(1, steps, Loop::General);
+        let general = run(1, steps, Loop::General, meshes);
         let touched: usize = general.1.iter().sum();
         assert!(touched > 2000, "the cloth reached the colliders: {touched}");
         assert!(general.2.iter().any(|s| s.max_depth > 0.0));
         swept += general.2.iter().map(|s| s.swept).sum::<usize>();
         for (threads, how) in [(1, Loop::Fused), (2, Loop::Fused), (2, Loop::Deferred)] {
-            let other = run(threads, steps, how);
+            let other = run(threads, steps, how, meshes);
             assert!(
                 other.0 == general.0,
                 "positions or velocities differ: {how:?}, {steps:?}, {threads} thread(s)"
@@ -150,7 +172,17 @@ fn closed_form_colliders_in_the_fused_frame_match_the_general_loop() {
 }
 
 #[test]
-fn meshes_and_self_collision_keep_the_general_loop() {
+fn closed_form_colliders_in_the_fused_frame_match_the_general_loop() {
+    fused_matches_general(false);
+}
+
+#[test]
+fn still_meshes_in_the_fused_frame_match_the_general_loop() {
+    fused_matches_general(true);
+}
+
+#[test]
+fn deforming_meshes_and_self_collision_keep_the_general_loop() {
     let (solver, mut world) = sphere_drop(Method::Xpbd, 8).expect("scenario");
     assert!(world.particle_contacts().is_some());
     world
@@ -159,5 +191,11 @@ fn meshes_and_self_collision_keep_the_general_loop() {
     assert!(
         world.particle_contacts().is_none(),
         "self-collision pairs particles"
+    );
+    let (mut solver, mut world) = breathing_drop(Method::Xpbd, 8).expect("scenario");
+    solver.step_with(&mut world).expect("stable");
+    assert!(
+        world.particle_contacts().is_none(),
+        "a deforming mesh keeps per-particle lists"
     );
 }

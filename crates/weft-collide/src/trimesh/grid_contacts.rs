@@ -1,0 +1,280 @@
+//! Contacts with a still triangle mesh through its contact grid (`contact_grid`), and the
+//! little each particle keeps for them: the triangle it touched last, the side of a closed
+//! mesh it was last known on, and where its last projection left it.
+
+use std::sync::atomic::{AtomicU8, AtomicU32, AtomicU64, Ordering::Relaxed};
+
+use glam::DVec3;
+
+use super::MeshPoint;
+use super::candidates::{MeshFrame, Outcome, ROUNDS};
+use super::closest::{Feature, closest_on_triangle};
+use super::contact_grid::{ContactGrid, Side};
+use super::normals::NONE;
+
+/// Triangles a particle's contact walks across from the one it touched last, at most.
+const WALK: usize = 4;
+
+/// Per-particle state of the grid path, indexed by global particle index. Relaxed atomics let
+/// the fused frame's domains update their own particles through a shared reference; a particle
+/// is only ever touched by the one task that owns it, so each holds what a plain array would.
+#[derive(Debug, Default)]
+pub(crate) struct GridParticles {
+    /// The triangle each particle touched (or came nearest to) last; `u32::MAX`: none.
+    hint: Vec<AtomicU32>,
+    /// 0: side unknown, 1: outside, 2: inside the closed mesh, when last known.
+    side: Vec<AtomicU8>,
+    /// Where the last projection left each particle (collider frame), as f64 bits.
+    last: Vec<[AtomicU64; 3]>,
+}
+
+impl GridParticles {
+    /// State for `n` particles: no triangle touched, side unknown.
+    pub fn new(n: usize) -> Self {
+        Self {
+            hint: (0..n).map(|_| AtomicU32::new(u32::MAX)).collect(),
+            side: (0..n).map(|_| AtomicU8::new(0)).collect(),
+            last: (0..n).map(|_| [0; 3].map(AtomicU64::new)).collect(),
+        }
+    }
+
+    fn hint(&self, i: usize) -> u32 {
+        self.hint[i].load(Relaxed)
+    }
+
+    fn set_hint(&self, i: usize, t: u32) {
+        self.hint[i].store(t, Relaxed);
+    }
+
+    fn side(&self, i: usize) -> Option<bool> {
+        match self.side[i].load(Relaxed) {
+            0 => None,
+            s => Some(s == 2),
+        }
+    }
+
+    fn set_side(&self, i: usize, inside: Option<bool>) {
+        self.side[i].store(inside.map_or(0, |b| 1 + u8::from(b)), Relaxed);
+    }
+
+    fn last(&self, i: usize) -> DVec3 {
+        let [x, y, z] = &self.last[i];
+        DVec3::new(
+            f64::from_bits(x.load(Relaxed)),
+            f64::from_bits(y.load(Relaxed)),
+            f64::from_bits(z.load(Relaxed)),
+        )
+    }
+
+    fn set_last(&self, i: usize, at: DVec3) {
+        for (slot, v) in self.last[i].iter().zip(at.to_array()) {
+            slot.store(v.to_bits(), Relaxed);
+        }
+    }
+}
+
+impl Clone for GridParticles {
+    fn clone(&self) -> Self {
+        let copy32 =
+            |v: &Vec<AtomicU32>| v.iter().map(|a| AtomicU32::new(a.load(Relaxed))).collect();
+        Self {
+            hint: copy32(&self.hint),
+            side: self
+                .side
+                .iter()
+                .map(|a| AtomicU8::new(a.load(Relaxed)))
+                .collect(),
+            last: self
+                .last
+                .iter()
+                .map(|l| [0, 1, 2].map(|k| AtomicU64::new(l[k].load(Relaxed))))
+                .collect(),
+        }
+    }
+}
+
+impl MeshFrame<'_> {
+    /// [`MeshFrame::resolve`] through a still mesh's contact grid (particle `i`, global): the particle's cell lists every
+    /// triangle within r of it, so nothing is kept per particle but its path's end, the
+    /// triangle it touched last and, for a closed mesh, the side it was last known on.
+    ///
+    /// Where no triangle is within r, the side is the cell's when the surface does not pass
+    /// through the cell, else the one last known: the particle cannot have changed sides
+    /// unseen, since a crossing ends within r of the surface unless its path is r/2 or longer,
+    /// and such paths are swept.
+    pub(crate) fn resolve_in_grid(
+        &self,
+        (grid, state): (&ContactGrid, &GridParticles),
+        i: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        r: f64,
+    ) -> Outcome {
+        let g = self.geometry;
+        let mut out = Outcome::default();
+        let mut xl = self.to_local(self.pose, *x);
+        let from = if self.fresh {
+            self.to_local(self.prev_pose, prev)
+        } else {
+            state.last(i)
+        };
+        // Continuous: a path shorter than r/2 cannot cross the surface from r away, where the
+        // last projection left the particle; a longer one is swept through the BVH.
+        let short = 0.5 * r;
+        if (xl - from).length_squared() > short * short
+            && let Some((t, n)) = g.sweep(from, xl)
+        {
+            let to = from + (xl - from) * t + n * r;
+            self.move_to(&mut xl, x, to);
+            state.set_side(i, Some(false));
+            out.swept += 1;
+        }
+        // The triangle touched last, or one a few edges across from it towards the particle,
+        // settles the contact alone where its face is nearest and no triangle in front of its
+        // plane is near (see `ContactGrid::clearance`).
+        let mut t = state.hint(i) as usize;
+        for _ in 0..WALK {
+            let Some(f) = g.faces.get(t) else { break };
+            let [a, b, c] = f.corners;
+            // Clear of everything without the closest point: r or more in front of the plane
+            // (so r from every triangle behind it), and near enough to a corner that the
+            // triangles in front are beyond r.
+            let (s, to_a) = (f.normal.dot(xl - a), (xl - a).length_squared());
+            if s >= r && {
+                let room = grid.clearance(t) - r;
+                room >= 0.0 && to_a <= room * room
+            } {
+                state.set_side(i, Some(false));
+                state.set_last(i, xl);
+                return out;
+            }
+            let q = closest_on_triangle(xl, a, b, c);
+            let k = match q.feature {
+                Feature::Edge(k) | Feature::Vertex(k) => k,
+                Feature::Face => {
+                    let clear = grid.clearance(t);
+                    let delta = xl - q.point;
+                    let d2 = delta.length_squared();
+                    let d = d2.sqrt();
+                    if delta.dot(f.normal) <= 0.0 || d <= 1e-12 || d.max(r) + r > clear {
+                        break;
+                    }
+                    state.set_side(i, Some(false));
+                    state.set_hint(i, t as u32);
+                    if d < r {
+                        // Outside, off the surface, nearest to the face: what `signed` gives.
+                        let hit = MeshPoint {
+                            triangle: t,
+                            closest: q,
+                            distance: d,
+                            normal: delta / d,
+                        };
+                        if let Some((depth, slip)) = self.push(&hit, &mut xl, x, prev, r) {
+                            out.contacts += 1;
+                            out.depth = depth;
+                            // Pushed to r in front of the plane, then slipped along it:
+                            // still clear if within the clearance less r.
+                            if 2.0 * r + slip > clear {
+                                return self.rounds_in_grid(
+                                    (grid, state),
+                                    i,
+                                    prev,
+                                    x,
+                                    xl,
+                                    from,
+                                    r,
+                                    out,
+                                );
+                            }
+                        }
+                    }
+                    state.set_last(i, xl);
+                    return out;
+                }
+            };
+            // Across the edge (from a corner, across its first edge) towards the particle.
+            match g.topology.adjacent[t][usize::from(k)] {
+                NONE => break,
+                u => t = u as usize,
+            }
+        }
+        self.rounds_in_grid((grid, state), i, prev, x, xl, from, r, out)
+    }
+
+    /// The contact rounds of [`Self::resolve_in_grid`] through the particle's cell, from
+    /// local position `xl` on the path from `from`, adding to `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn rounds_in_grid(
+        &self,
+        (grid, state): (&ContactGrid, &GridParticles),
+        i: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        mut xl: DVec3,
+        from: DVec3,
+        r: f64,
+        mut out: Outcome,
+    ) -> Outcome {
+        let g = self.geometry;
+        let mut cell = grid.cell(xl);
+        for _ in 0..ROUNDS {
+            let list = cell.map_or(&[][..], |c| grid.list(c));
+            let side = grid.side(cell);
+            if list.is_empty() && side == Side::Outside {
+                state.set_side(i, Some(false));
+                break;
+            }
+            let scan = self.scan(list, state.hint(i), xl, r);
+            let scanned_at = xl;
+            let hit = match scan.best {
+                Some(best) => self.contact(best, xl, from),
+                None => {
+                    let inside = g.closed()
+                        && match side {
+                            Side::Outside => false,
+                            Side::Inside => true,
+                            Side::Surface => state.side(i).unwrap_or_else(|| {
+                                g.nearest(xl, f64::INFINITY)
+                                    .is_some_and(|p| p.distance < 0.0)
+                            }),
+                        };
+                    state.set_side(i, Some(inside));
+                    if !inside {
+                        // The nearest-looking triangle, where the next contact starts.
+                        state.set_hint(i, scan.least);
+                        break;
+                    }
+                    // Deep inside a closed mesh: out through the nearest surface.
+                    match g.nearest(xl, f64::INFINITY) {
+                        Some(p) if p.distance < r => p,
+                        _ => break,
+                    }
+                }
+            };
+            // Within r of the surface or pushed out of it: outside from here.
+            state.set_side(i, Some(false));
+            state.set_hint(i, hit.triangle as u32);
+            let Some((depth, slip)) = self.push(&hit, &mut xl, x, prev, r) else {
+                break;
+            };
+            out.contacts += 1;
+            out.depth = out.depth.max(depth);
+            let now = grid.cell(xl);
+            // In another cell, triangles this one did not list may be within r.
+            let mut again =
+                now != cell || !scan.along_closest(&hit) || scan.second.sqrt() - depth - slip < r;
+            if again && now == cell && scan.along_closest(&hit) {
+                let moved = (xl - scanned_at).length();
+                if scan.others.sqrt() - moved >= r {
+                    again = self.may_touch_again(&scan, hit.triangle, xl, moved, r);
+                }
+            }
+            if !again {
+                break;
+            }
+            cell = now;
+        }
+        state.set_last(i, xl);
+        out
+    }
+}
