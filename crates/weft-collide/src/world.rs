@@ -13,7 +13,9 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
-use weft_solver::{Contacts, ParticleContacts, Particles, Solver, SubstepContext, SubstepHook};
+use weft_solver::{
+    Contacts, ParticleContacts, ParticleRun, Particles, Solver, SubstepContext, SubstepHook,
+};
 
 use crate::analytic::WorldPose;
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
@@ -660,16 +662,60 @@ impl SubstepHook for CollisionWorld {
 impl ParticleContacts for CollisionWorld {
     #[inline]
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
+        let frames = self.grid_frames(fresh);
+        self.resolve_particle(&frames, i, x, prev, fresh)
+    }
+
+    /// As the default, with each mesh's frame and grid looked up once per run.
+    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
+        let ParticleRun { start, x, prev, w } = run;
+        let frames = self.grid_frames(fresh);
+        let mut total = Contacts::default();
+        for (j, &wj) in w.iter().enumerate() {
+            if wj == 0.0 {
+                continue;
+            }
+            let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
+            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
+            total = total.merge(self.resolve_particle(&frames, start + j, &mut p, before, fresh));
+            for a in 0..3 {
+                x[a][j] = p[a];
+            }
+        }
+        total
+    }
+}
+
+impl CollisionWorld {
+    /// Per collider, the frame and grid of a still mesh on its grid path.
+    fn grid_frames(&self, fresh: bool) -> Vec<Option<(MeshFrame<'_>, GridRef<'_>)>> {
+        (self.colliders.iter().enumerate())
+            .map(|(k, c)| Some((mesh_frame(c, fresh)?, self.grid(k)?)))
+            .collect()
+    }
+
+    /// [`ParticleContacts::resolve`] with the frames of [`Self::grid_frames`].
+    #[inline(always)]
+    fn resolve_particle(
+        &self,
+        frames: &[Option<(MeshFrame<'_>, GridRef<'_>)>],
+        i: usize,
+        x: &mut DVec3,
+        prev: DVec3,
+        fresh: bool,
+    ) -> Contacts {
         let (parry, r) = (self.parry_meshes, self.thickness[i]);
         let mut out = Contacts::default();
         // Meshes (on their grids here) sweep in their own contacts.
-        let mesh = |k: usize| self.colliders[k].mesh().is_some();
-        if fresh {
+        // Slow paths (most) leave before the call: `x` and `prev` stay in registers.
+        let slow = 0.5 * r.max(1e-6);
+        if fresh && (*x - prev).length_squared() > slow * slow {
+            let mesh = |k: usize| frames[k].is_some();
             out.swept = sweep_one(&self.colliders, &self.bounds, mesh, parry, prev, x, r);
         }
-        for (k, (c, reach)) in self.colliders.iter().zip(&self.reach).enumerate() {
-            if let (Some(frame), Some(grid)) = (mesh_frame(c, fresh), self.grid(k)) {
-                let o = frame.resolve_in_grid(grid, i, prev, x, r);
+        for ((c, reach), frame) in self.colliders.iter().zip(&self.reach).zip(frames) {
+            if let Some((frame, grid)) = frame {
+                let o = frame.resolve_in_grid(*grid, i, prev, x, r);
                 out.contacts += o.contacts;
                 out.depth = out.depth.max(o.depth);
                 out.swept += o.swept;
