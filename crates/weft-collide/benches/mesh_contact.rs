@@ -3,9 +3,11 @@
 //!
 //! - `static_mesh/16384`: a 128² cloth draped (after 30 frames) on `icosphere_drop`'s
 //!   sphere-shaped mesh of 20,480 triangles, and the ground. `constraint_solve` steps the
-//!   same state without any collision; `mesh` with the mesh (f64 path); `mesh_parry` with
-//!   the same mesh through parry's f32 projection (the path before); `sphere` the same cloth
-//!   after 30 frames on `sphere_drop`'s analytic sphere of the same size.
+//!   same state without any collision; `mesh` with the mesh (f64 path, contact grid) and the
+//!   ground; `mesh_alone` with the mesh only; `mesh_parry` with the same mesh through parry's
+//!   f32 projection (the path before Weft's own); `sphere` the same cloth after 30 frames on
+//!   `sphere_drop`'s analytic sphere of the same size and the ground, `sphere_alone` on the
+//!   sphere only.
 //! - `deforming_mesh/8100`: a 90² cloth on `breathing_drop`'s deforming ball of 5,120
 //!   triangles (vertices set, faces and BVH refitted and contacts swept every substep),
 //!   against its own constraint solve.
@@ -17,8 +19,10 @@ use criterion::{
     BatchSize, Bencher, BenchmarkGroup, Criterion, SamplingMode, Throughput, criterion_group,
     criterion_main, measurement::WallTime,
 };
-use weft_collide::CollisionWorld;
-use weft_collide::scenarios::{breathing_drop, icosphere_drop, sphere_drop};
+use weft_collide::scenarios::{
+    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, icosphere_drop, sphere_drop,
+};
+use weft_collide::{ColliderDesc, CollisionWorld, Friction, ShapeDesc, TriangleMesh};
 use weft_solver::{Method, Solver};
 
 /// Frames stepped before timing: the cloth has fallen onto the collider.
@@ -63,21 +67,48 @@ fn step_with_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver, world: &Coll
     );
 }
 
+/// A world with `shape` alone (friction as the scenarios give it), stepped once on a copy of
+/// `solver` so that a mesh's grid and its particles' state exist before timing.
+fn alone(shape: ShapeDesc, solver: &Solver) -> CollisionWorld {
+    let mut w = CollisionWorld::new(solver);
+    w.add_collider(&ColliderDesc::new(shape).with_friction(Friction::new(0.8, 0.6)))
+        .expect("collider");
+    solver.clone().step_with(&mut w).expect("stable");
+    w
+}
+
 fn static_mesh(c: &mut Criterion) {
     let n = 128;
     let (solver, world) = in_contact(icosphere_drop(Method::Xpbd, n).expect("scene"));
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, n).expect("scene"));
     let mut parry = world.clone();
     parry.set_parry_meshes(true);
+    let mesh_alone = alone(
+        ShapeDesc::TriMesh(TriangleMesh::icosphere(
+            SPHERE_RADIUS,
+            ICOSPHERE_SUBDIVISIONS,
+        )),
+        &solver,
+    );
+    let sphere_alone = alone(
+        ShapeDesc::Sphere {
+            radius: SPHERE_RADIUS,
+        },
+        &sphere_solver,
+    );
     let mut g = c.benchmark_group(format!("static_mesh/{}", n * n));
     quick(&mut g);
     g.throughput(Throughput::Elements((n * n) as u64));
     g.bench_function("constraint_solve", |b| step_copies(b, &solver));
     g.bench_function("mesh", |b| step_with_copies(b, &solver, &world));
+    g.bench_function("mesh_alone", |b| step_with_copies(b, &solver, &mesh_alone));
     g.bench_function("mesh_parry", |b| step_with_copies(b, &solver, &parry));
     g.bench_function("sphere_solve", |b| step_copies(b, &sphere_solver));
     g.bench_function("sphere", |b| {
         step_with_copies(b, &sphere_solver, &sphere_world)
+    });
+    g.bench_function("sphere_alone", |b| {
+        step_with_copies(b, &sphere_solver, &sphere_alone)
     });
     g.finish();
 }
