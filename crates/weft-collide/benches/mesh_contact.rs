@@ -20,9 +20,10 @@ use criterion::{
     criterion_main, measurement::WallTime,
 };
 use weft_collide::scenarios::{
-    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, icosphere_drop, sphere_drop,
+    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, collider_alone, icosphere_drop,
+    sphere_drop,
 };
-use weft_collide::{ColliderDesc, CollisionWorld, Friction, ShapeDesc, TriangleMesh};
+use weft_collide::{CollisionWorld, ShapeDesc, TriangleMesh};
 use weft_solver::{Method, Solver};
 
 /// Frames stepped before timing: the cloth has fallen onto the collider.
@@ -67,35 +68,27 @@ fn step_with_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver, world: &Coll
     );
 }
 
-/// A world with `shape` alone (friction as the scenarios give it), stepped once on a copy of
-/// `solver` so that a mesh's grid and its particles' state exist before timing.
-fn alone(shape: ShapeDesc, solver: &Solver) -> CollisionWorld {
-    let mut w = CollisionWorld::new(solver);
-    w.add_collider(&ColliderDesc::new(shape).with_friction(Friction::new(0.8, 0.6)))
-        .expect("collider");
-    solver.clone().step_with(&mut w).expect("stable");
-    w
-}
-
 fn static_mesh(c: &mut Criterion) {
     let n = 128;
     let (solver, world) = in_contact(icosphere_drop(Method::Xpbd, n).expect("scene"));
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, n).expect("scene"));
     let mut parry = world.clone();
     parry.set_parry_meshes(true);
-    let mesh_alone = alone(
+    let mesh_alone = collider_alone(
         ShapeDesc::TriMesh(TriangleMesh::icosphere(
             SPHERE_RADIUS,
             ICOSPHERE_SUBDIVISIONS,
         )),
         &solver,
-    );
-    let sphere_alone = alone(
+    )
+    .expect("mesh alone");
+    let sphere_alone = collider_alone(
         ShapeDesc::Sphere {
             radius: SPHERE_RADIUS,
         },
         &sphere_solver,
-    );
+    )
+    .expect("sphere alone");
     let mut g = c.benchmark_group(format!("static_mesh/{}", n * n));
     quick(&mut g);
     g.throughput(Throughput::Elements((n * n) as u64));

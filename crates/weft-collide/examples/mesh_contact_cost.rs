@@ -22,9 +22,10 @@
 use std::time::Instant;
 
 use weft_collide::scenarios::{
-    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, ground, icosphere_drop, sphere_drop,
+    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, collider_alone, ground, icosphere_drop,
+    sphere_drop,
 };
-use weft_collide::{ColliderDesc, CollisionWorld, Friction, ShapeDesc, TriangleMesh};
+use weft_collide::{CollisionWorld, ShapeDesc, TriangleMesh};
 use weft_solver::{Method, Solver};
 
 /// Nanoseconds on a CPU, summed over the process's threads, if the system tells.
@@ -128,29 +129,21 @@ fn main() {
     ground_world
         .add_collider(&ground(-SPHERE_RADIUS))
         .expect("ground");
-    // Each scene's own collider alone (as the scenarios build them): the mesh, the sphere.
-    // Stepped once on a copy of the state, so that the grid and the particles' contact state
-    // exist before timing.
-    let alone = |shape: ShapeDesc, solver: &Solver| {
-        let mut w = CollisionWorld::new(solver);
-        w.add_collider(&ColliderDesc::new(shape).with_friction(Friction::new(0.8, 0.6)))
-            .expect("collider");
-        solver.clone().step_with(&mut w).expect("stable");
-        w
-    };
-    let mesh_alone = alone(
+    let mesh_alone = collider_alone(
         ShapeDesc::TriMesh(TriangleMesh::icosphere(
             SPHERE_RADIUS,
             ICOSPHERE_SUBDIVISIONS,
         )),
         &solver,
-    );
-    let sphere_alone = alone(
+    )
+    .expect("mesh alone");
+    let sphere_alone = collider_alone(
         ShapeDesc::Sphere {
             radius: SPHERE_RADIUS,
         },
         &sphere_solver,
-    );
+    )
+    .expect("sphere alone");
     println!(
         "solver kernel path: {} (WEFT_SIMD=avx512|avx2|scalar forces one)",
         solver.simd_path()

@@ -99,6 +99,16 @@ fn falling_sheet(
     build_one(method, "cloth", &mesh, THICKNESS)
 }
 
+/// A world for `solver` with `shape` alone as its collider (at the origin, with the friction
+/// of [`sphere_drop`]'s ball), stepped once on a copy of `solver` so that what it builds at its
+/// first substep (a mesh's contact grid) exists.
+pub fn collider_alone(shape: ShapeDesc, solver: &Solver) -> Result<CollisionWorld, CollideError> {
+    let mut world = CollisionWorld::new(solver);
+    world.add_collider(&ColliderDesc::new(shape).with_friction(Friction::new(0.8, 0.6)))?;
+    solver.clone().step_with(&mut world).map_err(solver_error)?;
+    Ok(world)
+}
+
 /// The ground: a half-space below y = `height` with friction.
 pub fn ground(height: f64) -> ColliderDesc {
     ColliderDesc::new(ShapeDesc::HalfSpace { normal: DVec3::Y }).at(DVec3::Y * height)

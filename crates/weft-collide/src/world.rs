@@ -668,21 +668,8 @@ impl ParticleContacts for CollisionWorld {
 
     /// As the default, with each mesh's frame and grid looked up once per run.
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
-        let ParticleRun { start, x, prev, w } = run;
         let frames = self.grid_frames(fresh);
-        let mut total = Contacts::default();
-        for (j, &wj) in w.iter().enumerate() {
-            if wj == 0.0 {
-                continue;
-            }
-            let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
-            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
-            total = total.merge(self.resolve_particle(&frames, start + j, &mut p, before, fresh));
-            for a in 0..3 {
-                x[a][j] = p[a];
-            }
-        }
-        total
+        run.each_free(|i, x, prev| self.resolve_particle(&frames, i, x, prev, fresh))
     }
 }
 

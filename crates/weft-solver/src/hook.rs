@@ -85,20 +85,7 @@ pub trait ParticleContacts: Sync {
     /// one call through a trait object per run of particles; inside it `resolve` is called
     /// directly, so an implementation's per-particle work can inline.
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
-        let ParticleRun { start, x, prev, w } = run;
-        let mut total = Contacts::default();
-        for (j, &wj) in w.iter().enumerate() {
-            if wj == 0.0 {
-                continue;
-            }
-            let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
-            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
-            total = total.merge(self.resolve(start + j, &mut p, before, fresh));
-            for a in 0..3 {
-                x[a][j] = p[a];
-            }
-        }
-        total
+        run.each_free(|i, x, prev| self.resolve(i, x, prev, fresh))
     }
 }
 
@@ -112,6 +99,29 @@ pub struct ParticleRun<'a> {
     pub prev: [&'a [f64]; 3],
     /// Inverse masses; a pinned particle (0) is left alone.
     pub w: &'a [f64],
+}
+
+impl ParticleRun<'_> {
+    /// Calls `f(i, x, prev)` on every free particle of the run in order (global index, position
+    /// to move, position at the substep's start), stores the moved positions and merges what
+    /// `f` returns.
+    #[inline(always)]
+    pub fn each_free(self, mut f: impl FnMut(usize, &mut DVec3, DVec3) -> Contacts) -> Contacts {
+        let ParticleRun { start, x, prev, w } = self;
+        let mut total = Contacts::default();
+        for (j, &wj) in w.iter().enumerate() {
+            if wj == 0.0 {
+                continue;
+            }
+            let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
+            let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
+            total = total.merge(f(start + j, &mut p, before));
+            for a in 0..3 {
+                x[a][j] = p[a];
+            }
+        }
+        total
+    }
 }
 
 /// What per-particle contacts did: summed (counts) and maximised (depth) over particles.

@@ -128,6 +128,22 @@ pub(crate) struct MeshFrame<'a> {
     pub friction: Friction,
 }
 
+#[cfg(test)]
+impl<'a> MeshFrame<'a> {
+    /// A mesh at rest at `pose`, seen in a substep's first projection.
+    pub(crate) fn still(g: &'a MeshGeometry, pose: &'a WorldPose, friction: Friction) -> Self {
+        Self {
+            geometry: g,
+            pose,
+            prev_pose: pose,
+            identity: true,
+            still: true,
+            fresh: true,
+            friction,
+        }
+    }
+}
+
 /// What one particle's contacts with one mesh did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Outcome {
@@ -287,12 +303,7 @@ impl MeshFrame<'_> {
     ) -> Outcome {
         let g = self.geometry;
         let mut out = Outcome::default();
-        let mut xl = self.to_local(self.pose, *x);
-        let from = if self.fresh {
-            self.to_local(self.prev_pose, prev)
-        } else {
-            lists.last[j]
-        };
+        let (mut xl, from) = self.local_path(*x, prev, || lists.last[j]);
         // Continuous: a crossing on the path is undone, the particle left r off the surface
         // (where the surface is at the end of the substep) on the side it came from.
         self.ensure(lists, j, xl, from, r);
@@ -367,6 +378,24 @@ impl MeshFrame<'_> {
         }
         lists.last[j] = xl;
         out
+    }
+
+    /// A particle's position `x` and the start of its path in the collider's frame: on the
+    /// substep's first projection its position `prev` at the substep's start (at the start
+    /// pose), else where the last projection left it (`last`).
+    #[inline]
+    pub(super) fn local_path(
+        &self,
+        x: DVec3,
+        prev: DVec3,
+        last: impl FnOnce() -> DVec3,
+    ) -> (DVec3, DVec3) {
+        let from = if self.fresh {
+            self.to_local(self.prev_pose, prev)
+        } else {
+            last()
+        };
+        (self.to_local(self.pose, x), from)
     }
 
     /// Moves the particle to `to` (local), its world position `x` along.

@@ -13,19 +13,6 @@ use crate::trimesh::MeshGeometry;
 use crate::trimesh::closest::closest_on_triangle;
 use crate::trimesh::vs_parry::bumpy_sphere;
 
-/// A mesh at rest at `pose`, seen in a substep's first projection.
-fn still_frame<'a>(g: &'a MeshGeometry, pose: &'a WorldPose, friction: Friction) -> MeshFrame<'a> {
-    MeshFrame {
-        geometry: g,
-        pose,
-        prev_pose: pose,
-        identity: true,
-        still: true,
-        fresh: true,
-        friction,
-    }
-}
-
 /// Each particle's list, as a sorted copy.
 fn lists_of(lists: &ChunkLists) -> Vec<Vec<u32>> {
     lists
@@ -44,7 +31,7 @@ fn compaction_keeps_the_lists_in_particle_order() {
     let m = TriangleMesh::icosphere(0.5, 3);
     let g = MeshGeometry::new(&m.vertices, &m.triangles);
     let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
-    let frame = still_frame(&g, &pose, Friction::NONE);
+    let frame = MeshFrame::still(&g, &pose, Friction::NONE);
     let mut rng = Rng(3);
     let n = 200;
     let mut x: Vec<DVec3> = (0..n)
@@ -94,7 +81,7 @@ fn rounds_stop_early_only_clear_of_every_triangle() {
     let m = bumpy_sphere();
     let g = MeshGeometry::new(&m.vertices, &m.triangles);
     let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
-    let frame = still_frame(&g, &pose, Friction::new(0.8, 0.6));
+    let frame = MeshFrame::still(&g, &pose, Friction::new(0.8, 0.6));
     let mut rng = Rng(12);
     let r = 0.02;
     let n = 400;

@@ -148,19 +148,6 @@ fn clearance_is_a_lower_bound_on_the_distance_to_triangles_in_front() {
     assert!((0..ball.faces.len()).all(|t| grid.clearance(t) >= 4.0 * reach));
 }
 
-/// A mesh at rest at the origin, seen in a substep's first projection.
-fn frame<'a>(g: &'a MeshGeometry, pose: &'a WorldPose) -> MeshFrame<'a> {
-    MeshFrame {
-        geometry: g,
-        pose,
-        prev_pose: pose,
-        identity: true,
-        still: true,
-        fresh: true,
-        friction: Friction::new(0.8, 0.6),
-    }
-}
-
 /// Particles started around and on a mesh, stepping towards its centre and sideways for
 /// several substeps with friction: each ends every substep where the per-particle lists put it
 /// (to rounding). Particles started deep inside a closed mesh may differ (after a push out
@@ -172,7 +159,7 @@ fn grid_matches_lists(m: &TriangleMesh, seed: u64) {
     let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
     let r = 0.02;
     let grid = ContactGrid::new(&g, r).expect("small grid");
-    let frame = frame(&g, &pose);
+    let frame = MeshFrame::still(&g, &pose, Friction::new(0.8, 0.6));
     let state = GridParticles::new(600);
     let mut rng = Rng(seed);
     let n = 600;

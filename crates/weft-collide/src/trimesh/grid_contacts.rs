@@ -112,12 +112,7 @@ impl MeshFrame<'_> {
     ) -> Outcome {
         let g = self.geometry;
         let mut out = Outcome::default();
-        let mut xl = self.to_local(self.pose, *x);
-        let from = if self.fresh {
-            self.to_local(self.prev_pose, prev)
-        } else {
-            state.last(i)
-        };
+        let (mut xl, from) = self.local_path(*x, prev, || state.last(i));
         // Continuous: a path shorter than r/2 cannot cross the surface from r away, where the
         // last projection left the particle; a longer one is swept through the BVH.
         let short = 0.5 * r;
