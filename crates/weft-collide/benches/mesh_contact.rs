@@ -19,11 +19,8 @@ use criterion::{
     BatchSize, Bencher, BenchmarkGroup, Criterion, SamplingMode, Throughput, criterion_group,
     criterion_main, measurement::WallTime,
 };
-use weft_collide::scenarios::{
-    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, collider_alone, icosphere_drop,
-    sphere_drop,
-};
-use weft_collide::{CollisionWorld, ShapeDesc, TriangleMesh};
+use weft_collide::CollisionWorld;
+use weft_collide::scenarios::{balls_alone, breathing_drop, icosphere_drop, sphere_drop};
 use weft_solver::{Method, Solver};
 
 /// Frames stepped before timing: the cloth has fallen onto the collider.
@@ -74,21 +71,7 @@ fn static_mesh(c: &mut Criterion) {
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, n).expect("scene"));
     let mut parry = world.clone();
     parry.set_parry_meshes(true);
-    let mesh_alone = collider_alone(
-        ShapeDesc::TriMesh(TriangleMesh::icosphere(
-            SPHERE_RADIUS,
-            ICOSPHERE_SUBDIVISIONS,
-        )),
-        &solver,
-    )
-    .expect("mesh alone");
-    let sphere_alone = collider_alone(
-        ShapeDesc::Sphere {
-            radius: SPHERE_RADIUS,
-        },
-        &sphere_solver,
-    )
-    .expect("sphere alone");
+    let (mesh_alone, sphere_alone) = balls_alone(&solver, &sphere_solver).expect("each ball alone");
     let mut g = c.benchmark_group(format!("static_mesh/{}", n * n));
     quick(&mut g);
     g.throughput(Throughput::Elements((n * n) as u64));

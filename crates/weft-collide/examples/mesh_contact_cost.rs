@@ -21,11 +21,10 @@
 
 use std::time::Instant;
 
+use weft_collide::CollisionWorld;
 use weft_collide::scenarios::{
-    ICOSPHERE_SUBDIVISIONS, SPHERE_RADIUS, breathing_drop, collider_alone, ground, icosphere_drop,
-    sphere_drop,
+    SPHERE_RADIUS, balls_alone, breathing_drop, ground, icosphere_drop, sphere_drop,
 };
-use weft_collide::{CollisionWorld, ShapeDesc, TriangleMesh};
 use weft_solver::{Method, Solver};
 
 /// Nanoseconds on a CPU, summed over the process's threads, if the system tells.
@@ -129,21 +128,7 @@ fn main() {
     ground_world
         .add_collider(&ground(-SPHERE_RADIUS))
         .expect("ground");
-    let mesh_alone = collider_alone(
-        ShapeDesc::TriMesh(TriangleMesh::icosphere(
-            SPHERE_RADIUS,
-            ICOSPHERE_SUBDIVISIONS,
-        )),
-        &solver,
-    )
-    .expect("mesh alone");
-    let sphere_alone = collider_alone(
-        ShapeDesc::Sphere {
-            radius: SPHERE_RADIUS,
-        },
-        &sphere_solver,
-    )
-    .expect("sphere alone");
+    let (mesh_alone, sphere_alone) = balls_alone(&solver, &sphere_solver).expect("each ball alone");
     println!(
         "solver kernel path: {} (WEFT_SIMD=avx512|avx2|scalar forces one)",
         solver.simd_path()

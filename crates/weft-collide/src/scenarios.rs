@@ -99,6 +99,25 @@ fn falling_sheet(
     build_one(method, "cloth", &mesh, THICKNESS)
 }
 
+/// The colliders of [`icosphere_drop`] and [`sphere_drop`] without their ground, each alone in
+/// a world for its solver (see [`collider_alone`]): the 20,480-triangle mesh and the analytic
+/// ball of the same radius.
+pub fn balls_alone(
+    mesh_solver: &Solver,
+    sphere_solver: &Solver,
+) -> Result<(CollisionWorld, CollisionWorld), CollideError> {
+    let mesh = crate::mesh::TriangleMesh::icosphere(SPHERE_RADIUS, ICOSPHERE_SUBDIVISIONS);
+    Ok((
+        collider_alone(ShapeDesc::TriMesh(mesh), mesh_solver)?,
+        collider_alone(
+            ShapeDesc::Sphere {
+                radius: SPHERE_RADIUS,
+            },
+            sphere_solver,
+        )?,
+    ))
+}
+
 /// A world for `solver` with `shape` alone as its collider (at the origin, with the friction
 /// of [`sphere_drop`]'s ball), stepped once on a copy of `solver` so that what it builds at its
 /// first substep (a mesh's contact grid) exists.
