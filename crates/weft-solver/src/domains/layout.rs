@@ -50,8 +50,13 @@ pub(super) struct Chunk {
 
 /// Loads one end of lanes `off..off + W` of a chunk: `idx` gives each lane's particle.
 #[inline(always)]
-fn gather<T: Copy, const W: usize>(src: &[T], idx: &[u32], off: usize) -> [T; W] {
-    std::array::from_fn(|l| src[idx[off + l] as usize])
+fn gather<T: Copy + Default, const W: usize>(src: &[T], idx: &[u32], off: usize) -> [T; W] {
+    // A plain loop: `array::from_fn` here stayed an out-of-line call per gather.
+    let mut out = [T::default(); W];
+    for l in 0..W {
+        out[l] = src[idx[off + l] as usize];
+    }
+    out
 }
 
 #[inline(always)]
