@@ -144,20 +144,38 @@ impl MeshFrame<'_> {
                 return out;
             }
             let q = closest_on_triangle(xl, a, b, c);
-            let k = match q.feature {
-                Feature::Edge(k) | Feature::Vertex(k) => k,
-                Feature::Face => {
-                    let clear = grid.clearance(t);
+            let adjacent = g.topology.adjacent[t];
+            // The nearest point of the mesh, if this triangle settles it, with the clearance
+            // that covers it: inside the face, from in front; or inside an edge that the
+            // neighbour across it gives too (then x − q lies in the cone of the two faces'
+            // normals, so it is the nearest point of the wedge behind both planes, where every
+            // triangle near both of them lies).
+            let settled = match q.feature {
+                Feature::Face => (f.normal.dot(xl - q.point) > 0.0).then(|| grid.clearance(t)),
+                Feature::Edge(k) => match adjacent[usize::from(k)] {
+                    NONE => None,
+                    u => g.faces.get(u as usize).and_then(|fu| {
+                        let [ua, ub, uc] = fu.corners;
+                        let across = closest_on_triangle(xl, ua, ub, uc);
+                        let shared = matches!(across.feature,
+                            Feature::Edge(ku) if g.topology.adjacent[u as usize][usize::from(ku)] as usize == t);
+                        shared.then(|| grid.clearance(t).min(grid.clearance(u as usize)))
+                    }),
+                },
+                Feature::Vertex(_) => None,
+            };
+            let k = match (q.feature, settled) {
+                (_, Some(clear)) => {
                     let delta = xl - q.point;
                     let d2 = delta.length_squared();
                     let d = d2.sqrt();
-                    if delta.dot(f.normal) <= 0.0 || d <= 1e-12 || d.max(r) + r > clear {
+                    if d <= 1e-12 || d.max(r) + r > clear {
                         break;
                     }
                     state.set_side(i, Some(false));
                     state.set_hint(i, t as u32);
                     if d < r {
-                        // Outside, off the surface, nearest to the face: what `signed` gives.
+                        // Outside, off the surface, nearest here: what `signed` gives.
                         let hit = MeshPoint {
                             triangle: t,
                             closest: q,
@@ -167,8 +185,8 @@ impl MeshFrame<'_> {
                         if let Some((depth, slip)) = self.push(&hit, &mut xl, x, prev, r) {
                             out.contacts += 1;
                             out.depth = depth;
-                            // Pushed to r in front of the plane, then slipped along it:
-                            // still clear if within the clearance less r.
+                            // Pushed to r off the face or edge, then slipped across its
+                            // normal: still clear if within the clearance less r.
                             if 2.0 * r + slip > clear {
                                 return self.rounds_in_grid(
                                     (grid, state),
@@ -186,9 +204,11 @@ impl MeshFrame<'_> {
                     state.set_last(i, xl);
                     return out;
                 }
+                (Feature::Face, None) => break,
+                (Feature::Edge(k) | Feature::Vertex(k), None) => k,
             };
             // Across the edge (from a corner, across its first edge) towards the particle.
-            match g.topology.adjacent[t][usize::from(k)] {
+            match adjacent[usize::from(k)] {
                 NONE => break,
                 u => t = u as usize,
             }
