@@ -13,26 +13,13 @@ fn the_shipped_cloth_drapes_on_the_blob_a_thickness_off() {
     let thickness = scene.cloths[0].thickness;
     let mut groups = common::with_method(&path, Method::Xpbd, &[]);
     let g = &mut groups[0];
-    let blob = g.world.as_ref().expect("colliders").colliders()[0].clone();
-    let mut worst = f64::INFINITY;
-    common::run_watched(g, 150, |_, p| {
-        for x in &p.positions {
-            if let Some(s) = blob.closest(*x, 1.0) {
-                worst = worst.min(s.distance);
-            }
-        }
-    });
+    let (worst, blob) = common::closest_approach(g, 0, 150);
     let fused = g
         .world
         .as_ref()
         .is_some_and(|w| w.particle_contacts().is_some());
     let p = g.solver.particles();
-    let middle = p
-        .positions
-        .iter()
-        .copied()
-        .min_by(|a, b| a.with_y(0.0).length().total_cmp(&b.with_y(0.0).length()))
-        .expect("particles");
+    let middle = common::middle_particle(p);
     // The middle particle rests on the blob's top, a thickness above it.
     let rest = blob.closest(middle, 1.0).expect("near the blob").distance;
     let centre = scene.colliders[0].position;

@@ -27,23 +27,9 @@ fn the_shipped_tablecloth_drapes_over_the_table_edges() {
     let thickness = scene.cloths[0].thickness;
     let mut groups = common::with_method(&path, Method::Xpbd, &[]);
     let g = &mut groups[0];
-    let box_ = g.world.as_ref().expect("colliders").colliders()[0].clone();
-    let mut worst = f64::INFINITY;
-    common::run_watched(g, 150, |_, p| {
-        for x in &p.positions {
-            if let Some(s) = box_.closest(*x, 1.0) {
-                worst = worst.min(s.distance);
-            }
-        }
-    });
+    let (worst, _) = common::closest_approach(g, 0, 150);
     let p = g.solver.particles();
-    // The particle nearest the middle (half a spacing off the axis for an even grid).
-    let middle = p
-        .positions
-        .iter()
-        .copied()
-        .min_by(|a, b| a.with_y(0.0).length().total_cmp(&b.with_y(0.0).length()))
-        .expect("particles");
+    let middle = common::middle_particle(p);
     let lowest = p.positions.iter().map(|x| x.y).fold(f64::MAX, f64::min);
     println!(
         "closest approach to the table {worst:.5} m; middle at y = {:.4} (top + thickness = \

@@ -89,3 +89,32 @@ pub fn assert_errors(cases: &[(String, usize, &str, &str)]) {
         );
     }
 }
+
+/// Runs `group` for `frames` frames and returns the least distance from any particle to its
+/// world's collider `k` seen after any substep (searched within 1 m), with the collider.
+pub fn closest_approach(
+    group: &mut SolverGroup,
+    k: usize,
+    frames: usize,
+) -> (f64, weft_collide::Collider) {
+    let collider = group.world.as_ref().expect("colliders").colliders()[k].clone();
+    let mut worst = f64::INFINITY;
+    run_watched(group, frames, |_, p| {
+        for x in &p.positions {
+            if let Some(s) = collider.closest(*x, 1.0) {
+                worst = worst.min(s.distance);
+            }
+        }
+    });
+    (worst, collider)
+}
+
+/// The particle nearest the vertical axis through the origin (half a spacing off it for an
+/// even grid centred there).
+pub fn middle_particle(p: &Particles) -> weft_solver::glam::DVec3 {
+    p.positions
+        .iter()
+        .copied()
+        .min_by(|a, b| a.with_y(0.0).length().total_cmp(&b.with_y(0.0).length()))
+        .expect("particles")
+}
