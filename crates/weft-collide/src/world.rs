@@ -302,8 +302,8 @@ impl CollisionWorld {
         }
         let (reach, n) = (self.max_thickness, self.thickness.len());
         for (k, c) in self.colliders.iter().enumerate() {
+            let still_mesh = self.own_mesh(c) && !c.is_deforming();
             let (sought, grid) = &mut self.mesh_grids[k];
-            let still_mesh = c.mesh().is_some() && !self.parry_meshes && !c.is_deforming();
             if still_mesh && *sought < reach {
                 *sought = reach;
                 *grid = c
@@ -463,7 +463,9 @@ fn over_free_particles<T: Copy + Send + Sync>(
 }
 
 /// Sweeps one particle's substep path `from → x` against every collider; returns how many
-/// stopped it.
+/// stopped it. A path shorter than half the thickness (most) leaves here, inlined, before
+/// `x`'s address is taken: the call's vector loads would wait on the caller's scalar stores.
+#[inline(always)]
 fn sweep_one(
     colliders: &[Collider],
     bounds: &[Option<Bounds>],
@@ -477,6 +479,19 @@ fn sweep_one(
     if (*x - from).length_squared() <= slow * slow {
         return 0;
     }
+    sweep_path(colliders, bounds, own, parry, from, x, r)
+}
+
+/// [`sweep_one`] for a path of half the thickness or longer.
+fn sweep_path(
+    colliders: &[Collider],
+    bounds: &[Option<Bounds>],
+    own: impl Fn(usize) -> bool,
+    parry: bool,
+    from: DVec3,
+    x: &mut DVec3,
+    r: f64,
+) -> usize {
     let step = (*x - from).length();
     let mut swept = 0;
     for (k, (c, b)) in colliders.iter().zip(bounds).enumerate() {
@@ -694,9 +709,7 @@ impl CollisionWorld {
         let (parry, r) = (self.parry_meshes, self.thickness[i]);
         let mut out = Contacts::default();
         // Meshes (on their grids here) sweep in their own contacts.
-        // Slow paths (most) leave before the call: `x` and `prev` stay in registers.
-        let slow = 0.5 * r.max(1e-6);
-        if fresh && (*x - prev).length_squared() > slow * slow {
+        if fresh {
             let mesh = |k: usize| frames[k].is_some();
             out.swept = sweep_one(&self.colliders, &self.bounds, mesh, parry, prev, x, r);
         }

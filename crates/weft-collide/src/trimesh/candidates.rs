@@ -362,17 +362,9 @@ impl MeshFrame<'_> {
             let Some((depth, slip)) = self.push(&hit, &mut xl, x, prev, r) else {
                 break;
             };
-            // Pushed from inside (or from on the surface) the triangle left may still be
-            // within r: look again.
-            again = !scan.along_closest(&hit) || scan.second.sqrt() - depth - slip < r;
-            // Another round only if a triangle other than the one just left may be within r
-            // where the particle is now, on a list still valid here.
-            if again && scan.along_closest(&hit) {
-                let moved = (xl - scanned_at).length();
-                if scan.others.sqrt() - moved >= r && self.valid(lists, j, xl, from, r) {
-                    again = self.may_touch_again(&scan, hit.triangle, xl, moved, r);
-                }
-            }
+            again = self.look_again(&scan, &hit, (depth, slip), (scanned_at, xl), r, || {
+                self.valid(lists, j, xl, from, r)
+            });
             out.contacts += 1;
             out.depth = out.depth.max(depth);
         }
@@ -538,6 +530,34 @@ impl MeshFrame<'_> {
         *x -= correction;
         *xl = self.to_local(self.pose, *x);
         Some((depth, correction.length()))
+    }
+
+    /// Whether a contact round must follow a push from `hit` by `depth`, then a slip of
+    /// `slip`, that moved the particle from `scanned_at` to `xl`. Pushed from inside (or from
+    /// on the surface), yes: the triangle left may still be within r. Otherwise only if the
+    /// scan's runner-up may now be within r, and, where the scanned candidates still hold
+    /// every triangle within r of `xl` (`listed`) and the others not followed are out of
+    /// reach, only if a followed triangle other than the one left is within r.
+    pub(super) fn look_again(
+        &self,
+        scan: &Scan,
+        hit: &MeshPoint,
+        (depth, slip): (f64, f64),
+        (scanned_at, xl): (DVec3, DVec3),
+        r: f64,
+        listed: impl FnOnce() -> bool,
+    ) -> bool {
+        let along = scan.along_closest(hit);
+        let again = !along || scan.second.sqrt() - depth - slip < r;
+        if !(again && along) {
+            return again;
+        }
+        let moved = (xl - scanned_at).length();
+        if scan.others.sqrt() - moved >= r && listed() {
+            self.may_touch_again(scan, hit.triangle, xl, moved, r)
+        } else {
+            again
+        }
     }
 
     /// Whether a followed triangle other than `left` may be within r of `xl`, the particle

@@ -94,9 +94,10 @@ impl Clone for GridParticles {
 }
 
 impl MeshFrame<'_> {
-    /// [`MeshFrame::resolve`] through a still mesh's contact grid (particle `i`, global): the particle's cell lists every
-    /// triangle within r of it, so nothing is kept per particle but its path's end, the
-    /// triangle it touched last and, for a closed mesh, the side it was last known on.
+    /// [`MeshFrame::resolve`] through a still mesh's contact grid (particle `i`, global): the
+    /// particle's cell lists every triangle within r of it, so nothing is kept per particle
+    /// but its path's end, the triangle it touched last and, for a closed mesh, the side it
+    /// was last known on.
     ///
     /// Where no triangle is within r, the side is the cell's when the surface does not pass
     /// through the cell, else the one last known: the particle cannot have changed sides
@@ -276,14 +277,8 @@ impl MeshFrame<'_> {
             out.depth = out.depth.max(depth);
             let now = grid.cell(xl);
             // In another cell, triangles this one did not list may be within r.
-            let mut again =
-                now != cell || !scan.along_closest(&hit) || scan.second.sqrt() - depth - slip < r;
-            if again && now == cell && scan.along_closest(&hit) {
-                let moved = (xl - scanned_at).length();
-                if scan.others.sqrt() - moved >= r {
-                    again = self.may_touch_again(&scan, hit.triangle, xl, moved, r);
-                }
-            }
+            let again = now != cell
+                || self.look_again(&scan, &hit, (depth, slip), (scanned_at, xl), r, || true);
             if !again {
                 break;
             }
