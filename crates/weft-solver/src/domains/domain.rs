@@ -30,15 +30,24 @@ pub(super) struct Pairs {
     pub group: Vec<u32>,
     /// XPBD multiplier.
     pub lambda: Vec<f32>,
+    /// Whether the entry is a constraint; a chunk's dead lane (see `Chunk::live`) holds an
+    /// entry that is not.
+    pub live: Vec<bool>,
 }
 
 impl Pairs {
     pub(super) fn push(&mut self, p: u32, q: u32, rest: f64, group: u32) {
+        self.push_f32(p, q, rest as f32, group, true);
+    }
+
+    /// Appends an entry with its rest length already in f32; `live` false for a dead lane.
+    pub(super) fn push_f32(&mut self, p: u32, q: u32, rest: f32, group: u32, live: bool) {
         self.p.push(p);
         self.q.push(q);
-        self.rest.push(rest as f32);
+        self.rest.push(rest);
         self.group.push(group);
         self.lambda.push(0.0);
+        self.live.push(live);
     }
 }
 

@@ -46,7 +46,14 @@ pub(super) struct Chunk {
     pub group: u32,
     /// The first lane's rest length (m, f32 like the sweep's arithmetic).
     pub rest: f32,
+    /// Bit l set when lane l is a constraint. A dead lane fills a structured window's hole
+    /// (a grid row's end): it loads and stores its two particles like any lane, but its
+    /// correction factor is forced to zero, so it writes back what it read.
+    pub live: u8,
 }
+
+/// [`Chunk::live`] of a chunk with no hole.
+pub(super) const ALL_LIVE: u8 = u8::MAX;
 
 /// Loads one end of lanes `off..off + W` of a chunk: `idx` gives each lane's particle.
 #[inline(always)]

@@ -157,12 +157,13 @@ impl Domains {
         };
         for d in &self.list {
             for c in &d.chunks {
+                let live = c.live.count_ones() as usize;
                 match c.layout {
-                    Layout::Contiguous => s.contiguous += LANES,
+                    Layout::Contiguous => s.contiguous += live,
                     Layout::Paired | Layout::Quad | Layout::Spaced | Layout::Strided => {
-                        s.strided += LANES
+                        s.strided += live
                     }
-                    Layout::Gathered => s.gathered += LANES,
+                    Layout::Gathered => s.gathered += live,
                 }
             }
             for ((_, tail), colour) in d.plan.iter().zip(&d.colours) {

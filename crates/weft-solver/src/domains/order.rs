@@ -1,6 +1,7 @@
 //! The order of a domain's interior constraints: conflict-free sets that chunk well.
 
 use super::domain::Domain;
+use super::domain::Pairs;
 use super::layout::{Chunk, Layout, structured_layout};
 use crate::coloring::color;
 use crate::constraints::lanes::LANES;
@@ -76,64 +77,158 @@ impl Domain {
         self.plan_chunks();
     }
 
-    /// Splits every colour into full chunks of [`LANES`] (classified by layout) and a remainder.
+    /// Splits every colour into full chunks of [`LANES`] (classified by layout) and a remainder,
+    /// rebuilding `pairs` in chunk order.
+    ///
+    /// Greedy scan in particle order: eight constraints that fit a structured layout make a
+    /// chunk; where a window of the contiguous or paired layout has holes (a grid row's end),
+    /// its constraints make a chunk with dead lanes (see [`Chunk::live`]); a constraint that
+    /// starts neither waits for the gathered chunks at the end of the set.
     fn plan_chunks(&mut self) {
-        for c in 0..self.colours.len() {
-            let colour = self.colours[c].clone();
-            // Greedy scan in particle order: eight constraints that fit a unit-stride layout
-            // make a chunk; a constraint that starts no such chunk (a run's ragged end, say at
-            // the end of a grid row) waits for the gathered chunks at the end of the set.
-            let mut order = Vec::with_capacity(colour.len());
-            let mut leftovers = Vec::new();
-            let mut layouts = Vec::new();
-            let mut k = colour.start;
-            while k < colour.end {
-                if k + LANES <= colour.end
-                    && let Some(layout) =
-                        structured_layout(&self.pairs.p[k..k + LANES], &self.pairs.q[k..k + LANES])
-                {
-                    order.extend(k..k + LANES);
-                    layouts.push(layout);
-                    k += LANES;
-                } else {
-                    leftovers.push(k);
-                    k += 1;
-                }
-            }
-            order.extend(leftovers);
-            let pairs = &mut self.pairs;
-            let take = |v: &Vec<u32>| order.iter().map(|&k| v[k]).collect::<Vec<u32>>();
-            let (p, q, group) = (take(&pairs.p), take(&pairs.q), take(&pairs.group));
-            let rest: Vec<f32> = order.iter().map(|&k| pairs.rest[k]).collect();
-            pairs.p[colour.clone()].copy_from_slice(&p);
-            pairs.q[colour.clone()].copy_from_slice(&q);
-            pairs.group[colour.clone()].copy_from_slice(&group);
-            pairs.rest[colour.clone()].copy_from_slice(&rest);
+        let old = std::mem::take(&mut self.pairs);
+        let colours = std::mem::take(&mut self.colours);
+        let n = self.len();
+        for colour in colours {
+            let begin = self.pairs.p.len();
             let first = self.chunks.len();
-            let mut k = colour.start;
-            let structured = layouts.into_iter().map(Some);
-            for layout in structured.chain(std::iter::repeat(None)) {
-                if k + LANES > colour.end {
-                    break;
+            let set: Vec<usize> = colour.collect();
+            let mut leftovers = Vec::new();
+            let mut i = 0;
+            while i < set.len() {
+                let ahead = &set[i..];
+                let full = (ahead.len() >= LANES)
+                    .then(|| {
+                        let k = &ahead[..LANES];
+                        let p: Vec<u32> = k.iter().map(|&k| old.p[k]).collect();
+                        let q: Vec<u32> = k.iter().map(|&k| old.q[k]).collect();
+                        structured_layout(&p, &q)
+                    })
+                    .flatten();
+                if let Some(layout) = full {
+                    let lanes = std::array::from_fn(|l| Some(ahead[l]));
+                    self.push_chunk(&old, layout, lanes, None);
+                    i += LANES;
+                } else if let Some(win) = holey_window(&old, ahead, n) {
+                    self.push_chunk(&old, win.layout, win.lanes, Some(win.slots));
+                    i += win.used;
+                } else {
+                    leftovers.push(ahead[0]);
+                    i += 1;
                 }
-                // The chunk carries what its lanes share: a structured chunk of one group reads
-                // no per-lane indices or groups, and one whose rest lengths have the same bits
-                // no rest lengths either.
-                let g = &pairs.group[k..k + LANES];
-                let rest = &pairs.rest[k..k + LANES];
-                self.chunks.push(Chunk {
-                    start: k,
-                    layout: layout.unwrap_or(Layout::Gathered),
-                    uniform: g.iter().all(|&x| x == g[0]),
-                    same_rest: rest.iter().all(|&x| x.to_bits() == rest[0].to_bits()),
-                    p0: pairs.p[k],
-                    q0: pairs.q[k],
-                    group: g[0],
-                    rest: rest[0],
-                });
-                k += LANES;
             }
-            self.plan.push((first..self.chunks.len(), k));
+            let mut rest = leftovers.chunks_exact(LANES);
+            for lanes in rest.by_ref() {
+                let lanes = std::array::from_fn(|l| Some(lanes[l]));
+                self.push_chunk(&old, Layout::Gathered, lanes, None);
+            }
+            let tail = self.pairs.p.len();
+            for &k in rest.remainder() {
+                let pairs = &mut self.pairs;
+                pairs.push_f32(old.p[k], old.q[k], old.rest[k], old.group[k], true);
+            }
+            self.colours.push(begin..self.pairs.p.len());
+            self.plan.push((first..self.chunks.len(), tail));
         }
     }
+
+    /// Appends a chunk: `lanes` gives each lane's constraint in `old`, `None` for a dead lane,
+    /// whose particles `slots` gives. The chunk carries what its lanes share: a structured chunk
+    /// of one group reads no per-lane indices or groups, and one whose rest lengths have the
+    /// same bits no rest lengths either. A dead lane takes the first live lane's group and
+    /// rest length, so it breaks neither.
+    fn push_chunk(
+        &mut self,
+        old: &Pairs,
+        layout: Layout,
+        lanes: [Option<usize>; LANES],
+        slots: Option<[(u32, u32); LANES]>,
+    ) {
+        let start = self.pairs.p.len();
+        let lead = lanes.iter().flatten().next().copied().unwrap_or_default();
+        let mut live = 0u8;
+        for (l, k) in lanes.iter().enumerate() {
+            match (k, slots) {
+                (Some(k), _) => {
+                    live |= 1 << l;
+                    let k = *k;
+                    self.pairs
+                        .push_f32(old.p[k], old.q[k], old.rest[k], old.group[k], true);
+                }
+                (None, Some(slots)) => {
+                    let (p, q) = slots[l];
+                    self.pairs
+                        .push_f32(p, q, old.rest[lead], old.group[lead], false);
+                }
+                (None, None) => unreachable!("a dead lane comes with its window's particles"),
+            }
+        }
+        let g = &self.pairs.group[start..start + LANES];
+        let rest = &self.pairs.rest[start..start + LANES];
+        self.chunks.push(Chunk {
+            start,
+            layout,
+            uniform: g.iter().all(|&x| x == g[0]),
+            same_rest: rest.iter().all(|&x| x.to_bits() == rest[0].to_bits()),
+            p0: self.pairs.p[start],
+            q0: self.pairs.q[start],
+            group: g[0],
+            rest: rest[0],
+            live,
+        });
+    }
+}
+
+/// A structured window with holes: some lanes hold constraints, the others are dead.
+struct Window {
+    /// Contiguous or paired.
+    layout: Layout,
+    /// Each lane's constraint, `None` for a dead lane.
+    lanes: [Option<usize>; LANES],
+    /// How many constraints it takes.
+    used: usize,
+    /// Every lane's particles.
+    slots: [(u32, u32); LANES],
+}
+
+/// A contiguous (q − p ≥ [`LANES`]) or paired (q = p + 1) window that starts at the first of
+/// `ahead`'s constraints and holds at least two of them, with the constraints that follow it
+/// in `ahead` as live lanes and its other slots dead. The window must lie inside the domain
+/// (`n` particles); its slots are distinct particles, so a dead lane shares none with a live
+/// one.
+fn holey_window(old: &Pairs, ahead: &[usize], n: usize) -> Option<Window> {
+    let k0 = *ahead.first()?;
+    let (p0, d) = (old.p[k0], old.q[k0] - old.p[k0]);
+    let (layout, step, reach) = if d as usize >= LANES {
+        (Layout::Contiguous, 1, d as usize + LANES)
+    } else if d == 1 {
+        (Layout::Paired, 2, 2 * LANES)
+    } else {
+        return None;
+    };
+    if p0 as usize + reach > n {
+        return None;
+    }
+    let mut lanes = [None; LANES];
+    let mut used = 0;
+    for &k in ahead {
+        let (p, q) = (old.p[k], old.q[k]);
+        let Some(off) = p.checked_sub(p0) else { break };
+        let slot = (off / step) as usize;
+        if q.checked_sub(p) != Some(d) || off % step != 0 || slot >= LANES || lanes[slot].is_some()
+        {
+            break;
+        }
+        lanes[slot] = Some(k);
+        used += 1;
+    }
+    let slots = std::array::from_fn(|l| {
+        let p = p0 + (l as u32) * step;
+        (p, p + d)
+    });
+    (used >= 2).then_some(Window {
+        layout,
+        lanes,
+        used,
+        slots,
+    })
 }

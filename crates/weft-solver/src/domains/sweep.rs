@@ -10,7 +10,7 @@
 use multiversion::multiversion;
 
 use super::domain::{Domain, Mode, Pairs, Rebased};
-use super::layout::{Chunk, Layout, layout_of, load_ends, store_ends, window_fits};
+use super::layout::{ALL_LIVE, Chunk, Layout, layout_of, load_ends, store_ends, window_fits};
 use super::simd::SimdPath;
 use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
 
@@ -105,6 +105,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
                 (&p, &q, 0),
                 &rest,
                 &k_coef,
+                ALL_LIVE,
             );
         }
     }
@@ -217,6 +218,7 @@ fn project_laid_out<
         rest: all_rest,
         group,
         lambda,
+        ..
     } = pairs;
     // A structured layout needs the first lane's particles only, kept in the chunk.
     let (p0, q0) = ([chunk.p0], [chunk.q0]);
@@ -239,7 +241,14 @@ fn project_laid_out<
             Coefs::from_fn(|l| coef[groups[l] as usize])
         };
         let lambda = &mut lambda[r];
-        project_part::<DAMPED, LAMBDA, UNIT_K, LAYOUT, W>(work, lambda, (p, q, off), &rest, &k);
+        project_part::<DAMPED, LAMBDA, UNIT_K, LAYOUT, W>(
+            work,
+            lambda,
+            (p, q, off),
+            &rest,
+            &k,
+            chunk.live,
+        );
     }
 }
 
@@ -316,7 +325,7 @@ fn project_paired<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, co
                 lambda[l] = pairs.lambda[first + l / 2];
             }
         }
-        let s = lanes::scale::<f32, W, DAMPED, LAMBDA, UNIT_K>(
+        let mut s = lanes::scale::<f32, W, DAMPED, LAMBDA, UNIT_K>(
             &d,
             &motion,
             &wp,
@@ -325,6 +334,9 @@ fn project_paired<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, co
             &k,
             &mut lambda,
         );
+        if chunk.live != ALL_LIVE {
+            kill_dead(&mut s, chunk.live, |l| (off + l) / 2);
+        }
         if LAMBDA {
             for j in 0..W / 2 {
                 pairs.lambda[first + j] = lambda[2 * j];
@@ -356,6 +368,7 @@ fn project_part<
     (p, q, off): (&[u32], &[u32], usize),
     rest: &[f32; W],
     k: &Coefs<W, f32>,
+    live: u8,
 ) {
     assert!(
         window_fits::<LAYOUT, W>(p, q, off, work.w.len()),
@@ -388,8 +401,11 @@ fn project_part<
     if LAMBDA {
         lambda.copy_from_slice(lambda_out);
     }
-    let s =
+    let mut s =
         lanes::scale::<f32, W, DAMPED, LAMBDA, UNIT_K>(&d, &motion, &wp, &wq, rest, k, &mut lambda);
+    if live != ALL_LIVE {
+        kill_dead(&mut s, live, |l| off + l);
+    }
     if LAMBDA {
         lambda_out.copy_from_slice(&lambda);
     }
@@ -399,6 +415,19 @@ fn project_part<
             qd[a][l] -= d[a][l] * (wq[l] * s[l]);
         }
         store_ends::<LAYOUT, W, f32>(work.disp[a], p, q, off, &pd[a], &qd[a]);
+    }
+}
+
+/// Forces the correction factor of every dead lane to zero (`lane` maps a slot of the part to
+/// its lane in the chunk). Its corrections are then d · (w · 0) = ±0, which leave every
+/// displacement as it was (a displacement is never −0: it starts at +0 and an IEEE sum is −0
+/// only when both terms are), so the dead lane stores back the values it loaded.
+#[inline(always)]
+fn kill_dead<const W: usize>(s: &mut [f32; W], live: u8, lane: impl Fn(usize) -> usize) {
+    for l in 0..W {
+        if live & (1 << lane(l)) == 0 {
+            s[l] = 0.0;
+        }
     }
 }
 
@@ -463,6 +492,7 @@ mod tests {
     /// kernel's de-interleaving path; returns both results' bits (displacements, multipliers).
     fn both<const D: bool, const L: bool, const U: bool, const W: usize>(
         seed: u64,
+        live: u8,
     ) -> [(Vec<u32>, Vec<u32>); 3] {
         let mut rnd = rng(seed);
         let n = 2 * LANES + 3;
@@ -498,6 +528,7 @@ mod tests {
             q0: first as u32 + 1,
             group: 0,
             rest: pairs.rest[0],
+            live,
         };
         let run = |paired: bool| {
             let mut d = disp.clone();
@@ -524,18 +555,124 @@ mod tests {
     #[test]
     fn a_paired_chunk_projected_slot_by_slot_gives_the_lane_kernels_bits() {
         for seed in 1..6 {
+            // With every lane live, and with dead lanes (a row's end).
             let checks = [
-                both::<false, false, true, 8>(seed),
-                both::<false, false, false, 8>(seed),
-                both::<false, true, true, 8>(seed),
-                both::<true, true, false, 8>(seed),
-                both::<true, false, true, 4>(seed),
-                both::<true, true, false, 2>(seed),
+                both::<false, false, true, 8>(seed, ALL_LIVE),
+                both::<false, false, false, 8>(seed, ALL_LIVE),
+                both::<false, true, true, 8>(seed, ALL_LIVE),
+                both::<true, true, false, 8>(seed, ALL_LIVE),
+                both::<true, false, true, 4>(seed, ALL_LIVE),
+                both::<true, true, false, 2>(seed, ALL_LIVE),
+                both::<false, false, true, 8>(seed, 0b0111_1111),
+                both::<true, true, false, 4>(seed, 0b1010_0101),
             ];
             for (i, [paired, lanes, before]) in checks.iter().enumerate() {
                 assert_eq!(paired, lanes, "seed {seed}, form {i}");
                 // The chunk moved particles: the comparison is not of two untouched copies.
                 assert_ne!(paired.0, before.0, "seed {seed}, form {i}");
+            }
+        }
+    }
+
+    /// A contiguous chunk with dead lanes against its live constraints projected one at a
+    /// time: the same bits, and the dead lanes' particles keep theirs.
+    fn holey<const D: bool, const L: bool, const W: usize>(seed: u64, live: u8) {
+        let mut rnd = rng(seed);
+        let (gap, n) = (11usize, 11 + LANES + 2);
+        let mut f = |scale: f64| -> Vec<f32> { (0..n).map(|_| (rnd() * scale) as f32).collect() };
+        let base: [Vec<f32>; 3] = [f(1.0), f(1.0), f(1.0)];
+        let disp: [Vec<f32>; 3] = [f(1e-2), f(1e-2), f(1e-2)];
+        let motion: [Vec<f32>; 3] = [f(1e-2), f(1e-2), f(1e-2)];
+        let w: Vec<f32> = f(1.0).iter().map(|v| v.abs() + 0.5).collect();
+        let mut pairs = Pairs::default();
+        for l in 0..LANES {
+            let p = (1 + l) as u32;
+            let alive = live & (1 << l) != 0;
+            pairs.push_f32(p, p + gap as u32, 0.3 + 0.01 * l as f32, 0, alive);
+        }
+        for lam in pairs.lambda.iter_mut() {
+            *lam = if L { 0.2 } else { 0.0 };
+        }
+        let coef = [Coef {
+            k: 1.0,
+            alpha: if L { 0.05 } else { 0.0 },
+            gamma: if D { 0.2 } else { 0.0 },
+        }];
+        let chunk = Chunk {
+            start: 0,
+            layout: Layout::Contiguous,
+            uniform: true,
+            same_rest: false,
+            p0: 1,
+            q0: 1 + gap as u32,
+            group: 0,
+            rest: pairs.rest[0],
+            live,
+        };
+        let mut chunked = disp.clone();
+        let mut one_by_one = disp.clone();
+        {
+            let [d0, d1, d2] = &mut chunked;
+            let mut v = View {
+                base: [&base[0][..], &base[1][..], &base[2][..]],
+                disp: [&mut d0[..], &mut d1[..], &mut d2[..]],
+                motion: [&motion[0][..], &motion[1][..], &motion[2][..]],
+                w: &w[..],
+            };
+            let mut pr = pairs.clone();
+            project_laid_out::<D, L, true, 0, W>(&chunk, &mut pr, &mut v, &coef);
+        }
+        {
+            let [d0, d1, d2] = &mut one_by_one;
+            let mut v = View {
+                base: [&base[0][..], &base[1][..], &base[2][..]],
+                disp: [&mut d0[..], &mut d1[..], &mut d2[..]],
+                motion: [&motion[0][..], &motion[1][..], &motion[2][..]],
+                w: &w[..],
+            };
+            let mut pr = pairs.clone();
+            for k in (0..LANES).filter(|&k| pr.live[k]) {
+                let (p, q) = ([pr.p[k]], [pr.q[k]]);
+                let rest = [pr.rest[k]];
+                project_part::<D, L, true, GATHERED, 1>(
+                    &mut v,
+                    &mut pr.lambda[k..k + 1],
+                    (&p, &q, 0),
+                    &rest,
+                    &Coefs::splat(coef[0]),
+                    ALL_LIVE,
+                );
+            }
+        }
+        let bits =
+            |d: &[Vec<f32>; 3]| -> Vec<u32> { d.iter().flatten().map(|v| v.to_bits()).collect() };
+        assert_eq!(
+            bits(&chunked),
+            bits(&one_by_one),
+            "seed {seed}, live {live:#010b}"
+        );
+        assert_ne!(bits(&chunked), bits(&disp), "seed {seed}: nothing moved");
+        for l in (0..LANES).filter(|l| live & (1 << l) == 0) {
+            for i in [1 + l, 1 + l + gap] {
+                for a in 0..3 {
+                    assert_eq!(
+                        chunked[a][i].to_bits(),
+                        disp[a][i].to_bits(),
+                        "dead lane {l}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_chunks_dead_lanes_write_back_what_they_read_and_its_live_ones_project() {
+        for seed in 1..6 {
+            for live in [0b0111_1111, 0b1000_0001, 0b0101_0110] {
+                holey::<false, false, 8>(seed, live);
+                holey::<false, true, 4>(seed, live);
+                holey::<true, true, 8>(seed, live);
+                holey::<true, false, 2>(seed, live);
             }
         }
     }
