@@ -310,20 +310,42 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
         let (g, wv, drag) = (f.gravity[a], f.wind.velocity[a], f.wind.drag);
         let (x, v, prev) = (&mut dom.x[a][..], &mut dom.v[a][..], &mut dom.prev[a][..]);
         let (x, v, prev) = (&mut x[..w.len()], &mut v[..w.len()], &mut prev[..w.len()]);
-        if let Some(finish) = finish {
-            end_velocities(x, prev, v, w, finish);
-        }
-        // Each value read once into a local: reading `v[i]` again in the selects made the
-        // compiler load it with a masked load.
-        for i in 0..w.len() {
-            let (x0, v0) = (x[i], v[i]);
-            prev[i] = x0;
+        // The prediction from velocity v0 (semi-implicit Euler): the new position, and the
+        // velocity to keep (both kept as they were for a pinned particle).
+        let predict = |x0: f64, v0: f64, free: bool| {
             let acc = g + drag * (wv - v0);
             let vi = v0 + acc * h;
             let xi = x0 + vi * h;
-            let free = w[i] > 0.0;
-            v[i] = if free { vi } else { v0 };
-            x[i] = if free { xi } else { x0 };
+            if free { (xi, vi) } else { (x0, v0) }
+        };
+        match finish {
+            // One pass ending the previous substep and predicting the next: v = (x − x_prev)/h
+            // and the damping as `end_velocities` computes them, kept in a register. The
+            // velocity array is not written: the next substep, or the frame's end, computes it
+            // again from the positions before anything reads it.
+            Some(finish) => {
+                let keep = finish.keep.unwrap_or(1.0);
+                for i in 0..w.len() {
+                    let (x0, free) = (x[i], w[i] > 0.0);
+                    let mut v0 = (x0 - prev[i]) * finish.inv_h;
+                    if finish.keep.is_some() {
+                        v0 *= if free { keep } else { 1.0 };
+                    }
+                    prev[i] = x0;
+                    x[i] = predict(x0, v0, free).0;
+                }
+            }
+            None => {
+                // Each value read once into a local: reading `v[i]` again in the selects made
+                // the compiler load it with a masked load.
+                for i in 0..w.len() {
+                    let (x0, v0) = (x[i], v[i]);
+                    prev[i] = x0;
+                    let (xi, vi) = predict(x0, v0, w[i] > 0.0);
+                    v[i] = vi;
+                    x[i] = xi;
+                }
+            }
         }
     }
 }

@@ -219,7 +219,11 @@ fn ragged_rows_chunk_with_dead_lanes_that_touch_no_live_lanes_particle() {
             let lanes = c.start..c.start + LANES;
             let live: Vec<bool> = lanes.clone().map(|k| d.pairs.live[k]).collect();
             for (l, &alive) in live.iter().enumerate() {
-                assert_eq!(alive, c.live & (1 << l) != 0, "chunk mask and entries agree");
+                assert_eq!(
+                    alive,
+                    c.live & (1 << l) != 0,
+                    "chunk mask and entries agree"
+                );
             }
             assert!(live[0], "a chunk starts with a constraint");
             if live.iter().all(|&a| a) {
@@ -234,7 +238,10 @@ fn ragged_rows_chunk_with_dead_lanes_that_touch_no_live_lanes_particle() {
                 .collect();
             for k in lanes.filter(|&k| !d.pairs.live[k]) {
                 let (p, q) = (d.pairs.p[k], d.pairs.q[k]);
-                assert!(!touched.contains(&p) && !touched.contains(&q), "dead lane {k}");
+                assert!(
+                    !touched.contains(&p) && !touched.contains(&q),
+                    "dead lane {k}"
+                );
                 assert!((q as usize) < d.len());
             }
         }
