@@ -93,8 +93,27 @@ pub(super) struct Rebased {
     pub disp: [Vec<f32>; 3],
     /// x − x_prev at the sweep's start, per axis (filled only for damped sweeps).
     pub motion: [Vec<f32>; 3],
-    /// Inverse masses rounded to f32.
+    /// Inverse masses rounded to f32 (converted wherever the domain's inverse masses are set).
     pub w: Vec<f32>,
+    /// The origin `base` is relative to, per axis (m): the first particle's position at the
+    /// substep's start for the substep's first sweep, its current position for later ones.
+    pub origin: [f64; 3],
+    /// The origin the next rebase takes, when the caller knows the substep's start (the
+    /// general loop's first sweep of a substep), so that it rounds as the fused integration
+    /// does.
+    pub next_origin: Option<[f64; 3]>,
+    /// `base` holds the positions and `disp` is zero: the fused integration rebased them while
+    /// it predicted, so the sweep that follows starts without a pass of its own.
+    pub fresh: bool,
+}
+
+impl Rebased {
+    /// Rounds the inverse masses `w` for the sweep.
+    pub(super) fn set_masses(&mut self, w: &[f64]) {
+        for (w32, &w) in self.w.iter_mut().zip(w) {
+            *w32 = w as f32;
+        }
+    }
 }
 
 /// A domain's share of the global particle arrays.
@@ -145,6 +164,7 @@ impl Domain {
             }
         }
         self.w.copy_from_slice(aos.w);
+        self.work.set_masses(aos.w);
     }
 
     /// Copies positions (and, when `prev` is given, previous positions) in.
@@ -162,6 +182,8 @@ impl Domain {
             }
         }
         self.w.copy_from_slice(w);
+        self.work.set_masses(w);
+        self.work.fresh = false;
     }
 
     /// Copies positions back out.
@@ -196,13 +218,16 @@ impl Domain {
     pub fn integrate(&mut self, step: &Integration<'_>, finish: Option<Finish>, lambda: bool) {
         advance(self, step, finish);
         let range = self.start..self.start + self.len();
+        let origin = self.work.origin;
         for &(i, p) in step.pins {
             if range.contains(&i) {
                 for a in 0..3 {
                     self.x[a][i - self.start] = p[a];
+                    self.work.base[a][i - self.start] = (p[a] - origin[a]) as f32;
                 }
             }
         }
+        self.work.fresh = true;
         if lambda {
             self.pairs.lambda.fill(0.0);
         }
@@ -306,10 +331,19 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
     let h = step.h;
     let f = step.forces;
     let w = &dom.w[..];
+    let n = w.len();
     for a in 0..3 {
         let (g, wv, drag) = (f.gravity[a], f.wind.velocity[a], f.wind.drag);
-        let (x, v, prev) = (&mut dom.x[a][..], &mut dom.v[a][..], &mut dom.prev[a][..]);
-        let (x, v, prev) = (&mut x[..w.len()], &mut v[..w.len()], &mut prev[..w.len()]);
+        let (x, v, prev) = (
+            &mut dom.x[a][..n],
+            &mut dom.v[a][..n],
+            &mut dom.prev[a][..n],
+        );
+        // The sweep's f32 state (see `Rebased`), relative to the first particle's position
+        // at the substep's start.
+        let origin = x.first().copied().unwrap_or(0.0);
+        dom.work.origin[a] = origin;
+        let (base, disp) = (&mut dom.work.base[a][..n], &mut dom.work.disp[a][..n]);
         // The prediction from velocity v0 (semi-implicit Euler): the new position, and the
         // velocity to keep (both kept as they were for a pinned particle).
         let predict = |x0: f64, v0: f64, free: bool| {
@@ -325,25 +359,30 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
             // again from the positions before anything reads it.
             Some(finish) => {
                 let keep = finish.keep.unwrap_or(1.0);
-                for i in 0..w.len() {
+                for i in 0..n {
                     let (x0, free) = (x[i], w[i] > 0.0);
                     let mut v0 = (x0 - prev[i]) * finish.inv_h;
                     if finish.keep.is_some() {
                         v0 *= if free { keep } else { 1.0 };
                     }
                     prev[i] = x0;
-                    x[i] = predict(x0, v0, free).0;
+                    let xi = predict(x0, v0, free).0;
+                    x[i] = xi;
+                    base[i] = (xi - origin) as f32;
+                    disp[i] = 0.0;
                 }
             }
             None => {
                 // Each value read once into a local: reading `v[i]` again in the selects made
                 // the compiler load it with a masked load.
-                for i in 0..w.len() {
+                for i in 0..n {
                     let (x0, v0) = (x[i], v[i]);
                     prev[i] = x0;
                     let (xi, vi) = predict(x0, v0, w[i] > 0.0);
                     v[i] = vi;
                     x[i] = xi;
+                    base[i] = (xi - origin) as f32;
+                    disp[i] = 0.0;
                 }
             }
         }

@@ -269,10 +269,12 @@ impl Domains {
         let (xs, n) = (&*x, x.len());
         self.project_with(|d, index| {
             let r = index * size..((index + 1) * size).min(n);
-            d.load_positions(&xs[r.clone()], damped.then_some(&prev[r.clone()]), &w[r]);
             if fresh {
                 d.pairs.lambda.fill(0.0);
+                // The substep's first sweep rebases where the fused integration does.
+                d.work.next_origin = prev.get(r.start).map(|p| p.to_array());
             }
+            d.load_positions(&xs[r.clone()], damped.then_some(&prev[r.clone()]), &w[r]);
         });
         self.list
             .par_iter_mut()

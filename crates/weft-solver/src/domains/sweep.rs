@@ -84,6 +84,7 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
         disp: [d0, d1, d2],
         motion: [m0, m1, m2],
         w,
+        ..
     } = work;
     let work = &mut View {
         base: [&b0[..n], &b1[..n], &b2[..n]],
@@ -124,8 +125,10 @@ struct View<'a> {
 /// The layout number of [`Layout::Gathered`] (one load per lane), as `project_part` takes it.
 const GATHERED: u8 = 5;
 
-/// Starts a sweep: the domain's positions rebased to f32 (see [`Rebased`]), relative to its
-/// first particle, with no displacement yet; for a damped sweep also x − x_prev.
+/// Starts a sweep: unless the fused integration just did it, the domain's positions rebased
+/// to f32 (see [`Rebased`]) with no displacement yet, relative to the origin the caller gave
+/// (the first particle's position at the substep's start, as the integration takes it) or else
+/// the first particle's position; for a damped sweep also x − x_prev.
 #[inline(always)]
 fn rebase<const DAMPED: bool>(dom: &mut Domain) {
     let n = dom.len();
@@ -133,15 +136,21 @@ fn rebase<const DAMPED: bool>(dom: &mut Domain) {
         base,
         disp,
         motion,
-        w,
+        origin,
+        next_origin,
+        fresh,
+        ..
     } = &mut dom.work;
+    let given = next_origin.take();
     for a in 0..3 {
         let x = &dom.x[a][..n];
-        let origin = x.first().copied().unwrap_or(0.0);
-        let (b, d) = (&mut base[a][..n], &mut disp[a][..n]);
-        for i in 0..n {
-            b[i] = (x[i] - origin) as f32;
-            d[i] = 0.0;
+        if !*fresh {
+            origin[a] = given.map_or_else(|| x.first().copied().unwrap_or(0.0), |o| o[a]);
+            let (b, d) = (&mut base[a][..n], &mut disp[a][..n]);
+            for i in 0..n {
+                b[i] = (x[i] - origin[a]) as f32;
+                d[i] = 0.0;
+            }
         }
         if DAMPED {
             let (prev, m) = (&dom.prev[a][..n], &mut motion[a][..n]);
@@ -150,9 +159,7 @@ fn rebase<const DAMPED: bool>(dom: &mut Domain) {
             }
         }
     }
-    for (w32, &w) in w[..n].iter_mut().zip(&dom.w[..n]) {
-        *w32 = w as f32;
-    }
+    *fresh = false;
 }
 
 /// Ends a sweep: the displacement it accumulated added to the f64 positions (each f32 widens

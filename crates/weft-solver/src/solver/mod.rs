@@ -439,6 +439,14 @@ impl Solver {
         Ok(stats)
     }
 
+    /// Whether a frame of this solver runs fused (integration, sweep and contacts inside the
+    /// domains' parallel regions) when its hook allows it; false when a constraint family or
+    /// force that only the general loop handles is present (dihedral, isometric, tethers,
+    /// seams, aerodynamics).
+    pub fn runs_fused(&self) -> bool {
+        self.fusable()
+    }
+
     /// Whether a frame can run fused (see [`Solver::step_with`]).
     fn fusable(&self) -> bool {
         self.forces.wind.aero.is_none()

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::flag::{flag_settings, in_pool, state_bits, step, windy_flag};
+use common::flag::{flag_settings, fusable_flag, in_pool, state_bits, step};
 use common::*;
 use weft_solver::glam::DVec3;
 use weft_solver::{
@@ -87,7 +87,7 @@ fn results_are_bit_identical_across_thread_counts() {
 /// everything the fused frame handles.
 fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
     in_pool(threads, || {
-        let (mut b, mesh) = windy_flag((40, 40), flag_settings(method, 200));
+        let (mut b, mesh) = fusable_flag((40, 40), flag_settings(method, 200));
         b.add_kinematic_pin(
             0,
             0,
@@ -97,6 +97,7 @@ fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
         )
         .expect("valid pin");
         let mut s = b.build();
+        assert!(s.runs_fused(), "the fused side really runs fused");
         assert!(s.domain_stats().domains > 1 && s.domain_stats().links > 0);
         let corner = 40 * 40 - 1;
         for frame in 0..30 {

@@ -6,7 +6,7 @@ use crate::common;
 
 use std::sync::{Arc, Mutex};
 
-use common::flag::{flag_settings, in_pool, state_bits, step, windy_flag};
+use common::flag::{flag_settings, fusable_flag, in_pool, state_bits, step, windy_flag};
 use weft_solver::glam::{DQuat, DVec3};
 use weft_solver::{Method, Particles, PinDriver, Solver, SolverError, SubstepContext, SubstepHook};
 
@@ -105,8 +105,9 @@ fn driven_particles_follow_their_driver_every_substep() {
 fn driven_pins_run_the_same_fused_and_general() {
     let run = |threads: usize, general: bool| {
         in_pool(threads, || {
-            let (b, _) = windy_flag((40, 40), flag_settings(Method::Xpbd, 200));
+            let (b, _) = fusable_flag((40, 40), flag_settings(Method::Xpbd, 200));
             let mut s = b.build();
+            assert!(s.runs_fused(), "the fused side really runs fused");
             assert!(s.domain_stats().domains > 1);
             s.add_pin_driver(turntable(&s)).expect("valid driver");
             for _ in 0..20 {

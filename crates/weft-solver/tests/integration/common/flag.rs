@@ -36,13 +36,27 @@ pub fn flag_settings(method: Method, domain_size: usize) -> Settings {
 /// stretch, in 3 m/s linear wind (drag 0.2) with global damping 0.1: the builder holding it
 /// (add pins before building) and its mesh.
 pub fn windy_flag(resolution: (usize, usize), settings: Settings) -> (SolverBuilder, ClothMesh) {
+    flag_with(resolution, settings, true)
+}
+
+/// [`windy_flag`] without dihedral bending, which only the general loop handles: its frames
+/// run fused unless a hook asks otherwise.
+pub fn fusable_flag(resolution: (usize, usize), settings: Settings) -> (SolverBuilder, ClothMesh) {
+    flag_with(resolution, settings, false)
+}
+
+fn flag_with(
+    resolution: (usize, usize),
+    settings: Settings,
+    dihedral: bool,
+) -> (SolverBuilder, ClothMesh) {
     let mesh = super::top_pinned_grid(resolution);
     let params = ClothParams::default()
         .edit(Family::BendDistance, |p| p.enabled = true)
         // Dihedral bending too, damped: its own lane kernel (AVX-512, AVX2 and portable
         // vectors, and one lane for the rest) must give the same bits on every path.
         .edit(Family::BendDihedral, |p| {
-            p.enabled = true;
+            p.enabled = dihedral;
             p.compliance = 1e-3;
             p.damping = 0.1;
         })
