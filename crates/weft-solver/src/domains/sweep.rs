@@ -495,21 +495,61 @@ mod tests {
     use super::*;
     use crate::test_rand::rng;
 
+    /// A domain's rebased state for a chunk test: random bases, displacements and motions of
+    /// `n` particles, positive inverse masses.
+    struct State {
+        base: [Vec<f32>; 3],
+        disp: [Vec<f32>; 3],
+        motion: [Vec<f32>; 3],
+        w: Vec<f32>,
+    }
+
+    impl State {
+        fn random(seed: u64, n: usize) -> Self {
+            let mut rnd = rng(seed);
+            let mut f =
+                |scale: f64| -> Vec<f32> { (0..n).map(|_| (rnd() * scale) as f32).collect() };
+            let base = [f(1.0), f(1.0), f(1.0)];
+            let disp = [f(1e-2), f(1e-2), f(1e-2)];
+            let motion = [f(1e-2), f(1e-2), f(1e-2)];
+            let w = f(1.0).iter().map(|v| v.abs() + 0.5).collect();
+            Self {
+                base,
+                disp,
+                motion,
+                w,
+            }
+        }
+
+        /// Runs `f` on a view of the state with its own copy of the displacements; returns
+        /// them.
+        fn run(&self, f: impl FnOnce(&mut View<'_>)) -> [Vec<f32>; 3] {
+            let mut d = self.disp.clone();
+            let [d0, d1, d2] = &mut d;
+            let (b, m) = (&self.base, &self.motion);
+            f(&mut View {
+                base: [&b[0][..], &b[1][..], &b[2][..]],
+                disp: [&mut d0[..], &mut d1[..], &mut d2[..]],
+                motion: [&m[0][..], &m[1][..], &m[2][..]],
+                w: &self.w[..],
+            });
+            d
+        }
+    }
+
+    fn bits(d: &[Vec<f32>; 3]) -> Vec<u32> {
+        d.iter().flatten().map(|v| v.to_bits()).collect()
+    }
+
     /// Runs one paired chunk of 16 particles through `project_paired` and through the lane
     /// kernel's de-interleaving path; returns both results' bits (displacements, multipliers).
     fn both<const D: bool, const L: bool, const U: bool, const W: usize>(
         seed: u64,
         live: u8,
     ) -> [(Vec<u32>, Vec<u32>); 3] {
-        let mut rnd = rng(seed);
-        let n = 2 * LANES + 3;
-        let mut f = |scale: f64| -> Vec<f32> { (0..n).map(|_| (rnd() * scale) as f32).collect() };
-        let base: [Vec<f32>; 3] = [f(1.0), f(1.0), f(1.0)];
-        let disp: [Vec<f32>; 3] = [f(1e-2), f(1e-2), f(1e-2)];
-        let motion: [Vec<f32>; 3] = [f(1e-2), f(1e-2), f(1e-2)];
-        // One pinned particle (w = 0) and otherwise positive inverse masses.
-        let mut w: Vec<f32> = f(1.0).iter().map(|v| v.abs() + 0.5).collect();
-        w[4] = 0.0;
+        let mut state = State::random(seed, 2 * LANES + 3);
+        // One pinned particle (w = 0).
+        state.w[4] = 0.0;
         let first = 1usize;
         let mut pairs = Pairs::default();
         for l in 0..LANES {
@@ -538,24 +578,17 @@ mod tests {
             live,
         };
         let run = |paired: bool| {
-            let mut d = disp.clone();
             let mut pr = pairs.clone();
-            let [d0, d1, d2] = &mut d;
-            let mut view = View {
-                base: [&base[0][..], &base[1][..], &base[2][..]],
-                disp: [&mut d0[..], &mut d1[..], &mut d2[..]],
-                motion: [&motion[0][..], &motion[1][..], &motion[2][..]],
-                w: &w[..],
-            };
-            if paired {
-                project_paired::<D, L, U, W>(&chunk, &mut pr, &mut view, &coef);
-            } else {
-                project_laid_out::<D, L, U, 1, W>(&chunk, &mut pr, &mut view, &coef);
-            }
-            let bits = d.iter().flatten().map(|v| v.to_bits()).collect();
-            (bits, pr.lambda.iter().map(|v| v.to_bits()).collect())
+            let d = state.run(|view| {
+                if paired {
+                    project_paired::<D, L, U, W>(&chunk, &mut pr, view, &coef);
+                } else {
+                    project_laid_out::<D, L, U, 1, W>(&chunk, &mut pr, view, &coef);
+                }
+            });
+            (bits(&d), pr.lambda.iter().map(|v| v.to_bits()).collect())
         };
-        let before = disp.iter().flatten().map(|v| v.to_bits()).collect();
+        let before = bits(&state.disp);
         [run(true), run(false), (before, Vec::new())]
     }
 
@@ -584,13 +617,8 @@ mod tests {
     /// A contiguous chunk with dead lanes against its live constraints projected one at a
     /// time: the same bits, and the dead lanes' particles keep theirs.
     fn holey<const D: bool, const L: bool, const W: usize>(seed: u64, live: u8) {
-        let mut rnd = rng(seed);
-        let (gap, n) = (11usize, 11 + LANES + 2);
-        let mut f = |scale: f64| -> Vec<f32> { (0..n).map(|_| (rnd() * scale) as f32).collect() };
-        let base: [Vec<f32>; 3] = [f(1.0), f(1.0), f(1.0)];
-        let disp: [Vec<f32>; 3] = [f(1e-2), f(1e-2), f(1e-2)];
-        let motion: [Vec<f32>; 3] = [f(1e-2), f(1e-2), f(1e-2)];
-        let w: Vec<f32> = f(1.0).iter().map(|v| v.abs() + 0.5).collect();
+        let gap = 11usize;
+        let state = State::random(seed, gap + LANES + 2);
         let mut pairs = Pairs::default();
         for l in 0..LANES {
             let p = (1 + l) as u32;
@@ -616,33 +644,17 @@ mod tests {
             rest: pairs.rest[0],
             live,
         };
-        let mut chunked = disp.clone();
-        let mut one_by_one = disp.clone();
-        {
-            let [d0, d1, d2] = &mut chunked;
-            let mut v = View {
-                base: [&base[0][..], &base[1][..], &base[2][..]],
-                disp: [&mut d0[..], &mut d1[..], &mut d2[..]],
-                motion: [&motion[0][..], &motion[1][..], &motion[2][..]],
-                w: &w[..],
-            };
+        let chunked = state.run(|view| {
             let mut pr = pairs.clone();
-            project_laid_out::<D, L, true, 0, W>(&chunk, &mut pr, &mut v, &coef);
-        }
-        {
-            let [d0, d1, d2] = &mut one_by_one;
-            let mut v = View {
-                base: [&base[0][..], &base[1][..], &base[2][..]],
-                disp: [&mut d0[..], &mut d1[..], &mut d2[..]],
-                motion: [&motion[0][..], &motion[1][..], &motion[2][..]],
-                w: &w[..],
-            };
+            project_laid_out::<D, L, true, 0, W>(&chunk, &mut pr, view, &coef);
+        });
+        let one_by_one = state.run(|view| {
             let mut pr = pairs.clone();
             for k in (0..LANES).filter(|&k| pr.live[k]) {
                 let (p, q) = ([pr.p[k]], [pr.q[k]]);
                 let rest = [pr.rest[k]];
                 project_part::<D, L, true, GATHERED, 1>(
-                    &mut v,
+                    view,
                     &mut pr.lambda[k..k + 1],
                     (&p, &q, 0),
                     &rest,
@@ -650,21 +662,23 @@ mod tests {
                     ALL_LIVE,
                 );
             }
-        }
-        let bits =
-            |d: &[Vec<f32>; 3]| -> Vec<u32> { d.iter().flatten().map(|v| v.to_bits()).collect() };
+        });
         assert_eq!(
             bits(&chunked),
             bits(&one_by_one),
             "seed {seed}, live {live:#010b}"
         );
-        assert_ne!(bits(&chunked), bits(&disp), "seed {seed}: nothing moved");
+        assert_ne!(
+            bits(&chunked),
+            bits(&state.disp),
+            "seed {seed}: nothing moved"
+        );
         for l in (0..LANES).filter(|l| live & (1 << l) == 0) {
             for i in [1 + l, 1 + l + gap] {
                 for a in 0..3 {
                     assert_eq!(
                         chunked[a][i].to_bits(),
-                        disp[a][i].to_bits(),
+                        state.disp[a][i].to_bits(),
                         "dead lane {l}"
                     );
                 }
