@@ -79,8 +79,9 @@ pub(crate) struct Domain {
 }
 
 /// A domain's positions as the sweep sees them, in f32: each particle at `base + disp`
-/// relative to the domain's origin (its first particle's position when the sweep starts).
-/// `base` is rounded once per sweep and never changes during it; the sweep's corrections
+/// relative to the domain's origin (its first particle's position at the substep's start for
+/// the substep's first sweep, written by the fused integration as it predicts; its position
+/// when a later sweep starts). `base` is rounded once per sweep and never changes during it; the sweep's corrections
 /// accumulate in `disp`, small numbers kept to f32's relative precision, and are added to the
 /// f64 positions when it ends. So f32 rounding moves where a constraint is evaluated by at most
 /// half an ulp of the particle's distance from the origin, but never the f64 state the
