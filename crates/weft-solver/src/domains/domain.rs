@@ -28,26 +28,23 @@ pub(super) struct Pairs {
     pub rest: Vec<f32>,
     /// Parameter group.
     pub group: Vec<u32>,
-    /// XPBD multiplier.
+    /// XPBD multiplier (a chunk's dead lane, see `Chunk::live`, has an entry whose multiplier
+    /// means nothing).
     pub lambda: Vec<f32>,
-    /// Whether the entry is a constraint; a chunk's dead lane (see `Chunk::live`) holds an
-    /// entry that is not.
-    pub live: Vec<bool>,
 }
 
 impl Pairs {
     pub(super) fn push(&mut self, p: u32, q: u32, rest: f64, group: u32) {
-        self.push_f32(p, q, rest as f32, group, true);
+        self.push_f32(p, q, rest as f32, group);
     }
 
-    /// Appends an entry with its rest length already in f32; `live` false for a dead lane.
-    pub(super) fn push_f32(&mut self, p: u32, q: u32, rest: f32, group: u32, live: bool) {
+    /// Appends an entry with its rest length already in f32.
+    pub(super) fn push_f32(&mut self, p: u32, q: u32, rest: f32, group: u32) {
         self.p.push(p);
         self.q.push(q);
         self.rest.push(rest);
         self.group.push(group);
         self.lambda.push(0.0);
-        self.live.push(live);
     }
 }
 
@@ -81,11 +78,12 @@ pub(crate) struct Domain {
 /// A domain's positions as the sweep sees them, in f32: each particle at `base + disp`
 /// relative to the domain's origin (its first particle's position at the substep's start for
 /// the substep's first sweep, written by the fused integration as it predicts; its position
-/// when a later sweep starts). `base` is rounded once per sweep and never changes during it; the sweep's corrections
-/// accumulate in `disp`, small numbers kept to f32's relative precision, and are added to the
-/// f64 positions when it ends. So f32 rounding moves where a constraint is evaluated by at most
-/// half an ulp of the particle's distance from the origin, but never the f64 state the
-/// integration reads (f32 positions would bias XPBD's equilibrium: see the README).
+/// when a later sweep starts). `base` is rounded once per sweep and never changes during it;
+/// the sweep's corrections accumulate in `disp`, small numbers kept to f32's relative
+/// precision, and are added to the f64 positions when it ends. So f32 rounding moves where a
+/// constraint is evaluated by at most half an ulp of the particle's distance from the origin,
+/// but never the f64 state the integration reads (f32 positions would bias XPBD's
+/// equilibrium: see the README).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rebased {
     /// Position at the sweep's start relative to the origin, per axis, rounded to f32.
@@ -276,20 +274,27 @@ pub(crate) struct Finish {
     pub keep: Option<f64>,
 }
 
-/// One axis of the PBD velocity update v = (x − x_prev)/h, then global damping v ← v·keep of
-/// free particles — the solver's general loop does the same arithmetic.
+impl Finish {
+    /// One particle's PBD velocity update v = (x − x_prev)/h, then global damping v ← v·keep
+    /// if it is free — the solver's general loop does the same arithmetic. v · 1 = v exactly:
+    /// a factor chosen per particle keeps the store unconditional, where a kept value became a
+    /// masked store (microcoded on AMD).
+    #[inline(always)]
+    fn velocity(&self, x: f64, prev: f64, free: bool) -> f64 {
+        let v = (x - prev) * self.inv_h;
+        match self.keep {
+            Some(keep) => v * if free { keep } else { 1.0 },
+            None => v,
+        }
+    }
+}
+
+/// One axis of [`Finish::velocity`].
 #[inline(always)]
 fn end_velocities(x: &[f64], prev: &[f64], v: &mut [f64], w: &[f64], finish: Finish) {
     let (x, prev, v) = (&x[..w.len()], &prev[..w.len()], &mut v[..w.len()]);
     for i in 0..w.len() {
-        v[i] = (x[i] - prev[i]) * finish.inv_h;
-    }
-    if let Some(keep) = finish.keep {
-        // v · 1 = v exactly: a factor chosen per particle keeps the store unconditional, where
-        // a kept value became a masked store (microcoded on AMD).
-        for i in 0..w.len() {
-            v[i] *= if w[i] > 0.0 { keep } else { 1.0 };
-        }
+        v[i] = finish.velocity(x[i], prev[i], w[i] > 0.0);
     }
 }
 
@@ -354,18 +359,14 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
             if free { (xi, vi) } else { (x0, v0) }
         };
         match finish {
-            // One pass ending the previous substep and predicting the next: v = (x − x_prev)/h
-            // and the damping as `end_velocities` computes them, kept in a register. The
-            // velocity array is not written: the next substep, or the frame's end, computes it
-            // again from the positions before anything reads it.
+            // One pass ending the previous substep and predicting the next: the velocity
+            // update and damping (`Finish::velocity`) kept in a register. The velocity array
+            // is not written: the next substep, or the frame's end, computes it again from the
+            // positions before anything reads it.
             Some(finish) => {
-                let keep = finish.keep.unwrap_or(1.0);
                 for i in 0..n {
                     let (x0, free) = (x[i], w[i] > 0.0);
-                    let mut v0 = (x0 - prev[i]) * finish.inv_h;
-                    if finish.keep.is_some() {
-                        v0 *= if free { keep } else { 1.0 };
-                    }
+                    let v0 = finish.velocity(x0, prev[i], free);
                     prev[i] = x0;
                     let xi = predict(x0, v0, free).0;
                     x[i] = xi;

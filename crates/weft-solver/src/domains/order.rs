@@ -98,9 +98,8 @@ impl Domain {
                 let ahead = &set[i..];
                 let full = (ahead.len() >= LANES)
                     .then(|| {
-                        let k = &ahead[..LANES];
-                        let p: Vec<u32> = k.iter().map(|&k| old.p[k]).collect();
-                        let q: Vec<u32> = k.iter().map(|&k| old.q[k]).collect();
+                        let p: [u32; LANES] = std::array::from_fn(|l| old.p[ahead[l]]);
+                        let q: [u32; LANES] = std::array::from_fn(|l| old.q[ahead[l]]);
                         structured_layout(&p, &q)
                     })
                     .flatten();
@@ -124,7 +123,7 @@ impl Domain {
             let tail = self.pairs.p.len();
             for &k in rest.remainder() {
                 let pairs = &mut self.pairs;
-                pairs.push_f32(old.p[k], old.q[k], old.rest[k], old.group[k], true);
+                pairs.push_f32(old.p[k], old.q[k], old.rest[k], old.group[k]);
             }
             self.colours.push(begin..self.pairs.p.len());
             self.plan.push((first..self.chunks.len(), tail));
@@ -152,12 +151,11 @@ impl Domain {
                     live |= 1 << l;
                     let k = *k;
                     self.pairs
-                        .push_f32(old.p[k], old.q[k], old.rest[k], old.group[k], true);
+                        .push_f32(old.p[k], old.q[k], old.rest[k], old.group[k]);
                 }
                 (None, Some(slots)) => {
                     let (p, q) = slots[l];
-                    self.pairs
-                        .push_f32(p, q, old.rest[lead], old.group[lead], false);
+                    self.pairs.push_f32(p, q, old.rest[lead], old.group[lead]);
                 }
                 (None, None) => unreachable!("a dead lane comes with its window's particles"),
             }

@@ -622,8 +622,7 @@ mod tests {
         let mut pairs = Pairs::default();
         for l in 0..LANES {
             let p = (1 + l) as u32;
-            let alive = live & (1 << l) != 0;
-            pairs.push_f32(p, p + gap as u32, 0.3 + 0.01 * l as f32, 0, alive);
+            pairs.push_f32(p, p + gap as u32, 0.3 + 0.01 * l as f32, 0);
         }
         for lam in pairs.lambda.iter_mut() {
             *lam = if L { 0.2 } else { 0.0 };
@@ -650,7 +649,7 @@ mod tests {
         });
         let one_by_one = state.run(|view| {
             let mut pr = pairs.clone();
-            for k in (0..LANES).filter(|&k| pr.live[k]) {
+            for k in (0..LANES).filter(|&k| live & (1 << k) != 0) {
                 let (p, q) = ([pr.p[k]], [pr.q[k]]);
                 let rest = [pr.rest[k]];
                 project_part::<D, L, true, GATHERED, 1>(
