@@ -73,6 +73,9 @@ pub(crate) struct Domain {
     pub(super) plan: Vec<(Range<usize>, usize)>,
     /// The kernel path its sweep and integration run on.
     pub(super) path: SimdPath,
+    /// Local index ranges covering every end of a link (constraints to other domains), in
+    /// order: the links read positions that must have their sweep's displacement added.
+    pub(super) linked: Vec<Range<usize>>,
 }
 
 /// A domain's positions as the sweep sees them, in f32: each particle at `base + disp`
@@ -80,7 +83,8 @@ pub(crate) struct Domain {
 /// the substep's first sweep, written by the fused integration as it predicts; its position
 /// when a later sweep starts). `base` is rounded once per sweep and never changes during it;
 /// the sweep's corrections accumulate in `disp`, small numbers kept to f32's relative
-/// precision, and are added to the f64 positions when it ends. So f32 rounding moves where a
+/// precision, and are added to the f64 positions by the next pass that reads them (see
+/// `unfolded`). So f32 rounding moves where a
 /// constraint is evaluated by at most half an ulp of the particle's distance from the origin,
 /// but never the f64 state the integration reads (f32 positions would bias XPBD's
 /// equilibrium: see the README).
@@ -104,6 +108,11 @@ pub(super) struct Rebased {
     /// `base` holds the positions and `disp` is zero: the fused integration rebased them while
     /// it predicted, so the sweep that follows starts without a pass of its own.
     pub fresh: bool,
+    /// `disp` holds a finished sweep's displacement not yet added to the f64 positions: the
+    /// next reader of the positions adds it first (the integration in its own pass, the links
+    /// particle by particle, anything else through [`Domain::settle`]), so a sweep ends
+    /// without a pass of its own.
+    pub unfolded: bool,
 }
 
 impl Rebased {
@@ -164,6 +173,7 @@ impl Domain {
         }
         self.w.copy_from_slice(aos.w);
         self.work.set_masses(aos.w);
+        self.work.unfolded = false;
     }
 
     /// Copies positions (and, when `prev` is given, previous positions) in.
@@ -183,17 +193,51 @@ impl Domain {
         self.w.copy_from_slice(w);
         self.work.set_masses(w);
         self.work.fresh = false;
+        self.work.unfolded = false;
     }
 
-    /// Copies positions back out.
+    /// Adds the last sweep's displacement to the f64 positions if it is still pending (each
+    /// f32 widens exactly; the sum rounds in f64 like any position update).
+    pub(super) fn settle(&mut self) {
+        if !std::mem::take(&mut self.work.unfolded) {
+            return;
+        }
+        let n = self.len();
+        for a in 0..3 {
+            let (x, d) = (&mut self.x[a][..n], &self.work.disp[a][..n]);
+            for i in 0..n {
+                x[i] += f64::from(d[i]);
+            }
+        }
+    }
+
+    /// [`Self::settle`] for the ends of links alone (see `linked`), as a sweep ends: their
+    /// displacement becomes −0, which adds to any position exactly, so the later settle leaves
+    /// their bits as the links wrote them.
+    #[inline(always)]
+    pub(super) fn settle_linked(&mut self) {
+        for r in &self.linked {
+            for a in 0..3 {
+                let (x, d) = (&mut self.x[a][r.clone()], &mut self.work.disp[a][r.clone()]);
+                for (x, d) in x.iter_mut().zip(d) {
+                    *x += f64::from(*d);
+                    *d = -0.0;
+                }
+            }
+        }
+    }
+
+    /// Copies positions back out (after [`Self::settle`]).
     pub(super) fn store_positions(&self, x: &mut [DVec3]) {
+        debug_assert!(!self.work.unfolded);
         for (i, p) in x.iter_mut().enumerate() {
             *p = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
         }
     }
 
-    /// Copies positions, previous positions and velocities back out.
+    /// Copies positions, previous positions and velocities back out (after [`Self::settle`]).
     pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3]) {
+        debug_assert!(!self.work.unfolded);
         for i in 0..self.len() {
             x[i] = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
             prev[i] = DVec3::new(self.prev[0][i], self.prev[1][i], self.prev[2][i]);
@@ -204,6 +248,7 @@ impl Domain {
     /// The PBD velocity update v = (x − x_prev)/h, then global damping v ← v e^(−c h) of free
     /// particles when `keep` is given — the same arithmetic as the solver's general loop.
     pub fn finish_velocities(&mut self, finish: Finish) {
+        self.settle();
         let w = &self.w[..];
         for a in 0..3 {
             end_velocities(&self.x[a], &self.prev[a], &mut self.v[a], w, finish);
@@ -234,6 +279,7 @@ impl Domain {
 
     /// Resolves the contacts of every free particle (see [`crate::ParticleContacts`]).
     pub fn collide(&mut self, contacts: &dyn ParticleContacts, fresh: bool) -> Contacts {
+        self.settle();
         let n = self.len();
         let [x0, x1, x2] = &mut self.x;
         let [p0, p1, p2] = &self.prev;
@@ -334,6 +380,22 @@ fn advance_scalar(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finis
 
 #[inline(always)]
 fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+    // The last sweep's displacement, if still pending, is added as each position is read.
+    if std::mem::take(&mut dom.work.unfolded) {
+        advance_from::<true>(dom, step, finish);
+    } else {
+        advance_from::<false>(dom, step, finish);
+    }
+}
+
+/// [`advance_body`], adding the pending displacement to each position it reads when
+/// `UNFOLDED`.
+#[inline(always)]
+fn advance_from<const UNFOLDED: bool>(
+    dom: &mut Domain,
+    step: &Integration<'_>,
+    finish: Option<Finish>,
+) {
     let h = step.h;
     let f = step.forces;
     let w = &dom.w[..];
@@ -347,9 +409,16 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
         );
         // The sweep's f32 state (see `Rebased`), relative to the first particle's position
         // at the substep's start.
-        let origin = x.first().copied().unwrap_or(0.0);
-        dom.work.origin[a] = origin;
         let (base, disp) = (&mut dom.work.base[a][..n], &mut dom.work.disp[a][..n]);
+        let at = |x: &[f64], disp: &[f32], i: usize| {
+            if UNFOLDED {
+                x[i] + f64::from(disp[i])
+            } else {
+                x[i]
+            }
+        };
+        let origin = if n > 0 { at(x, disp, 0) } else { 0.0 };
+        dom.work.origin[a] = origin;
         // The prediction from velocity v0 (semi-implicit Euler): the new position, and the
         // velocity to keep (both kept as they were for a pinned particle).
         let predict = |x0: f64, v0: f64, free: bool| {
@@ -365,7 +434,7 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
             // positions before anything reads it.
             Some(finish) => {
                 for i in 0..n {
-                    let (x0, free) = (x[i], w[i] > 0.0);
+                    let (x0, free) = (at(x, disp, i), w[i] > 0.0);
                     let v0 = finish.velocity(x0, prev[i], free);
                     prev[i] = x0;
                     let xi = predict(x0, v0, free).0;
@@ -378,7 +447,7 @@ fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>
                 // Each value read once into a local: reading `v[i]` again in the selects made
                 // the compiler load it with a masked load.
                 for i in 0..n {
-                    let (x0, v0) = (x[i], v[i]);
+                    let (x0, v0) = (at(x, disp, i), v[i]);
                     prev[i] = x0;
                     let (xi, vi) = predict(x0, v0, w[i] > 0.0);
                     v[i] = vi;

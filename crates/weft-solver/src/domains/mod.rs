@@ -31,6 +31,8 @@ mod sweep;
 mod tests;
 mod tree;
 
+use std::ops::Range;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -64,6 +66,20 @@ pub struct DomainStats {
     pub remainder: usize,
     /// The kernel path the domains run on.
     pub simd: SimdPath,
+}
+
+/// Ranges covering the local indices `ends`, in order; indices less than a vector apart share
+/// a range (adding a particle's displacement early gives the same bits).
+fn cover(mut ends: Vec<usize>) -> Vec<Range<usize>> {
+    ends.sort_unstable();
+    let mut ranges: Vec<Range<usize>> = Vec::new();
+    for i in ends {
+        match ranges.last_mut() {
+            Some(r) if i < r.end + LANES => r.end = r.end.max(i + 1),
+            _ => ranges.push(i..i + 1),
+        }
+    }
+    ranges
 }
 
 /// The distance constraints cut into domains, plus the links between them.
@@ -127,6 +143,14 @@ impl Domains {
         }
         for (dom, cons) in list.iter_mut().zip(interior) {
             dom.order(cons);
+        }
+        let mut ends: Vec<Vec<usize>> = vec![Vec::new(); count];
+        for &[(dp, ip), (dq, iq)] in links.iter().flat_map(|set| &set.ends) {
+            ends[dp as usize].push(ip as usize);
+            ends[dq as usize].push(iq as usize);
+        }
+        for (dom, ends) in list.iter_mut().zip(ends) {
+            dom.linked = cover(ends);
         }
         let mut used = Vec::new();
         for &g in &block.group {
@@ -279,7 +303,10 @@ impl Domains {
         self.list
             .par_iter_mut()
             .zip(x.par_chunks_mut(size))
-            .for_each(|(d, x)| d.store_positions(x));
+            .for_each(|(d, x)| {
+                d.settle();
+                d.store_positions(x);
+            });
     }
 
     /// Resolves every free particle's contacts with `contacts` (see

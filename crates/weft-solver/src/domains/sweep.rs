@@ -110,7 +110,11 @@ fn sweep_with<const DAMPED: bool, const LAMBDA: bool, const UNIT_K: bool, const 
             );
         }
     }
-    fold(dom);
+    // The displacement is added to the f64 positions by whatever reads them next (see
+    // `Rebased::unfolded`): usually the next substep's integration, in its own pass. The
+    // links read their ends' positions, so those are added now.
+    dom.settle_linked();
+    dom.work.unfolded = true;
 }
 
 /// A domain's [`Rebased`] arrays cut to its particle count: every slice has the same length,
@@ -131,6 +135,7 @@ const GATHERED: u8 = 5;
 /// the first particle's position; for a damped sweep also x − x_prev.
 #[inline(always)]
 fn rebase<const DAMPED: bool>(dom: &mut Domain) {
+    dom.settle();
     let n = dom.len();
     let Rebased {
         base,
@@ -160,19 +165,6 @@ fn rebase<const DAMPED: bool>(dom: &mut Domain) {
         }
     }
     *fresh = false;
-}
-
-/// Ends a sweep: the displacement it accumulated added to the f64 positions (each f32 widens
-/// exactly; the sum rounds in f64 like any position update).
-#[inline(always)]
-fn fold(dom: &mut Domain) {
-    let n = dom.len();
-    for a in 0..3 {
-        let (x, d) = (&mut dom.x[a][..n], &dom.work.disp[a][..n]);
-        for i in 0..n {
-            x[i] += f64::from(d[i]);
-        }
-    }
 }
 
 #[inline(always)]
