@@ -98,6 +98,8 @@ pub(crate) struct Domains {
     mode: Mode,
     /// Whether each parameter group has a constraint here.
     used: Vec<bool>,
+    /// The next pass visits the domains in reverse order (see `Job::reverse`).
+    reverse: bool,
 }
 
 impl Domains {
@@ -167,6 +169,7 @@ impl Domains {
             coef: Vec::new(),
             mode: Mode::default(),
             used,
+            reverse: false,
         }
     }
 
@@ -263,12 +266,14 @@ impl Domains {
             links,
             coef,
             mode,
+            reverse,
             ..
         } = self;
         let job = Job {
             before: &before,
             coef,
             mode: *mode,
+            reverse: std::mem::replace(reverse, !*reverse),
         };
         fork(list, 0, links, &job);
     }

@@ -46,6 +46,10 @@ pub(super) struct Job<'a, F> {
     pub coef: &'a [Coef],
     /// Which optional terms to evaluate.
     pub mode: Mode,
+    /// Visit the right half of every node first. Alternated from one pass to the next, so a
+    /// thread starts a pass on the domain it ended the last one with, still in its cache; the
+    /// halves share no particle, so their order changes no bit.
+    pub reverse: bool,
 }
 
 /// Solves `doms` (domains `first..`) with their `links` (the subtree's internal nodes, in
@@ -70,10 +74,13 @@ where
     };
     let (left_links, right_links) = below.split_at_mut(mid - 1);
     let (left, right) = doms.split_at_mut(mid);
-    rayon::join(
-        || fork(left, first, left_links, job),
-        || fork(right, first + mid, right_links, job),
-    );
+    let left = || fork(left, first, left_links, job);
+    let right = || fork(right, first + mid, right_links, job);
+    if job.reverse {
+        rayon::join(right, left);
+    } else {
+        rayon::join(left, right);
+    }
     if job.mode.damped {
         project_links::<true>(doms, first, own, job.coef);
     } else {
