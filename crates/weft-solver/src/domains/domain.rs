@@ -84,10 +84,9 @@ pub(crate) struct Domain {
 /// when a later sweep starts). `base` is rounded once per sweep and never changes during it;
 /// the sweep's corrections accumulate in `disp`, small numbers kept to f32's relative
 /// precision, and are added to the f64 positions by the next pass that reads them (see
-/// `unfolded`). So f32 rounding moves where a
-/// constraint is evaluated by at most half an ulp of the particle's distance from the origin,
-/// but never the f64 state the integration reads (f32 positions would bias XPBD's
-/// equilibrium: see the README).
+/// `unfolded`). So f32 rounding moves where a constraint is evaluated by at most half an ulp
+/// of the particle's distance from the origin, but never the f64 state the integration reads
+/// (f32 positions would bias XPBD's equilibrium: see the README).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rebased {
     /// Position at the sweep's start relative to the origin, per axis, rounded to f32.
@@ -109,9 +108,9 @@ pub(super) struct Rebased {
     /// it predicted, so the sweep that follows starts without a pass of its own.
     pub fresh: bool,
     /// `disp` holds a finished sweep's displacement not yet added to the f64 positions: the
-    /// next reader of the positions adds it first (the integration in its own pass, the links
-    /// particle by particle, anything else through [`Domain::settle`]), so a sweep ends
-    /// without a pass of its own.
+    /// next reader of the positions adds it first (the integration in its own pass, anything
+    /// else through [`Domain::settle`]), so a sweep ends without a pass of its own. The ends
+    /// of links are the exception, settled as the sweep ends ([`Domain::settle_linked`]).
     pub unfolded: bool,
 }
 
@@ -202,13 +201,7 @@ impl Domain {
         if !std::mem::take(&mut self.work.unfolded) {
             return;
         }
-        let n = self.len();
-        for a in 0..3 {
-            let (x, d) = (&mut self.x[a][..n], &self.work.disp[a][..n]);
-            for i in 0..n {
-                x[i] += f64::from(d[i]);
-            }
-        }
+        self.fold(0..self.len());
     }
 
     /// [`Self::settle`] for the ends of links alone (see `linked`), as a sweep ends: their
@@ -216,13 +209,22 @@ impl Domain {
     /// their bits as the links wrote them.
     #[inline(always)]
     pub(super) fn settle_linked(&mut self) {
-        for r in &self.linked {
-            for a in 0..3 {
-                let (x, d) = (&mut self.x[a][r.clone()], &mut self.work.disp[a][r.clone()]);
-                for (x, d) in x.iter_mut().zip(d) {
-                    *x += f64::from(*d);
-                    *d = -0.0;
-                }
+        for k in 0..self.linked.len() {
+            let r = self.linked[k].clone();
+            self.fold(r.clone());
+            for d in &mut self.work.disp {
+                d[r.clone()].fill(-0.0);
+            }
+        }
+    }
+
+    /// Adds the displacement of particles `r` to their f64 positions.
+    #[inline(always)]
+    fn fold(&mut self, r: Range<usize>) {
+        for a in 0..3 {
+            let (x, d) = (&mut self.x[a][r.clone()], &self.work.disp[a][r.clone()]);
+            for (x, &d) in x.iter_mut().zip(d) {
+                *x += f64::from(d);
             }
         }
     }
