@@ -9,7 +9,7 @@
 use crate::common;
 
 use common::*;
-use weft_solver::{Forces, Method};
+use weft_solver::{Forces, Method, Settings};
 
 const DT: f64 = 1.0 / 60.0;
 const ALPHA: f64 = 0.03;
@@ -23,18 +23,25 @@ fn sag(
     compliance: f64,
     pbd_stiffness: f64,
 ) -> f64 {
+    let settings = settings(method, dt, substeps, iterations);
+    sag_with(settings, compliance, pbd_stiffness).0
+}
+
+/// [`sag`] with every setting given, and the number of domains the cloth was cut into.
+fn sag_with(settings: Settings, compliance: f64, pbd_stiffness: f64) -> (f64, usize) {
+    let dt = settings.dt;
     let forces = Forces {
         damping: 2.0,
         ..Forces::default()
     };
     let mut s = solver(
-        settings(method, dt, substeps, iterations),
+        settings,
         forces,
         &hanging_grid(16),
         in_plane(compliance, pbd_stiffness, 0.0),
     );
     run(&mut s, (5.0 / dt) as usize);
-    -0.5 - lowest_y(&s)
+    (-0.5 - lowest_y(&s), s.domain_stats().domains)
 }
 
 #[test]
@@ -107,5 +114,26 @@ fn xpbd_sag_does_not_depend_on_the_time_step_but_pbd_sag_does() {
     assert!(
         pbd[0] > 3.0 * pbd[1] && pbd[1] > 3.0 * pbd[2],
         "PBD should stiffen as dt shrinks: {pbd:?}"
+    );
+}
+
+#[test]
+fn xpbd_sag_is_the_same_in_one_domain_and_cut_into_four() {
+    // 256 particles: one domain by default, four of 64 (with links between them) when cut.
+    let base = settings(Method::Xpbd, DT, 5, 20);
+    let (whole, one) = sag_with(base, ALPHA, 1.0);
+    let (cut, four) = sag_with(
+        Settings {
+            domain_size: 64,
+            ..base
+        },
+        ALPHA,
+        1.0,
+    );
+    println!("XPBD sag in one domain {whole:.5} m, in four {cut:.5} m");
+    assert_eq!((one, four), (1, 4), "domain counts");
+    assert!(
+        (cut / whole - 1.0).abs() < 0.001,
+        "the domains' split moved the converged sag: {whole} vs {cut}"
     );
 }
