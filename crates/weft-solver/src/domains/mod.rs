@@ -15,18 +15,19 @@
 //! eight consecutive particles (`Layout::Contiguous`, e.g. a row of vertical grid edges) or a
 //! window of 15–31 consecutive ones (`Layout::Paired`, `Quad`, `Spaced`, `Strided`): those
 //! chunks load and store with unit stride, and anything else is gathered lane by lane.
-
 //!
 //! The module's parts: [`domain`] (a domain's particles, integration and velocity update),
 //! [`order`] (colouring and chunking of a domain's constraints), [`layout`] (how a chunk's
-//! lanes reach their particles), [`sweep`] (the Gauss–Seidel sweep over a domain's chunks)
-//! and [`tree`] (the fork–join tree and the links between domains).
+//! lanes reach their particles), [`sweep`] (the Gauss–Seidel sweep over a domain's chunks),
+//! [`tree`] (the fork–join tree and the links between domains) and [`team`] (the threads that
+//! stay together for a fused frame).
 
 mod domain;
 mod layout;
 mod order;
 mod simd;
 mod sweep;
+mod team;
 #[cfg(test)]
 mod tests;
 mod tree;
@@ -38,7 +39,6 @@ use rayon::prelude::*;
 
 use crate::constraints::lanes::{Coef, LANES};
 use crate::constraints::{Block, Distance, Rule};
-use crate::hook::{Contacts, ParticleContacts};
 use crate::params::FamilyParams;
 
 pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode};
@@ -233,30 +233,6 @@ impl Domains {
         self.mode.unit_k = (self.coef.iter().enumerate()).all(|(g, c)| c.k == 1.0 || !used(g));
     }
 
-    /// Projects every domain and link once; coefficients from [`Self::prepare`].
-    pub fn project(&mut self) {
-        self.project_with(|_, _| {});
-    }
-
-    /// Runs `before` on every domain, then projects every domain and link once, all in one
-    /// fork–join tree over the domains (see [`fork`]).
-    pub fn project_after<F>(&mut self, x: &[DVec3], v: &[DVec3], w: &[f64], before: F)
-    where
-        F: Fn(&mut Domain, &AosChunk<'_>) + Sync,
-    {
-        let size = self.size;
-        let n = x.len();
-        self.project_with(|d, index| {
-            let r = index * size..((index + 1) * size).min(n);
-            let aos = AosChunk {
-                x: &x[r.clone()],
-                v: &v[r.clone()],
-                w: &w[r],
-            };
-            before(d, &aos);
-        });
-    }
-
     fn project_with<F>(&mut self, before: F)
     where
         F: Fn(&mut Domain, usize) + Sync,
@@ -274,6 +250,7 @@ impl Domains {
             coef,
             mode: *mode,
             reverse: std::mem::replace(reverse, !*reverse),
+            serial: false,
         };
         fork(list, 0, links, &job);
     }
@@ -312,15 +289,6 @@ impl Domains {
                 d.settle();
                 d.store_positions(x);
             });
-    }
-
-    /// Resolves every free particle's contacts with `contacts` (see
-    /// [`crate::ParticleContacts`]), domain by domain in parallel; returns the totals.
-    pub fn collide(&mut self, contacts: &dyn ParticleContacts, fresh: bool) -> Contacts {
-        self.list
-            .par_iter_mut()
-            .map(|d| d.collide(contacts, fresh))
-            .reduce(Contacts::default, Contacts::merge)
     }
 
     /// Ends a fused frame: velocity update and damping, then copies the state back out.

@@ -50,10 +50,14 @@ pub(super) struct Job<'a, F> {
     /// thread starts a pass on the domain it ended the last one with, still in its cache; the
     /// halves share no particle, so their order changes no bit.
     pub reverse: bool,
+    /// Visit both halves on the calling thread (a team worker's share of the tree, see
+    /// `team`), never forking.
+    pub serial: bool,
 }
 
 /// Solves `doms` (domains `first..`) with their `links` (the subtree's internal nodes, in
-/// preorder): the two halves in parallel (`rayon::join`), then the links between them.
+/// preorder): the two halves in parallel (`rayon::join`, or one after the other when
+/// `job.serial`), then the links between them.
 ///
 /// A leaf runs `before` and its own interior constraints. The tree's shape depends only on
 /// the number of domains, so the order of every link relative to every domain is fixed: the
@@ -74,17 +78,35 @@ where
     };
     let (left_links, right_links) = below.split_at_mut(mid - 1);
     let (left, right) = doms.split_at_mut(mid);
-    let left = || fork(left, first, left_links, job);
-    let right = || fork(right, first + mid, right_links, job);
-    if job.reverse {
-        rayon::join(right, left);
-    } else {
-        rayon::join(left, right);
+    let mut left = || fork(left, first, left_links, job);
+    let mut right = || fork(right, first + mid, right_links, job);
+    match (job.serial, job.reverse) {
+        (true, false) => {
+            left();
+            right();
+        }
+        (true, true) => {
+            right();
+            left();
+        }
+        (false, false) => _ = rayon::join(left, right),
+        (false, true) => _ = rayon::join(right, left),
     }
-    if job.mode.damped {
-        project_links::<true>(doms, first, own, job.coef);
+    solve_links(doms, first, own, job.coef, job.mode);
+}
+
+/// Projects one node's links (`first`: the global index of `list[0]`).
+pub(super) fn solve_links(
+    list: &mut [Domain],
+    first: usize,
+    links: &mut LinkSet,
+    coef: &[Coef],
+    mode: Mode,
+) {
+    if mode.damped {
+        project_links::<true>(list, first, links, coef);
     } else {
-        project_links::<false>(doms, first, own, job.coef);
+        project_links::<false>(list, first, links, coef);
     }
 }
 

@@ -2,13 +2,15 @@
 //! domains' parallel regions) and general (every phase on the particle store, the hook in
 //! between). Both do the same arithmetic in the same order, so they give the same bits.
 
+use std::sync::atomic::Ordering;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{Solver, StepStats};
 use crate::chunk::CHUNK;
 use crate::constraints::Rule;
-use crate::domains::{Finish, Integration};
+use crate::domains::{AosChunk, Domain, Finish, Integration};
 use crate::hook::{SubstepContext, SubstepHook};
 
 impl Solver {
@@ -40,8 +42,9 @@ impl Solver {
         time
     }
 
-    /// One frame with every substep phase inside the domains' parallel regions, with the hook's
-    /// per-particle contacts when it is active; false when the stop flag cut it short.
+    /// One frame with every substep phase inside the domains' parallel regions, run by a team
+    /// of threads kept for the whole frame, with the hook's per-particle contacts when it is
+    /// active; false when the stop flag cut it short.
     pub(super) fn frame_fused(
         &mut self,
         rule: Rule,
@@ -52,55 +55,72 @@ impl Solver {
         let inv_h = 1.0 / h;
         let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
         let active = hook.is_active();
-        let mut stats = StepStats::default();
         self.domains.prepare(&self.params, rule);
         let lambda = self.domains.mode().lambda;
-        let mut whole = true;
-        for k in 0..s.substeps {
-            if self.stopping() {
-                if k == 0 {
-                    // Nothing loaded into the domains yet: the store is as it was.
-                    return (stats, false);
-                }
-                whole = false;
-                break;
-            }
-            let time = self.substep_targets(k);
-            if active {
-                let ctx = SubstepContext {
-                    method: s.method,
-                    time,
-                    h,
-                    substep: k,
-                };
-                hook.begin_substep(&ctx, &self.particles);
-            }
+        // Every substep's targets depend on its time alone: worked out before the team starts,
+        // so that its workers read them while the frame runs.
+        let mut targets = std::mem::take(&mut self.frame_targets);
+        targets.resize_with(s.substeps as usize, Vec::new);
+        let mut times = Vec::with_capacity(s.substeps as usize);
+        for (k, t) in (0..s.substeps).zip(&mut targets) {
+            times.push(self.substep_targets(k));
+            t.clone_from(&self.targets);
+        }
+        let forces = &self.forces;
+        let work = |k: u32, d: &mut Domain, aos: &AosChunk<'_>| {
+            let finish = if k == 0 {
+                d.load(aos);
+                None
+            } else {
+                Some(Finish { inv_h, keep })
+            };
             let step = Integration {
                 h,
-                forces: &self.forces,
-                pins: &self.targets,
+                forces,
+                pins: &targets[k as usize],
             };
-            let p = &self.particles;
-            self.domains.reset_link_multipliers();
+            d.integrate(&step, finish, lambda);
+        };
+        let stop = self.stop.as_deref();
+        let p = &self.particles;
+        let (stats, done) =
             self.domains
-                .project_after(&p.positions, &p.velocities, &p.inv_masses, |d, aos| {
-                    let finish = if k == 0 {
-                        d.load(aos);
-                        None
-                    } else {
-                        Some(Finish { inv_h, keep })
-                    };
-                    d.integrate(&step, finish, lambda);
+                .team(&p.positions, &p.velocities, &p.inv_masses, &work, |team| {
+                    let mut stats = StepStats::default();
+                    for k in 0..s.substeps {
+                        if stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+                            return (stats, k);
+                        }
+                        if active {
+                            let ctx = SubstepContext {
+                                method: s.method,
+                                time: times[k as usize],
+                                h,
+                                substep: k,
+                            };
+                            hook.begin_substep(&ctx, p);
+                        }
+                        team.integrate_and_project(k);
+                        for it in 0..s.iterations {
+                            if it > 0 {
+                                team.project();
+                            }
+                            if active && let Some(contacts) = hook.particle_contacts() {
+                                let totals = team.collide(contacts, it == 0);
+                                stats.contacts = hook.fused_pass(it == 0, totals);
+                            }
+                        }
+                    }
+                    (stats, s.substeps)
                 });
-            for it in 0..s.iterations {
-                if it > 0 {
-                    self.domains.project();
-                }
-                if active && let Some(contacts) = hook.particle_contacts() {
-                    let totals = self.domains.collide(contacts, it == 0);
-                    stats.contacts = hook.fused_pass(it == 0, totals);
-                }
-            }
+        self.frame_targets = targets;
+        if done == 0 {
+            // Nothing loaded into the domains yet: the store is as it was.
+            return (stats, false);
+        }
+        if done < s.substeps {
+            // The driven velocities of the last substep run.
+            self.substep_targets(done - 1);
         }
         let p = &mut self.particles;
         self.domains.finish(
@@ -114,7 +134,7 @@ impl Solver {
         for &(i, v) in &self.driven_velocities {
             p.velocities[i] = v;
         }
-        (stats, whole)
+        (stats, done == s.substeps)
     }
 
     /// One frame of the general loop: every phase on the particle store, the hook in between;

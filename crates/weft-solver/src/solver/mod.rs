@@ -76,6 +76,9 @@ pub struct Solver {
     domains: Domains,
     /// Pin and grab targets of the current substep (scratch).
     targets: Vec<(usize, DVec3)>,
+    /// Pin and grab targets of every substep of a fused frame, worked out before it starts
+    /// (scratch).
+    frame_targets: Vec<Vec<(usize, DVec3)>>,
     accel: Vec<DVec3>,
     force: Vec<DVec3>,
     time: f64,
@@ -116,6 +119,7 @@ impl Solver {
             forces,
             domains,
             targets: Vec::new(),
+            frame_targets: Vec::new(),
             initial: particles.clone(),
             particles,
             cloths,

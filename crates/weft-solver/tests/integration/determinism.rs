@@ -63,7 +63,7 @@ fn run_in_pool(threads: usize, method: Method, domain_size: usize) -> Vec<[u64; 
 
 #[test]
 fn results_are_bit_identical_across_thread_counts() {
-    // 48² = 2304 particles in domains of 256: nine domains and their links.
+    // 48² = 2304 particles in domains of at most 256: sixteen domains and their links.
     for method in Method::ALL {
         let reference = run_in_pool(1, method, 256);
         assert_eq!(reference, run_in_pool(1, method, 256), "{method}: twice");
@@ -71,6 +71,12 @@ fn results_are_bit_identical_across_thread_counts() {
             reference,
             run_in_pool(2, method, 256),
             "{method}: 2 threads"
+        );
+        // Three threads make a team of two workers; four, a team of four (see `team`).
+        assert_eq!(
+            reference,
+            run_in_pool(3, method, 256),
+            "{method}: 3 threads"
         );
         assert_eq!(
             reference,
