@@ -238,13 +238,22 @@ impl Domain {
     }
 
     /// Copies positions, previous positions and velocities back out (after [`Self::settle`]).
-    pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3]) {
+    /// Returns whether every position is finite with no coordinate beyond `bound` in magnitude
+    /// (checked as it is copied: the solver's divergence check then needs no pass of its own).
+    pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3], bound: f64) -> bool {
         debug_assert!(!self.work.unfolded);
+        // NaN fails `<=`; the bound may be infinite, so finiteness is tested too. No branch
+        // per particle.
+        let fine = |a: f64| (a.abs() <= bound) & (a.abs() < f64::INFINITY);
+        let mut ok = true;
         for i in 0..self.len() {
-            x[i] = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
+            let xi = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
+            ok &= fine(xi.x) & fine(xi.y) & fine(xi.z);
+            x[i] = xi;
             prev[i] = DVec3::new(self.prev[0][i], self.prev[1][i], self.prev[2][i]);
             v[i] = DVec3::new(self.v[0][i], self.v[1][i], self.v[2][i]);
         }
+        ok
     }
 
     /// The PBD velocity update v = (x − x_prev)/h, then global damping v ← v e^(−c h) of free

@@ -291,24 +291,27 @@ impl Domains {
             });
     }
 
-    /// Ends a fused frame: velocity update and damping, then copies the state back out.
+    /// Ends a fused frame: velocity update and damping, then copies the state back out;
+    /// returns whether every position is finite and within `bound` (see [`Domain::store`]).
     pub fn finish(
         &mut self,
-        inv_h: f64,
-        keep: Option<f64>,
+        finish: Finish,
+        bound: f64,
         x: &mut [DVec3],
         prev: &mut [DVec3],
         v: &mut [DVec3],
-    ) {
+    ) -> bool {
         let size = self.size;
         self.list
             .par_iter_mut()
             .zip(x.par_chunks_mut(size))
             .zip(prev.par_chunks_mut(size))
             .zip(v.par_chunks_mut(size))
-            .for_each(|(((d, x), prev), v)| {
-                d.finish_velocities(Finish { inv_h, keep });
-                d.store(x, prev, v);
-            });
+            .map(|(((d, x), prev), v)| {
+                d.finish_velocities(finish);
+                d.store(x, prev, v, bound)
+            })
+            // Not `all`: it would stop finishing the other domains at the first `false`.
+            .reduce(|| true, |a, b| a & b)
     }
 }

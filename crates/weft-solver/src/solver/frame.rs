@@ -13,6 +13,28 @@ use crate::constraints::Rule;
 use crate::domains::{AosChunk, Domain, Finish, Integration};
 use crate::hook::{SubstepContext, SubstepHook};
 
+/// How a frame ended.
+pub(super) struct Frame {
+    /// What the frame did.
+    pub stats: StepStats,
+    /// False when the stop flag cut it short.
+    pub whole: bool,
+    /// Every position is known to be finite and within the divergence bound (checked as the
+    /// fused frame copied them out); false when unchecked.
+    pub within: bool,
+}
+
+impl Frame {
+    /// A frame stopped before it changed anything.
+    fn cut(stats: StepStats) -> Self {
+        Self {
+            stats,
+            whole: false,
+            within: false,
+        }
+    }
+}
+
 impl Solver {
     /// Time at the end of substep `k`, and the pin and grab targets there, into `self.targets`.
     pub(super) fn substep_targets(&mut self, k: u32) -> f64 {
@@ -44,12 +66,9 @@ impl Solver {
 
     /// One frame with every substep phase inside the domains' parallel regions, run by a team
     /// of threads kept for the whole frame, with the hook's per-particle contacts when it is
-    /// active; false when the stop flag cut it short.
-    pub(super) fn frame_fused(
-        &mut self,
-        rule: Rule,
-        hook: &mut dyn SubstepHook,
-    ) -> (StepStats, bool) {
+    /// active; false when the stop flag cut it short. The frame's end copies the positions out
+    /// and checks them against the divergence bound (see [`Frame`]).
+    pub(super) fn frame_fused(&mut self, rule: Rule, hook: &mut dyn SubstepHook) -> Frame {
         let s = self.settings;
         let h = s.h();
         let inv_h = 1.0 / h;
@@ -116,16 +135,16 @@ impl Solver {
         self.frame_targets = targets;
         if done == 0 {
             // Nothing loaded into the domains yet: the store is as it was.
-            return (stats, false);
+            return Frame::cut(stats);
         }
         if done < s.substeps {
             // The driven velocities of the last substep run.
             self.substep_targets(done - 1);
         }
         let p = &mut self.particles;
-        self.domains.finish(
-            inv_h,
-            keep,
+        let within = self.domains.finish(
+            Finish { inv_h, keep },
+            s.divergence_bound,
             &mut p.positions,
             &mut p.prev_positions,
             &mut p.velocities,
@@ -134,12 +153,16 @@ impl Solver {
         for &(i, v) in &self.driven_velocities {
             p.velocities[i] = v;
         }
-        (stats, done == s.substeps)
+        Frame {
+            stats,
+            whole: done == s.substeps,
+            within,
+        }
     }
 
     /// One frame of the general loop: every phase on the particle store, the hook in between;
     /// false when the stop flag cut it short.
-    pub(super) fn frame_general(&mut self, hook: &mut dyn SubstepHook) -> (StepStats, bool) {
+    pub(super) fn frame_general(&mut self, hook: &mut dyn SubstepHook) -> Frame {
         let s = self.settings;
         let h = s.h();
         let strategy = s.method.strategy();
@@ -264,7 +287,11 @@ impl Solver {
             self.finish_velocities(inv_h, keep);
             hook.end_substep(&ctx, &mut self.particles);
         }
-        (stats, whole)
+        Frame {
+            stats,
+            whole,
+            within: false,
+        }
     }
 
     /// Every particle's velocity from its substep's positions ([`end_velocity`]), in parallel,

@@ -411,9 +411,10 @@ impl Solver {
     /// When nothing needs the particle store between the phases of a substep (no active hook, or
     /// one whose contacts are per particle ([`SubstepHook::particle_contacts`]), no
     /// aerodynamics, only distance constraints, a position-based method), the frame runs fused:
-    /// each domain integrates, pins and projects its own particles in one parallel region per
-    /// substep and iteration, and resolves its particles' contacts in one more. That path does
-    /// the same arithmetic in the same order as the general loop, so both give the same bits.
+    /// each domain integrates, pins and projects its own particles, on a team of threads kept
+    /// for the whole frame that hands each pass over with a spin, and resolves its particles'
+    /// contacts in one parallel region per iteration. That path does the same arithmetic in
+    /// the same order as the general loop, so both give the same bits.
     ///
     /// The frame runs on one of rayon's threads (`rayon::scope`, inline when called from one):
     /// its parallel loops then start from inside the pool, and the calling thread is handed
@@ -421,7 +422,7 @@ impl Solver {
     pub fn step_with(&mut self, hook: &mut dyn SubstepHook) -> Result<StepStats, SolverError> {
         let s = self.settings;
         let rule = s.method.strategy().rule(s.h());
-        let (stats, whole) = rayon::scope(|_| match rule {
+        let done = rayon::scope(|_| match rule {
             Some(rule)
                 if self.fusable() && (!hook.is_active() || hook.particle_contacts().is_some()) =>
             {
@@ -429,6 +430,11 @@ impl Solver {
             }
             _ => self.frame_general(hook),
         });
+        let frame::Frame {
+            stats,
+            whole,
+            within,
+        } = done;
         if !whole {
             // Stopped inside the frame: the state is part of a frame; time and frame stay.
             return Err(SolverError::Interrupted { frame: self.frame });
@@ -439,7 +445,9 @@ impl Solver {
         self.time += s.dt;
         let frame = self.frame;
         self.frame += 1;
-        self.check_divergence(frame)?;
+        if !within {
+            self.check_divergence(frame)?;
+        }
         Ok(stats)
     }
 

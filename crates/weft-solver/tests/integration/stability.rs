@@ -163,3 +163,35 @@ fn the_stability_bound_predicts_where_explicit_springs_explode() {
         "{err}"
     );
 }
+
+#[test]
+fn a_fused_frame_reports_a_particle_beyond_the_bound() {
+    let mut s = solver(
+        settings(Method::Xpbd, DT, 4, 1),
+        Forces::default(),
+        &hanging_grid(8),
+        in_plane(0.0, 1.0, 0.0),
+    );
+    assert!(
+        s.runs_fused(),
+        "the fused frame checks positions as it copies them out"
+    );
+    run(&mut s, 5);
+    // Finite, but 1e9 m/s for a frame carries particle 37 and its neighbours far past the
+    // 1e4 m bound.
+    s.particles_mut().velocities[37].z = 1e9;
+    match s.step() {
+        Err(SolverError::Diverged {
+            method: Method::Xpbd,
+            frame: 5,
+            particle,
+            position,
+            bound,
+            ..
+        }) => {
+            assert!(particle <= 37, "particle {particle}");
+            assert!(position.is_finite() && position.abs().max_element() > bound);
+        }
+        other => panic!("expected divergence at frame 5, got {other:?}"),
+    }
+}
