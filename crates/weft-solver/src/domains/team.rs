@@ -28,7 +28,7 @@ use crate::hook::{Contacts, ParticleContacts};
 /// The low word of a posted pass that integrates nothing: a sweep only.
 const PROJECT: u32 = u32::MAX;
 
-/// Spins of a waiting helper between looks for other rayon work.
+/// Spins of the waiting leader between checks for a worker's panic.
 const SPINS: u32 = 256;
 
 /// One worker's share of the tree: a subtree's domains and the links of its internal nodes.
@@ -130,12 +130,11 @@ where
         fork(doms, first, links, &job);
     }
 
-    /// A helper's loop: claims slots as passes are posted until the frame ends; while it
-    /// waits, it spins, now and then running other rayon work (the frame's parallel collision
-    /// passes among it).
+    /// A helper's loop: claims slots as passes are posted until the frame ends. While it
+    /// waits, it runs any other rayon work pending (the frame's parallel collision passes and
+    /// the hook's own loops among it: the helper is one of the pool's threads), else spins.
     fn serve(&self, me: usize) {
         let mut seen = 0;
-        let mut spins = 0;
         while !self.exit.load(Ordering::Acquire) {
             let word = self.posted.load(Ordering::Acquire);
             let pass = word >> 32;
@@ -143,12 +142,7 @@ where
                 seen = pass;
                 // The low word is the pass's code by construction.
                 self.claim(me, pass, word as u32);
-                spins = 0;
-            } else if spins == SPINS {
-                spins = 0;
-                rayon::yield_now();
-            } else {
-                spins += 1;
+            } else if rayon::yield_now() != Some(rayon::Yield::Executed) {
                 spin_loop();
             }
         }
