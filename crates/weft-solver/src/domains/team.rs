@@ -123,7 +123,8 @@ where
             coef: self.coef,
             mode: self.mode,
             reverse,
-            serial: true,
+            // A team of one (see `Domains::team`) forks inside its slot as the tree always did.
+            serial: self.slots.len() > 1,
         };
         let first = slot.first;
         let Slot { doms, links, .. } = slot;
@@ -231,17 +232,16 @@ where
         }
     }
 
-    /// Resolves every free particle's contacts with `contacts`, slot by slot in parallel;
+    /// Resolves every free particle's contacts with `contacts`, domain by domain in parallel;
     /// returns the totals (sums and a maximum: the same whatever the order).
     pub fn collide(&mut self, contacts: &dyn ParticleContacts, fresh: bool) -> Contacts {
         self.board
             .slots
             .par_iter()
             .map(|slot| {
-                let mut slot = lock(slot);
-                (slot.doms.iter_mut())
+                (lock(slot).doms.par_iter_mut())
                     .map(|d| d.collide(contacts, fresh))
-                    .fold(Contacts::default(), Contacts::merge)
+                    .reduce(Contacts::default, Contacts::merge)
             })
             .reduce(Contacts::default, Contacts::merge)
     }
@@ -297,22 +297,30 @@ enum Owner {
 
 impl Domains {
     /// Runs `body` with a team of workers over the domains: one per rayon thread, at most one
-    /// per domain, a power of two. `work(k, domain, particles)` runs on each domain before its
-    /// sweep in a pass that integrates substep `k`, with the domain's particles in the store
-    /// (`x`, `v`, `w`). Coefficients from [`Domains::prepare`].
+    /// per domain, a power of two; or, unless `spin`, a team of one whose passes fork and join
+    /// in rayon as [`fork`] does (a frame whose hook runs work of its own between the passes,
+    /// which a spinning helper slowed down: see `docs/performance-notes.md`).
+    /// `work(k, domain, particles)` runs on each domain before its sweep in a pass that
+    /// integrates substep `k`, with the domain's particles in the store (`x`, `v`, `w`).
+    /// Coefficients from [`Domains::prepare`].
     pub fn team<W, R>(
         &mut self,
         x: &[DVec3],
         v: &[DVec3],
         w: &[f64],
         work: &W,
+        spin: bool,
         body: impl FnOnce(&mut Team<'_, '_, W>) -> R,
     ) -> R
     where
         W: Fn(u32, &mut Domain, &AosChunk<'_>) + Sync,
     {
         let count = self.list.len();
-        let workers = rayon::current_num_threads().min(count).max(1);
+        let workers = if spin {
+            rayon::current_num_threads().min(count).max(1)
+        } else {
+            1
+        };
         let slots = 1 << workers.ilog2();
         let (mut out, mut upper_nodes) = (Vec::new(), Vec::new());
         carve(0, count, 0, slots, &mut out, &mut upper_nodes);
