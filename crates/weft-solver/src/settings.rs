@@ -1,8 +1,19 @@
 //! Time stepping settings.
 
+use glam::DVec3;
+
 use crate::domains::SimdPath;
 use crate::error::ParamError;
 use crate::method::Method;
+
+/// Whether position `x` is finite with no coordinate beyond `bound` in magnitude (the
+/// divergence check, see [`Settings::divergence_bound`]). No branch: NaN fails `<=`, and an
+/// infinite coordinate fails the second test whatever the bound.
+#[inline(always)]
+pub(crate) fn within_bound(x: DVec3, bound: f64) -> bool {
+    let fine = |c: f64| (c.abs() <= bound) & (c.abs() < f64::INFINITY);
+    fine(x.x) & fine(x.y) & fine(x.z)
+}
 
 /// How the solver steps: method, frame time step, substeps and iterations.
 #[derive(Clone, Copy, Debug, PartialEq)]

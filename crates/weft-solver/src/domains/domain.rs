@@ -15,6 +15,7 @@ use super::sweep::sweep;
 use crate::constraints::lanes::Coef;
 use crate::forces::Forces;
 use crate::hook::{Contacts, ParticleContacts, ParticleRun};
+use crate::settings::within_bound;
 
 /// Distance constraints as struct-of-arrays; rest lengths and multipliers in f32, the lane
 /// type of the domain sweep (see `sweep`).
@@ -242,13 +243,10 @@ impl Domain {
     /// (checked as it is copied: the solver's divergence check then needs no pass of its own).
     pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3], bound: f64) -> bool {
         debug_assert!(!self.work.unfolded);
-        // NaN fails `<=`; the bound may be infinite, so finiteness is tested too. No branch
-        // per particle.
-        let fine = |a: f64| (a.abs() <= bound) & (a.abs() < f64::INFINITY);
         let mut ok = true;
         for i in 0..self.len() {
             let xi = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
-            ok &= fine(xi.x) & fine(xi.y) & fine(xi.z);
+            ok &= within_bound(xi, bound);
             x[i] = xi;
             prev[i] = DVec3::new(self.prev[0][i], self.prev[1][i], self.prev[2][i]);
             v[i] = DVec3::new(self.v[0][i], self.v[1][i], self.v[2][i]);

@@ -18,7 +18,7 @@ use crate::hook::SubstepHook;
 use crate::motion::KinematicPin;
 use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
-use crate::settings::Settings;
+use crate::settings::{Settings, within_bound};
 use crate::stability::{StabilityBound, bound};
 
 /// A cloth inside a solver: its particle range and its mesh in global particle indices.
@@ -474,7 +474,7 @@ impl Solver {
             .particles
             .positions
             .iter()
-            .position(|x| !x.is_finite() || x.abs().max_element() > bound)
+            .position(|&x| !within_bound(x, bound))
         {
             Some(particle) => Err(SolverError::Diverged {
                 method: self.settings.method,
