@@ -72,7 +72,6 @@ fn results_are_bit_identical_across_thread_counts() {
             run_in_pool(2, method, 256),
             "{method}: 2 threads"
         );
-        // Three threads make a team of two workers; four, a team of four (see `team`).
         assert_eq!(
             reference,
             run_in_pool(3, method, 256),
@@ -128,5 +127,9 @@ fn fused_frames_match_the_general_loop_bit_for_bit() {
         assert_eq!(fused, fusable(method, 1, true), "{method}");
         assert_eq!(fused, fusable(method, 2, false), "{method}, 2 threads");
         assert_eq!(fused, fusable(method, 2, true), "{method}, 2 threads");
+        // Without a hook the fused frame runs on a team of threads: of two workers with four
+        // domains each on three threads, of four workers on four (links above the slots).
+        assert_eq!(fused, fusable(method, 3, false), "{method}, 3 threads");
+        assert_eq!(fused, fusable(method, 4, false), "{method}, 4 threads");
     }
 }
