@@ -238,29 +238,27 @@ impl Domain {
         }
     }
 
-    /// Copies positions, previous positions and velocities back out (after [`Self::settle`]).
-    /// Returns whether every position is finite with no coordinate beyond `bound` in magnitude
-    /// (checked as it is copied: the solver's divergence check then needs no pass of its own).
-    pub fn store(&self, x: &mut [DVec3], prev: &mut [DVec3], v: &mut [DVec3], bound: f64) -> bool {
-        debug_assert!(!self.work.unfolded);
-        let mut ok = true;
-        for i in 0..self.len() {
-            let xi = DVec3::new(self.x[0][i], self.x[1][i], self.x[2][i]);
-            ok &= within_bound(xi, bound);
-            x[i] = xi;
-            prev[i] = DVec3::new(self.prev[0][i], self.prev[1][i], self.prev[2][i]);
-            v[i] = DVec3::new(self.v[0][i], self.v[1][i], self.v[2][i]);
-        }
-        ok
-    }
-
-    /// The PBD velocity update v = (x − x_prev)/h, then global damping v ← v e^(−c h) of free
-    /// particles when `keep` is given — the same arithmetic as the solver's general loop.
-    pub fn finish_velocities(&mut self, finish: Finish) {
-        self.settle();
-        let w = &self.w[..];
-        for a in 0..3 {
-            end_velocities(&self.x[a], &self.prev[a], &mut self.v[a], w, finish);
+    /// Ends the frame: the PBD velocity update v = (x − x_prev)/h with global damping
+    /// ([`Finish::velocity`], the general loop's arithmetic), written out with the positions and
+    /// previous positions to the particle store in one pass. The last sweep's displacement, if
+    /// still pending, is added as each position is read; the domain keeps it pending (its
+    /// positions plus the displacement are still its state). Returns whether every position
+    /// is finite with no coordinate beyond `bound` in magnitude (checked as it is copied: the
+    /// solver's divergence check then needs no pass of its own).
+    pub fn finish(
+        &self,
+        finish: Finish,
+        x: &mut [DVec3],
+        prev: &mut [DVec3],
+        v: &mut [DVec3],
+        bound: f64,
+    ) -> bool {
+        let out = Out { x, prev, v };
+        match self.path {
+            SimdPath::Avx512 => finish_avx512(self, finish, out, bound),
+            SimdPath::Avx2 => finish_avx2(self, finish, out, bound),
+            SimdPath::Neon => finish_neon(self, finish, out, bound),
+            SimdPath::Scalar => finish_scalar(self, finish, out, bound),
         }
     }
 
@@ -344,13 +342,82 @@ impl Finish {
     }
 }
 
-/// One axis of [`Finish::velocity`].
+/// A domain's share of the particle store, written by [`Domain::finish`].
+struct Out<'a> {
+    x: &'a mut [DVec3],
+    prev: &'a mut [DVec3],
+    v: &'a mut [DVec3],
+}
+
+/// [`Domain::finish`] compiled for AVX-512 (the baseline build where the CPU lacks it).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
+fn finish_avx512<'a>(dom: &Domain, finish: Finish, out: Out<'a>, bound: f64) -> bool {
+    finish_body(dom, finish, out, bound)
+}
+
+/// [`Domain::finish`] compiled for AVX2 and FMA.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn finish_avx2<'a>(dom: &Domain, finish: Finish, out: Out<'a>, bound: f64) -> bool {
+    finish_body(dom, finish, out, bound)
+}
+
+/// [`Domain::finish`] compiled for NEON.
+#[multiversion(targets("aarch64+neon"))]
+fn finish_neon<'a>(dom: &Domain, finish: Finish, out: Out<'a>, bound: f64) -> bool {
+    finish_body(dom, finish, out, bound)
+}
+
+/// [`Domain::finish`] compiled for the baseline target.
+#[inline(never)]
+fn finish_scalar(dom: &Domain, finish: Finish, out: Out<'_>, bound: f64) -> bool {
+    finish_body(dom, finish, out, bound)
+}
+
 #[inline(always)]
-fn end_velocities(x: &[f64], prev: &[f64], v: &mut [f64], w: &[f64], finish: Finish) {
-    let (x, prev, v) = (&x[..w.len()], &prev[..w.len()], &mut v[..w.len()]);
-    for i in 0..w.len() {
-        v[i] = finish.velocity(x[i], prev[i], w[i] > 0.0);
+fn finish_body(dom: &Domain, finish: Finish, out: Out<'_>, bound: f64) -> bool {
+    if dom.work.unfolded {
+        finish_from::<true>(dom, finish, out, bound)
+    } else {
+        finish_from::<false>(dom, finish, out, bound)
     }
+}
+
+/// [`finish_body`], adding the pending displacement to each position it reads when
+/// `UNFOLDED`.
+#[inline(always)]
+fn finish_from<const UNFOLDED: bool>(
+    dom: &Domain,
+    finish: Finish,
+    out: Out<'_>,
+    bound: f64,
+) -> bool {
+    let n = dom.len();
+    let w = &dom.w[..n];
+    let (xs, ps) = (&dom.x, &dom.prev);
+    let ds = &dom.work.disp;
+    let (x, prev, v) = (&mut out.x[..n], &mut out.prev[..n], &mut out.v[..n]);
+    let at = |a: usize, i: usize| {
+        if UNFOLDED {
+            xs[a][i] + f64::from(ds[a][i])
+        } else {
+            xs[a][i]
+        }
+    };
+    let mut ok = true;
+    for i in 0..n {
+        let free = w[i] > 0.0;
+        let xi = DVec3::new(at(0, i), at(1, i), at(2, i));
+        let pi = DVec3::new(ps[0][i], ps[1][i], ps[2][i]);
+        ok &= within_bound(xi, bound);
+        x[i] = xi;
+        prev[i] = pi;
+        v[i] = DVec3::new(
+            finish.velocity(xi.x, pi.x, free),
+            finish.velocity(xi.y, pi.y, free),
+            finish.velocity(xi.z, pi.z, free),
+        );
+    }
+    ok
 }
 
 /// The per-particle part of [`Domain::integrate`] on the domain's kernel path, like [`sweep`].

@@ -291,8 +291,8 @@ impl Domains {
             });
     }
 
-    /// Ends a fused frame: velocity update and damping, then copies the state back out;
-    /// returns whether every position is finite and within `bound` (see [`Domain::store`]).
+    /// Ends a fused frame: velocity update and damping, written out with the positions;
+    /// returns whether every position is finite and within `bound` (see [`Domain::finish`]).
     pub fn finish(
         &mut self,
         finish: Finish,
@@ -307,10 +307,7 @@ impl Domains {
             .zip(x.par_chunks_mut(size))
             .zip(prev.par_chunks_mut(size))
             .zip(v.par_chunks_mut(size))
-            .map(|(((d, x), prev), v)| {
-                d.finish_velocities(finish);
-                d.store(x, prev, v, bound)
-            })
+            .map(|(((d, x), prev), v)| d.finish(finish, x, prev, v, bound))
             // Not `all`: it would stop finishing the other domains at the first `false`.
             .reduce(|| true, |a, b| a & b)
     }
