@@ -58,8 +58,6 @@ pub(crate) struct Domain {
     pub(super) x: [Vec<f64>; 3],
     /// Positions at the start of the substep per axis (m).
     pub(super) prev: [Vec<f64>; 3],
-    /// Velocities per axis (m/s).
-    pub(super) v: [Vec<f64>; 3],
     /// Inverse masses (1/kg).
     pub(super) w: Vec<f64>,
     /// The sweep's working state (see [`Rebased`]).
@@ -154,26 +152,12 @@ impl Domain {
         for a in 0..3 {
             self.x[a].resize(n, 0.0);
             self.prev[a].resize(n, 0.0);
-            self.v[a].resize(n, 0.0);
             self.work.base[a].resize(n, 0.0);
             self.work.disp[a].resize(n, 0.0);
             self.work.motion[a].resize(n, 0.0);
         }
         self.w.resize(n, 0.0);
         self.work.w.resize(n, 0.0);
-    }
-
-    /// Copies positions, velocities and inverse masses in from the global arrays.
-    pub fn load(&mut self, aos: &AosChunk<'_>) {
-        for (i, (x, v)) in aos.x.iter().zip(aos.v).enumerate() {
-            for a in 0..3 {
-                self.x[a][i] = x[a];
-                self.v[a][i] = v[a];
-            }
-        }
-        self.w.copy_from_slice(aos.w);
-        self.work.set_masses(aos.w);
-        self.work.unfolded = false;
     }
 
     /// Copies positions (and, when `prev` is given, previous positions) in.
@@ -262,12 +246,14 @@ impl Domain {
         }
     }
 
-    /// Ends the previous substep when `finish` is given (v = (x − x_prev)/h, then damping
-    /// v ← v·keep of free particles), then predicts with semi-implicit Euler, a = g + c_d (v_wind
-    /// − v), and applies the pins — the same arithmetic, particle by particle, as the solver's
-    /// general loop. Clears the multipliers when `lambda`.
-    pub fn integrate(&mut self, step: &Integration<'_>, finish: Option<Finish>, lambda: bool) {
-        advance(self, step, finish);
+    /// Starts a substep from `start`: the particle store at a frame's start (positions,
+    /// velocities and inverse masses read straight from it), or the previous substep, which it
+    /// ends (v = (x − x_prev)/h, then damping v ← v·keep of free particles). Then predicts with
+    /// semi-implicit Euler, a = g + c_d (v_wind − v), and applies the pins — the same
+    /// arithmetic, particle by particle, as the solver's general loop. Clears the multipliers
+    /// when `lambda`.
+    pub fn integrate(&mut self, step: &Integration<'_>, start: Start<'_>, lambda: bool) {
+        advance(self, step, start);
         let range = self.start..self.start + self.len();
         let origin = self.work.origin;
         for &(i, p) in step.pins {
@@ -316,6 +302,15 @@ pub(crate) struct Mode {
     /// Every group has k = 1 (XPBD with none disabled): the kernel negates C instead of
     /// multiplying it by −k.
     pub unit_k: bool,
+}
+
+/// Where a fused substep starts from (see [`Domain::integrate`]).
+#[derive(Clone, Copy)]
+pub(crate) enum Start<'a> {
+    /// The frame's first substep: the domain's share of the particle store.
+    Store(&'a AosChunk<'a>),
+    /// A later substep, ending the previous one as this says.
+    Finish(Finish),
 }
 
 /// How a fused substep ends the previous one: 1/h and the damping factor, if any.
@@ -421,68 +416,131 @@ fn finish_from<const UNFOLDED: bool>(
 }
 
 /// The per-particle part of [`Domain::integrate`] on the domain's kernel path, like [`sweep`].
-fn advance(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
+fn advance(dom: &mut Domain, step: &Integration<'_>, start: Start<'_>) {
     match dom.path {
-        SimdPath::Avx512 => advance_avx512(dom, step, finish),
-        SimdPath::Avx2 => advance_avx2(dom, step, finish),
-        SimdPath::Neon => advance_neon(dom, step, finish),
-        SimdPath::Scalar => advance_scalar(dom, step, finish),
+        SimdPath::Avx512 => advance_avx512(dom, step, start),
+        SimdPath::Avx2 => advance_avx2(dom, step, start),
+        SimdPath::Neon => advance_neon(dom, step, start),
+        SimdPath::Scalar => advance_scalar(dom, step, start),
     }
 }
 
 /// [`advance`] compiled for AVX-512 (the baseline build where the CPU lacks it).
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
-fn advance_avx512<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
-    advance_body(dom, step, finish);
+fn advance_avx512<'a>(dom: &mut Domain, step: &Integration<'a>, start: Start<'a>) {
+    advance_body(dom, step, start);
 }
 
 /// [`advance`] compiled for AVX2 and FMA.
 #[multiversion(targets("x86_64+avx2+fma"))]
-fn advance_avx2<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
-    advance_body(dom, step, finish);
+fn advance_avx2<'a>(dom: &mut Domain, step: &Integration<'a>, start: Start<'a>) {
+    advance_body(dom, step, start);
 }
 
 /// [`advance`] compiled for NEON.
 #[multiversion(targets("aarch64+neon"))]
-fn advance_neon<'a>(dom: &mut Domain, step: &Integration<'a>, finish: Option<Finish>) {
-    advance_body(dom, step, finish);
+fn advance_neon<'a>(dom: &mut Domain, step: &Integration<'a>, start: Start<'a>) {
+    advance_body(dom, step, start);
 }
 
 /// [`advance`] compiled for the baseline target.
 #[inline(never)]
-fn advance_scalar(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
-    advance_body(dom, step, finish);
+fn advance_scalar(dom: &mut Domain, step: &Integration<'_>, start: Start<'_>) {
+    advance_body(dom, step, start);
 }
 
 #[inline(always)]
-fn advance_body(dom: &mut Domain, step: &Integration<'_>, finish: Option<Finish>) {
-    // The last sweep's displacement, if still pending, is added as each position is read.
-    if std::mem::take(&mut dom.work.unfolded) {
-        advance_from::<true>(dom, step, finish);
-    } else {
-        advance_from::<false>(dom, step, finish);
+fn advance_body(dom: &mut Domain, step: &Integration<'_>, start: Start<'_>) {
+    match start {
+        Start::Store(aos) => advance_load(dom, step, aos),
+        // The last sweep's displacement, if still pending, is added as each position is read.
+        Start::Finish(finish) => {
+            if std::mem::take(&mut dom.work.unfolded) {
+                advance_from::<true>(dom, step, finish);
+            } else {
+                advance_from::<false>(dom, step, finish);
+            }
+        }
     }
 }
 
-/// [`advance_body`], adding the pending displacement to each position it reads when
-/// `UNFOLDED`.
+/// One axis of the prediction (semi-implicit Euler), its constants read once into locals
+/// (read through the step inside the loop, they kept it from vectorising).
+#[derive(Clone, Copy)]
+struct Predict {
+    g: f64,
+    wind: f64,
+    drag: f64,
+    h: f64,
+}
+
+impl Predict {
+    fn along(step: &Integration<'_>, a: usize) -> Self {
+        let f = step.forces;
+        Self {
+            g: f.gravity[a],
+            wind: f.wind.velocity[a],
+            drag: f.wind.drag,
+            h: step.h,
+        }
+    }
+
+    /// The new position from velocity `v0`, a = g + c_d (v_wind − v0); kept as it was for a
+    /// pinned particle.
+    #[inline(always)]
+    fn position(self, x0: f64, v0: f64, free: bool) -> f64 {
+        let acc = self.g + self.drag * (self.wind - v0);
+        let vi = v0 + acc * self.h;
+        let xi = x0 + vi * self.h;
+        if free { xi } else { x0 }
+    }
+}
+
+/// [`advance_body`] at a frame's start: positions, velocities and inverse masses read from the
+/// particle store as they are used (no copy into the domain first; the velocities are never
+/// kept: later substeps compute them from the positions).
 #[inline(always)]
-fn advance_from<const UNFOLDED: bool>(
-    dom: &mut Domain,
-    step: &Integration<'_>,
-    finish: Option<Finish>,
-) {
-    let h = step.h;
-    let f = step.forces;
+fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
+    let n = dom.len();
+    let (ax, av, aw) = (&aos.x[..n], &aos.v[..n], &aos.w[..n]);
+    dom.w.copy_from_slice(aw);
+    dom.work.set_masses(aw);
+    dom.work.unfolded = false;
+    let predict = [0, 1, 2].map(|a| Predict::along(step, a));
+    let origin = ax.first().map_or([0.0; 3], |p| p.to_array());
+    dom.work.origin = origin;
+    // One loop over the particles, three axes at a time: the store holds them side by side.
+    let [x0s, x1s, x2s] = &mut dom.x;
+    let [p0s, p1s, p2s] = &mut dom.prev;
+    let [b0s, b1s, b2s] = &mut dom.work.base;
+    let [d0s, d1s, d2s] = &mut dom.work.disp;
+    let x = [&mut x0s[..n], &mut x1s[..n], &mut x2s[..n]];
+    let prev = [&mut p0s[..n], &mut p1s[..n], &mut p2s[..n]];
+    let base = [&mut b0s[..n], &mut b1s[..n], &mut b2s[..n]];
+    let disp = [&mut d0s[..n], &mut d1s[..n], &mut d2s[..n]];
+    for i in 0..n {
+        let free = aw[i] > 0.0;
+        let (p, v) = (ax[i].to_array(), av[i].to_array());
+        for a in 0..3 {
+            prev[a][i] = p[a];
+            let xi = predict[a].position(p[a], v[a], free);
+            x[a][i] = xi;
+            base[a][i] = (xi - origin[a]) as f32;
+            disp[a][i] = 0.0;
+        }
+    }
+}
+
+/// [`advance_body`] after a substep, adding the pending displacement to each position it reads
+/// when `UNFOLDED`. One pass ending the previous substep and predicting the next: the
+/// velocity update and damping (`Finish::velocity`) kept in a register, never written (the
+/// next substep, or the frame's end, computes it again from the positions).
+#[inline(always)]
+fn advance_from<const UNFOLDED: bool>(dom: &mut Domain, step: &Integration<'_>, finish: Finish) {
     let w = &dom.w[..];
     let n = w.len();
     for a in 0..3 {
-        let (g, wv, drag) = (f.gravity[a], f.wind.velocity[a], f.wind.drag);
-        let (x, v, prev) = (
-            &mut dom.x[a][..n],
-            &mut dom.v[a][..n],
-            &mut dom.prev[a][..n],
-        );
+        let (x, prev) = (&mut dom.x[a][..n], &mut dom.prev[a][..n]);
         // The sweep's f32 state (see `Rebased`), relative to the first particle's position
         // at the substep's start.
         let (base, disp) = (&mut dom.work.base[a][..n], &mut dom.work.disp[a][..n]);
@@ -493,45 +551,17 @@ fn advance_from<const UNFOLDED: bool>(
                 x[i]
             }
         };
+        let predict = Predict::along(step, a);
         let origin = if n > 0 { at(x, disp, 0) } else { 0.0 };
         dom.work.origin[a] = origin;
-        // The prediction from velocity v0 (semi-implicit Euler): the new position, and the
-        // velocity to keep (both kept as they were for a pinned particle).
-        let predict = |x0: f64, v0: f64, free: bool| {
-            let acc = g + drag * (wv - v0);
-            let vi = v0 + acc * h;
-            let xi = x0 + vi * h;
-            if free { (xi, vi) } else { (x0, v0) }
-        };
-        match finish {
-            // One pass ending the previous substep and predicting the next: the velocity
-            // update and damping (`Finish::velocity`) kept in a register. The velocity array
-            // is not written: the next substep, or the frame's end, computes it again from the
-            // positions before anything reads it.
-            Some(finish) => {
-                for i in 0..n {
-                    let (x0, free) = (at(x, disp, i), w[i] > 0.0);
-                    let v0 = finish.velocity(x0, prev[i], free);
-                    prev[i] = x0;
-                    let xi = predict(x0, v0, free).0;
-                    x[i] = xi;
-                    base[i] = (xi - origin) as f32;
-                    disp[i] = 0.0;
-                }
-            }
-            None => {
-                // Each value read once into a local: reading `v[i]` again in the selects made
-                // the compiler load it with a masked load.
-                for i in 0..n {
-                    let (x0, v0) = (at(x, disp, i), v[i]);
-                    prev[i] = x0;
-                    let (xi, vi) = predict(x0, v0, w[i] > 0.0);
-                    v[i] = vi;
-                    x[i] = xi;
-                    base[i] = (xi - origin) as f32;
-                    disp[i] = 0.0;
-                }
-            }
+        for i in 0..n {
+            let (x0, free) = (at(x, disp, i), w[i] > 0.0);
+            let v0 = finish.velocity(x0, prev[i], free);
+            prev[i] = x0;
+            let xi = predict.position(x0, v0, free);
+            x[i] = xi;
+            base[i] = (xi - origin) as f32;
+            disp[i] = 0.0;
         }
     }
 }

@@ -41,7 +41,7 @@ use crate::constraints::lanes::{Coef, LANES};
 use crate::constraints::{Block, Distance, Rule};
 use crate::params::FamilyParams;
 
-pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode};
+pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode, Start};
 use layout::Layout;
 use order::Interior;
 pub use simd::{SIMD_ENV, SimdPath, UnknownSimdPath};

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::{Solver, StepStats};
 use crate::chunk::CHUNK;
 use crate::constraints::Rule;
-use crate::domains::{AosChunk, Domain, Finish, Integration};
+use crate::domains::{AosChunk, Domain, Finish, Integration, Start};
 use crate::hook::{SubstepContext, SubstepHook};
 
 /// How a frame ended.
@@ -87,18 +87,17 @@ impl Solver {
         }
         let forces = &self.forces;
         let work = |k: u32, d: &mut Domain, aos: &AosChunk<'_>| {
-            let finish = if k == 0 {
-                d.load(aos);
-                None
+            let start = if k == 0 {
+                Start::Store(aos)
             } else {
-                Some(Finish { inv_h, keep })
+                Start::Finish(Finish { inv_h, keep })
             };
             let step = Integration {
                 h,
                 forces,
                 pins: &targets[k as usize],
             };
-            d.integrate(&step, finish, lambda);
+            d.integrate(&step, start, lambda);
         };
         let stop = self.stop.as_deref();
         let p = &self.particles;
