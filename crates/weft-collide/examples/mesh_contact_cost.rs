@@ -16,7 +16,9 @@
 //! `cargo run --release -p weft-collide --example mesh_contact_cost -- [REPS] [SCENE]`; set
 //! `RAYON_NUM_THREADS` to choose the thread count and `WEFT_SIMD` the solver's kernel path.
 //! SCENE `mesh`, `sphere` or `deforming` steps only that scene's collider frame `REPS` times
-//! (for a profiler).
+//! from copies of the same state, `ground` the mesh scene's cloth on the ground alone, `REPS`
+//! frames in a row (for a profiler); `steady` steps the static scenes continuously instead of
+//! from copies (as a running app steps them), three rounds alternating between them.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
@@ -85,6 +87,50 @@ fn with(reps: usize, s: &Solver, w: &CollisionWorld) -> (Option<f64>, f64) {
     )
 }
 
+/// Median wall-clock milliseconds of `reps` frames of `s` (with `w`, if given) stepped one
+/// after another: no copies, so caches and the solver's buffers are as a running app has them.
+fn steady(reps: usize, s: &mut Solver, w: Option<&mut CollisionWorld>) -> (Option<f64>, f64) {
+    let mut wall = Vec::new();
+    let mut w = w;
+    for _ in 0..reps {
+        let t0 = Instant::now();
+        let stats = match w.as_deref_mut() {
+            Some(w) => s.step_with(w),
+            None => s.step(),
+        };
+        std::hint::black_box(stats.expect("stable"));
+        wall.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    (None, median(wall))
+}
+
+/// The static scenes stepped continuously, in three rounds alternating between them.
+fn steady_frames(reps: usize) {
+    let (solver, mesh) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
+    let (sphere_solver, sphere) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
+    let mut ground_only = CollisionWorld::new(&solver);
+    ground_only
+        .add_collider(&ground(-SPHERE_RADIUS))
+        .expect("ground");
+    let mut cases = [
+        ("bare solve (mesh scene)", solver.clone(), None),
+        ("ground alone", solver.clone(), Some(ground_only)),
+        ("20,480-triangle mesh + ground", solver, Some(mesh)),
+        ("bare solve (sphere scene)", sphere_solver.clone(), None),
+        ("analytic sphere + ground", sphere_solver, Some(sphere)),
+    ];
+    println!(
+        "solver kernel path: {}; static scenes at 128², stepped continuously, median of {reps} frames:",
+        cases[0].1.simd_path()
+    );
+    for round in 1..=3 {
+        println!("round {round}");
+        for (name, s, w) in &mut cases {
+            show(name, steady(reps, s, w.as_mut()));
+        }
+    }
+}
+
 fn show(name: &str, (cpu, wall): (Option<f64>, f64)) {
     match cpu {
         Some(c) => println!("  {name:<34} CPU {c:7.2} ms   wall {wall:7.2} ms"),
@@ -110,6 +156,13 @@ fn main() {
             show("20,480-triangle mesh + ground", with(reps, &s, &w));
             return;
         }
+        Some("ground") => {
+            let (mut s, _) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
+            let mut w = CollisionWorld::new(&s);
+            w.add_collider(&ground(-SPHERE_RADIUS)).expect("ground");
+            show("ground alone", steady(reps, &mut s, Some(&mut w)));
+            return;
+        }
         Some("sphere") => {
             let (s, w) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
             show("analytic sphere + ground", with(reps, &s, &w));
@@ -118,6 +171,10 @@ fn main() {
         Some("deforming") => {
             let (s, w) = in_contact(breathing_drop(Method::Xpbd, 90).expect("scene"));
             show("deforming mesh + ground", with(reps, &s, &w));
+            return;
+        }
+        Some("steady") => {
+            steady_frames(reps);
             return;
         }
         _ => {}

@@ -8,6 +8,7 @@ mod analytic;
 #[cfg(test)]
 mod analytic_vs_parry;
 pub mod body;
+mod closed_run;
 mod collider;
 mod convert;
 mod error;

@@ -11,7 +11,7 @@ use crate::collider::Collider;
 pub(crate) type Bounds = (DVec3, DVec3);
 
 /// Relative slack on a ball's reach, far above the rounding of |x − c| − R (~1e-16).
-const BALL_SLACK: f64 = 1e-9;
+pub(crate) const BALL_SLACK: f64 = 1e-9;
 
 /// A collider's reach at the current pose: where a particle of thickness r may be within r
 /// of the surface (or inside it).

@@ -9,6 +9,7 @@
 //! v = (x − x_prev) / h then removes the normal approach velocity, exactly as it does for XPBD
 //! and PBD.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
@@ -19,6 +20,7 @@ use weft_solver::{
 
 use crate::analytic::WorldPose;
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
+use crate::closed_run::{Run, Still, resolve_still};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::friction::Friction;
@@ -62,6 +64,9 @@ pub struct CollisionWorld {
     /// Per collider, which particles it can touch at the current pose; refreshed every
     /// substep with `bounds`.
     reach: Vec<Reach>,
+    /// Per collider, the still half-space or ball it is at the current pose, if it is one
+    /// (the fused frame pushes particles out of those a run at a time); refreshed with `reach`.
+    still: Vec<Option<Still>>,
     /// Largest thickness of any particle (m).
     max_thickness: f64,
     fresh: bool,
@@ -96,6 +101,7 @@ impl CollisionWorld {
             self_collision: None,
             bounds: Vec::new(),
             reach: Vec::new(),
+            still: Vec::new(),
             max_thickness: 0.0,
             fresh: true,
             stats: ContactStats::default(),
@@ -180,6 +186,7 @@ impl CollisionWorld {
         self.colliders.push(c);
         self.bounds.push(None);
         self.reach.push(Reach::Box(None));
+        self.still.push(None);
         self.mesh_lists.clear();
         Ok(self.colliders.len() - 1)
     }
@@ -525,7 +532,13 @@ fn sweep_path(
 
 /// Pushes one particle out of one collider to surface + `r`, with friction against the
 /// surface's motion; returns the contacts resolved and the deepest overlap.
-fn resolve_one(c: &Collider, parry: bool, prev: DVec3, x: &mut DVec3, r: f64) -> (usize, f64) {
+pub(crate) fn resolve_one(
+    c: &Collider,
+    parry: bool,
+    prev: DVec3,
+    x: &mut DVec3,
+    r: f64,
+) -> (usize, f64) {
     let friction = c.friction();
     let (mut contacts, mut deepest) = (0, 0.0f64);
     // A closed-form shape reports any point inside it, so only a surface nearer than r can
@@ -580,9 +593,10 @@ impl SubstepHook for CollisionWorld {
         self.build_grids();
         let t0 = ctx.time - ctx.h;
         let margin = self.search_margin();
-        for ((c, b), reach) in (self.colliders.iter_mut())
+        for (((c, b), reach), still) in (self.colliders.iter_mut())
             .zip(&mut self.bounds)
             .zip(&mut self.reach)
+            .zip(&mut self.still)
         {
             c.set_time(t0, ctx.time);
             *b = c.world_aabb(0.0).map(|a| {
@@ -590,6 +604,7 @@ impl SubstepHook for CollisionWorld {
                 (a.mins.as_dvec3() - m, a.maxs.as_dvec3() + m)
             });
             *reach = Reach::of(c, *b);
+            *still = Still::of(c);
         }
         let reach = 2.0 * self.max_thickness;
         for b in &mut self.bodies {
@@ -678,14 +693,79 @@ impl ParticleContacts for CollisionWorld {
     #[inline]
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        self.resolve_particle(&frames, i, x, prev, fresh)
+        self.resolve_particle(&frames, 0..frames.len(), fresh, i, x, prev)
     }
 
-    /// As the default, with each mesh's frame and grid looked up once per run.
+    /// [`Self::resolve`] on every free particle of the run, collider by collider (each
+    /// particle meets the colliders in the same order, and what one particle meets depends on
+    /// that particle alone, so the bits are the same): the substep's sweep first, then each
+    /// mesh on its grid particle by particle, each still half-space or ball a block of
+    /// particles at a time ([`resolve_still`]), any other collider particle by particle.
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        run.each_free(|i, x, prev| self.resolve_particle(&frames, i, x, prev, fresh))
+        let ParticleRun { start, x, prev, w } = run;
+        let mut x = x;
+        let r = &self.thickness[start..start + w.len()];
+        let n = self.colliders.len();
+        let mut total = Contacts::default();
+        let (mut k, mut sweep) = (0, fresh);
+        while k < n || sweep {
+            // Colliders `k..still` particle by particle (after the sweep in the substep's
+            // first pass), then collider `still`, if any, a block at a time.
+            let still = (k..n)
+                .find(|&j| self.still[j].is_some() && frames[j].is_none())
+                .unwrap_or(n);
+            if still > k || sweep {
+                let pass = each_free(start, &mut x, prev, w, |i, p, before| {
+                    self.resolve_particle(&frames, k..still, sweep, i, p, before)
+                });
+                total = total.merge(pass);
+                sweep = false;
+            }
+            if let Some(Some(surface)) = self.still.get(still) {
+                let [a, b, c] = &mut x;
+                let run = Run {
+                    x: [&mut **a, &mut **b, &mut **c],
+                    prev,
+                    w,
+                    r,
+                };
+                total = total.merge(resolve_still(
+                    *surface,
+                    self.colliders[still].friction(),
+                    run,
+                ));
+            }
+            k = still + 1;
+        }
+        total
     }
+}
+
+/// Calls `f(i, x, prev)` on every free particle of a run in order (global index from
+/// `start`, position to move, position at the substep's start), stores the moved positions
+/// and merges what `f` returns.
+#[inline(always)]
+fn each_free(
+    start: usize,
+    x: &mut [&mut [f64]; 3],
+    prev: [&[f64]; 3],
+    w: &[f64],
+    mut f: impl FnMut(usize, &mut DVec3, DVec3) -> Contacts,
+) -> Contacts {
+    let mut sum = Contacts::default();
+    for (j, &wj) in w.iter().enumerate() {
+        if wj == 0.0 {
+            continue;
+        }
+        let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
+        let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
+        sum = sum.merge(f(start + j, &mut p, before));
+        for a in 0..3 {
+            x[a][j] = p[a];
+        }
+    }
+    sum
 }
 
 impl CollisionWorld {
@@ -696,24 +776,30 @@ impl CollisionWorld {
             .collect()
     }
 
-    /// [`ParticleContacts::resolve`] with the frames of [`Self::grid_frames`].
+    /// [`ParticleContacts::resolve`] with the frames of [`Self::grid_frames`], against colliders
+    /// `range` alone, after the substep's sweep when `sweep`.
     #[inline(always)]
     fn resolve_particle(
         &self,
         frames: &[Option<(MeshFrame<'_>, GridRef<'_>)>],
+        range: Range<usize>,
+        sweep: bool,
         i: usize,
         x: &mut DVec3,
         prev: DVec3,
-        fresh: bool,
     ) -> Contacts {
         let (parry, r) = (self.parry_meshes, self.thickness[i]);
         let mut out = Contacts::default();
         // Meshes (on their grids here) sweep in their own contacts.
-        if fresh {
+        if sweep {
             let mesh = |k: usize| frames[k].is_some();
             out.swept = sweep_one(&self.colliders, &self.bounds, mesh, parry, prev, x, r);
         }
-        for ((c, reach), frame) in self.colliders.iter().zip(&self.reach).zip(frames) {
+        let colliders = self.colliders[range.clone()].iter();
+        for ((c, reach), frame) in colliders
+            .zip(&self.reach[range.clone()])
+            .zip(&frames[range])
+        {
             if let Some((frame, grid)) = frame {
                 let o = frame.resolve_in_grid(*grid, i, prev, x, r);
                 out.contacts += o.contacts;
