@@ -11,7 +11,7 @@
 
 use glam::DVec3;
 use multiversion::multiversion;
-use weft_solver::Contacts;
+use weft_solver::{Contacts, SimdPath};
 
 use crate::analytic::Analytic;
 use crate::collider::Collider;
@@ -84,17 +84,47 @@ pub(crate) struct Run<'a> {
 
 /// Pushes every free particle of `run` within its thickness of `surface` out to that distance
 /// and applies `friction` against the still surface; returns the contacts and the deepest.
-pub(crate) fn resolve_still(surface: Still, friction: Friction, run: Run<'_>) -> Contacts {
-    resolve_dispatch(surface, friction, run)
+/// Compiled for kernel path `path` (the solver's: every path gives the same bits).
+pub(crate) fn resolve_still(
+    surface: Still,
+    friction: Friction,
+    run: Run<'_>,
+    path: SimdPath,
+) -> Contacts {
+    match path {
+        SimdPath::Avx512 => run_avx512(surface, friction, run),
+        SimdPath::Avx2 => run_avx2(surface, friction, run),
+        SimdPath::Neon => run_neon(surface, friction, run),
+        SimdPath::Scalar => run_scalar(surface, friction, run),
+    }
 }
 
-/// [`resolve_still`] compiled for the widest vector unit the CPU has.
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512dq+avx2+fma",
-    "x86_64+avx2+fma",
-    "aarch64+neon"
-))]
-fn resolve_dispatch<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+/// [`resolve_still`] compiled for AVX-512 (the baseline build where the CPU lacks it).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
+fn run_avx512<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+    run_body(surface, friction, run)
+}
+
+/// [`resolve_still`] compiled for AVX2 and FMA.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn run_avx2<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+    run_body(surface, friction, run)
+}
+
+/// [`resolve_still`] compiled for NEON.
+#[multiversion(targets("aarch64+neon"))]
+fn run_neon<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+    run_body(surface, friction, run)
+}
+
+/// [`resolve_still`] compiled for the baseline target.
+#[inline(never)]
+fn run_scalar(surface: Still, friction: Friction, run: Run<'_>) -> Contacts {
+    run_body(surface, friction, run)
+}
+
+#[inline(always)]
+fn run_body(surface: Still, friction: Friction, run: Run<'_>) -> Contacts {
     let Run { x, prev, w, r } = run;
     let n = w.len();
     let [x0, x1, x2] = x;
@@ -326,7 +356,7 @@ mod tests {
                 let surface = Still::of(&c).expect("a still plane or ball");
                 let reach = Reach::of(&c, None);
                 // 1003: full blocks and a remainder.
-                let (mut x, prev, w, r) = particles(&c, 1003, 11 + k as u64);
+                let (x, prev, w, r) = particles(&c, 1003, 11 + k as u64);
                 let (mut expected, mut contacts, mut deepest) = (x.clone(), 0, 0.0f64);
                 for i in 0..w.len() {
                     let mut p = DVec3::new(x[0][i], x[1][i], x[2][i]);
@@ -340,23 +370,29 @@ mod tests {
                         expected[a][i] = p[a];
                     }
                 }
-                let [x0, x1, x2] = &mut x;
-                let run = Run {
-                    x: [x0, x1, x2],
-                    prev: [&prev[0], &prev[1], &prev[2]],
-                    w: &w,
-                    r: &r,
-                };
-                let total = resolve_still(surface, friction, run);
-                for a in 0..3 {
-                    let same = x[a]
-                        .iter()
-                        .zip(&expected[a])
-                        .all(|(p, q)| p.to_bits() == q.to_bits());
-                    assert!(same, "{shape:?}, {friction:?}: axis {a} differs");
+                for path in [
+                    SimdPath::Avx512,
+                    SimdPath::Avx2,
+                    SimdPath::Neon,
+                    SimdPath::Scalar,
+                ] {
+                    let mut x = x.clone();
+                    let [x0, x1, x2] = &mut x;
+                    let run = Run {
+                        x: [x0, x1, x2],
+                        prev: [&prev[0], &prev[1], &prev[2]],
+                        w: &w,
+                        r: &r,
+                    };
+                    let total = resolve_still(surface, friction, run, path);
+                    for a in 0..3 {
+                        let same = (x[a].iter().zip(&expected[a]))
+                            .all(|(p, q)| p.to_bits() == q.to_bits());
+                        assert!(same, "{shape:?}, {friction:?}, {path:?}: axis {a} differs");
+                    }
+                    assert_eq!(total.contacts, contacts, "{shape:?}, {path:?}");
+                    assert_eq!(total.depth.to_bits(), deepest.to_bits(), "{shape:?}");
                 }
-                assert_eq!(total.contacts, contacts, "{shape:?}");
-                assert_eq!(total.depth.to_bits(), deepest.to_bits(), "{shape:?}");
                 // Some particles touched and some did not.
                 assert!(contacts > 200 && contacts < 900, "{shape:?}: {contacts}");
             }

@@ -703,7 +703,13 @@ impl ParticleContacts for CollisionWorld {
     /// particles at a time ([`resolve_still`]), any other collider particle by particle.
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        let ParticleRun { start, x, prev, w } = run;
+        let ParticleRun {
+            start,
+            x,
+            prev,
+            w,
+            path,
+        } = run;
         let mut x = x;
         let r = &self.thickness[start..start + w.len()];
         let n = self.colliders.len();
@@ -730,11 +736,8 @@ impl ParticleContacts for CollisionWorld {
                     w,
                     r,
                 };
-                total = total.merge(resolve_still(
-                    *surface,
-                    self.colliders[still].friction(),
-                    run,
-                ));
+                let friction = self.colliders[still].friction();
+                total = total.merge(resolve_still(*surface, friction, run, path));
             }
             k = still + 1;
         }

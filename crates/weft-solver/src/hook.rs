@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use crate::domains::SimdPath;
 use crate::method::Method;
 use crate::particles::Particles;
 
@@ -99,6 +100,8 @@ pub struct ParticleRun<'a> {
     pub prev: [&'a [f64]; 3],
     /// Inverse masses; a pinned particle (0) is left alone.
     pub w: &'a [f64],
+    /// The kernel path the solver runs on (a hook's own vector loops may follow it).
+    pub path: SimdPath,
 }
 
 impl ParticleRun<'_> {
@@ -107,7 +110,9 @@ impl ParticleRun<'_> {
     /// `f` returns.
     #[inline(always)]
     pub fn each_free(self, mut f: impl FnMut(usize, &mut DVec3, DVec3) -> Contacts) -> Contacts {
-        let ParticleRun { start, x, prev, w } = self;
+        let ParticleRun {
+            start, x, prev, w, ..
+        } = self;
         let mut total = Contacts::default();
         for (j, &wj) in w.iter().enumerate() {
             if wj == 0.0 {

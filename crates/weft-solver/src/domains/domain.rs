@@ -281,6 +281,7 @@ impl Domain {
             x: [&mut x0[..n], &mut x1[..n], &mut x2[..n]],
             prev: [&p0[..n], &p1[..n], &p2[..n]],
             w: &self.w[..n],
+            path: self.path,
         };
         contacts.resolve_run(run, fresh)
     }
