@@ -7,16 +7,20 @@
 //!   self-collision, ground).
 //!
 //! Each scenario is first stepped with its collision world until the cloth is in contact;
-//! `with` then steps it through the world (`step_with`), `without` steps a fresh copy of
-//! that state without any (`step`). The difference is the collision cost per frame.
+//! `with` then steps it through the world (`step_with`), frame after frame; `without` steps
+//! copies of that state without any (`step`), also warm (`common::warm_frames`: a fresh copy
+//! every 20 frames, so the cloth does not fall far). The difference is the collision cost per
+//! frame.
 //!
 //! `self_vs_solve/16384` puts, at N = 128, the constraint solve (a frame without collisions),
 //! the solve with self-collision only (no ground), and the self-collision hook alone (its
 //! calls of one frame: per substep `begin_substep`, `project` per iteration, `end_substep`,
 //! on the unmoving state) side by side.
 
+mod common;
+
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use criterion::{
     BatchSize, Bencher, BenchmarkGroup, BenchmarkId, Criterion, SamplingMode, Throughput,
@@ -49,35 +53,10 @@ fn in_contact(build: Scenario, n: usize) -> (Solver, CollisionWorld) {
     (solver, world)
 }
 
-/// Frames stepped from one copy before the next copy is made (a third of a second): without
-/// its colliders the cloth would otherwise fall for thousands of frames and leave the
-/// divergence bound.
-const REFRESH: u64 = 20;
-
-/// Times frames of copies of `solver` stepped without collisions, each frame warm: the same
-/// copy's previous frame ran just before it, as in a running app (a frame timed on a fresh
-/// copy made in criterion's batches starts with cold caches, which made the bare solve look
-/// up to 1.9× slower than it runs). A fresh copy, made and stepped once untimed, every
-/// [`REFRESH`] frames.
+/// Warm frames of copies of `solver` stepped without collisions (see
+/// `common::warm_frames`).
 fn step_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver) {
-    b.iter_custom(|iters| {
-        let mut total = Duration::ZERO;
-        let mut copy = None;
-        for i in 0..iters {
-            if i % REFRESH == 0 {
-                copy = None;
-            }
-            let s = copy.get_or_insert_with(|| {
-                let mut s = solver.clone();
-                s.step().expect("stable");
-                s
-            });
-            let start = Instant::now();
-            black_box(s.step().expect("stable"));
-            total += start.elapsed();
-        }
-        total
-    });
+    common::warm_frames(b, solver, None);
 }
 
 fn with_and_without(c: &mut Criterion, name: &str, build: Scenario) {

@@ -13,10 +13,11 @@
 //!   against its own constraint solve.
 //!
 //! Every timed frame is warm: it follows the same copy's previous frame, as in a running app
-//! (see `warm_frames`).
+//! (see `common::warm_frames`).
 
-use std::hint::black_box;
-use std::time::{Duration, Instant};
+mod common;
+
+use std::time::Duration;
 
 use criterion::{
     Bencher, BenchmarkGroup, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
@@ -24,7 +25,7 @@ use criterion::{
 };
 use weft_collide::CollisionWorld;
 use weft_collide::scenarios::{balls_alone, breathing_drop, icosphere_drop, sphere_drop};
-use weft_solver::{Method, Solver, StepStats};
+use weft_solver::{Method, Solver};
 
 /// Frames stepped before timing: the cloth has fallen onto the collider.
 const PREROLL: usize = 30;
@@ -43,53 +44,14 @@ fn in_contact(mut scene: (Solver, CollisionWorld)) -> (Solver, CollisionWorld) {
     scene
 }
 
-/// Frames stepped from one copy before the next copy is made: every timed frame is within a
-/// third of a second of the draped state.
-const REFRESH: u64 = 20;
-
-/// One frame of `solver`, through `world` if given.
-fn frame(solver: &mut Solver, world: Option<&mut CollisionWorld>) -> StepStats {
-    match world {
-        Some(w) => solver.step_with(w),
-        None => solver.step(),
-    }
-    .expect("stable")
-}
-
-/// Times frames of copies of `solver` (with copies of `world`, if given), each frame warm: the
-/// same copy's previous frame ran just before it, as in a running app. A fresh copy, made and
-/// stepped once untimed, every [`REFRESH`] frames. (Each frame timed on a fresh copy instead,
-/// made in criterion's batches, starts with cold caches: the bare solve measured 1.9× its
-/// warm time that way.)
-fn warm_frames(b: &mut Bencher<'_, WallTime>, solver: &Solver, world: Option<&CollisionWorld>) {
-    b.iter_custom(|iters| {
-        let mut total = Duration::ZERO;
-        let mut copy = None;
-        for i in 0..iters {
-            if i % REFRESH == 0 {
-                copy = None;
-            }
-            let (s, w) = copy.get_or_insert_with(|| {
-                let (mut s, mut w) = (solver.clone(), world.cloned());
-                frame(&mut s, w.as_mut());
-                (s, w)
-            });
-            let start = Instant::now();
-            black_box(frame(s, w.as_mut()));
-            total += start.elapsed();
-        }
-        total
-    });
-}
-
 /// Warm frames of `solver` without collisions.
 fn step_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver) {
-    warm_frames(b, solver, None);
+    common::warm_frames(b, solver, None);
 }
 
 /// Warm frames of `solver` through `world`.
 fn step_with_copies(b: &mut Bencher<'_, WallTime>, solver: &Solver, world: &CollisionWorld) {
-    warm_frames(b, solver, Some(world));
+    common::warm_frames(b, solver, Some(world));
 }
 
 fn static_mesh(c: &mut Criterion) {

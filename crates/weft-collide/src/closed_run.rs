@@ -1,4 +1,5 @@
-//! The push-out and friction of a still half-space or ball for a run of particles side by side:
+//! The push-out and friction of a still half-space or ball (a [`Surface`] that does not move
+//! during the substep) for a run of particles side by side:
 //! struct-of-arrays, a block of [`LANES`] particles per step, every branch a select, so the
 //! compiler keeps a block in vector registers. Each particle's arithmetic is that of the
 //! reach test and `resolve_one` (closest point, push to the thickness, Coulomb friction),
@@ -9,14 +10,12 @@
 // that each compiles to one vector operation per axis.
 #![allow(clippy::needless_range_loop)]
 
-use glam::DVec3;
 use multiversion::multiversion;
 use weft_solver::{Contacts, SimdPath};
 
-use crate::analytic::Analytic;
 use crate::collider::Collider;
 use crate::friction::Friction;
-use crate::reach::BALL_SLACK;
+use crate::reach::{BALL_SLACK, Reach, Surface};
 
 /// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
 const LANES: usize = 8;
@@ -25,48 +24,12 @@ const LANES: usize = 8;
 /// form's fallback).
 const TINY: f64 = 1e-12;
 
-/// A still closed-form surface at the substep's pose, as the run takes it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Still {
-    /// A half-space: outward unit normal `n` of the plane through `at` (world).
-    Plane {
-        /// Outward unit normal.
-        n: DVec3,
-        /// A point of the plane.
-        at: DVec3,
-    },
-    /// A ball about `centre`; `pole` is the normal taken at the centre itself.
-    Ball {
-        /// Centre (world).
-        centre: DVec3,
-        /// Radius (m).
-        radius: f64,
-        /// The local y axis in world (the closed form's fallback normal).
-        pole: DVec3,
-    },
-}
-
-impl Still {
-    /// `c` at its current pose, if it is a half-space or a ball that does not move during
-    /// the substep.
-    pub(crate) fn of(c: &Collider) -> Option<Self> {
-        let (pose, _, still) = c.poses64();
-        if c.mesh().is_some() || !still {
-            return None;
-        }
-        match c.analytic()? {
-            // As `Reach::of` and `Analytic::closest` compute them.
-            Analytic::HalfSpace { normal } => Some(Self::Plane {
-                n: pose.basis * normal,
-                at: pose.translation,
-            }),
-            Analytic::Sphere { radius } => Some(Self::Ball {
-                centre: pose.translation,
-                radius,
-                pole: pose.basis.y_axis,
-            }),
-            _ => None,
-        }
+/// `c`'s surface, if its reach at the current pose is a half-space or ball and it does not move
+/// during the substep: what [`resolve_still`] takes.
+pub(crate) fn still_surface(c: &Collider, reach: &Reach) -> Option<Surface> {
+    match *reach {
+        Reach::Surface(s) if c.poses64().2 => Some(s),
+        _ => None,
     }
 }
 
@@ -86,7 +49,7 @@ pub(crate) struct Run<'a> {
 /// and applies `friction` against the still surface; returns the contacts and the deepest.
 /// Compiled for kernel path `path` (the solver's: every path gives the same bits).
 pub(crate) fn resolve_still(
-    surface: Still,
+    surface: Surface,
     friction: Friction,
     run: Run<'_>,
     path: SimdPath,
@@ -101,30 +64,30 @@ pub(crate) fn resolve_still(
 
 /// [`resolve_still`] compiled for AVX-512 (the baseline build where the CPU lacks it).
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
-fn run_avx512<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+fn run_avx512<'a>(surface: Surface, friction: Friction, run: Run<'a>) -> Contacts {
     run_body(surface, friction, run)
 }
 
 /// [`resolve_still`] compiled for AVX2 and FMA.
 #[multiversion(targets("x86_64+avx2+fma"))]
-fn run_avx2<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+fn run_avx2<'a>(surface: Surface, friction: Friction, run: Run<'a>) -> Contacts {
     run_body(surface, friction, run)
 }
 
 /// [`resolve_still`] compiled for NEON.
 #[multiversion(targets("aarch64+neon"))]
-fn run_neon<'a>(surface: Still, friction: Friction, run: Run<'a>) -> Contacts {
+fn run_neon<'a>(surface: Surface, friction: Friction, run: Run<'a>) -> Contacts {
     run_body(surface, friction, run)
 }
 
 /// [`resolve_still`] compiled for the baseline target.
 #[inline(never)]
-fn run_scalar(surface: Still, friction: Friction, run: Run<'_>) -> Contacts {
+fn run_scalar(surface: Surface, friction: Friction, run: Run<'_>) -> Contacts {
     run_body(surface, friction, run)
 }
 
 #[inline(always)]
-fn run_body(surface: Still, friction: Friction, run: Run<'_>) -> Contacts {
+fn run_body(surface: Surface, friction: Friction, run: Run<'_>) -> Contacts {
     let Run { x, prev, w, r } = run;
     let n = w.len();
     let [x0, x1, x2] = x;
@@ -182,7 +145,7 @@ impl Tally {
 /// One block of `L` particles: positions `x` moved in place.
 #[inline(always)]
 fn block<const L: usize>(
-    surface: &Still,
+    surface: &Surface,
     friction: Friction,
     x: &mut [[f64; L]; 3],
     prev: &[[f64; L]; 3],
@@ -195,7 +158,7 @@ fn block<const L: usize>(
     let mut normal = [[0.0; L]; 3];
     let mut near = [false; L];
     match *surface {
-        Still::Plane { n, at } => {
+        Surface::Plane { n, at } => {
             for l in 0..L {
                 // n · (x − at), glam's dot order.
                 let d = n.x * (x[0][l] - at.x) + n.y * (x[1][l] - at.y) + n.z * (x[2][l] - at.z);
@@ -206,7 +169,7 @@ fn block<const L: usize>(
                 }
             }
         }
-        Still::Ball {
+        Surface::Ball {
             centre,
             radius,
             pole,
@@ -288,11 +251,10 @@ fn block<const L: usize>(
 
 #[cfg(test)]
 mod tests {
-    use glam::DQuat;
+    use glam::{DQuat, DVec3};
 
     use super::*;
     use crate::collider::ColliderDesc;
-    use crate::reach::Reach;
     use crate::shape::ShapeDesc;
     use crate::test_rand::rand;
     use crate::world::resolve_one;
@@ -353,8 +315,8 @@ mod tests {
                     .rotated(tilted)
                     .with_friction(friction);
                 let c = Collider::new(&desc).expect("valid collider");
-                let surface = Still::of(&c).expect("a still plane or ball");
                 let reach = Reach::of(&c, None);
+                let surface = still_surface(&c, &reach).expect("a still plane or ball");
                 // 1003: full blocks and a remainder.
                 let (x, prev, w, r) = particles(&c, 1003, 11 + k as u64);
                 let (mut expected, mut contacts, mut deepest) = (x.clone(), 0, 0.0f64);
@@ -405,16 +367,22 @@ mod tests {
             .moving(weft_solver::Motion::Linear { velocity: DVec3::X });
         let mut c = Collider::new(&moving).expect("valid");
         c.set_time(0.0, 0.01);
-        assert_eq!(Still::of(&c), None, "a moving ball");
+        assert_eq!(
+            still_surface(&c, &Reach::of(&c, None)),
+            None,
+            "a moving ball"
+        );
         let capsule = ColliderDesc::new(ShapeDesc::Capsule {
             half_height: 0.2,
             radius: 0.1,
         });
-        assert_eq!(Still::of(&Collider::new(&capsule).expect("valid")), None);
+        let c = Collider::new(&capsule).expect("valid");
+        assert_eq!(still_surface(&c, &Reach::of(&c, None)), None, "a capsule");
         let ball = ColliderDesc::new(ShapeDesc::Sphere { radius: 0.4 });
+        let c = Collider::new(&ball).expect("valid");
         assert!(matches!(
-            Still::of(&Collider::new(&ball).expect("valid")),
-            Some(Still::Ball { .. })
+            still_surface(&c, &Reach::of(&c, None)),
+            Some(Surface::Ball { .. })
         ));
     }
 }

@@ -13,27 +13,37 @@ pub(crate) type Bounds = (DVec3, DVec3);
 /// Relative slack on a ball's reach, far above the rounding of |x − c| − R (~1e-16).
 pub(crate) const BALL_SLACK: f64 = 1e-9;
 
+/// A half-space or ball at the current pose, as its closed form computes it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Surface {
+    /// A half-space: outward unit normal `n` of the plane through `at` (world).
+    Plane {
+        /// Outward unit normal.
+        n: DVec3,
+        /// A point of the plane.
+        at: DVec3,
+    },
+    /// A ball about `centre`; `pole` is the normal taken at the centre itself.
+    Ball {
+        /// Centre (world).
+        centre: DVec3,
+        /// Radius (m).
+        radius: f64,
+        /// The local y axis in world (the closed form's fallback normal).
+        pole: DVec3,
+    },
+}
+
 /// A collider's reach at the current pose: where a particle of thickness r may be within r
 /// of the surface (or inside it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Reach {
     /// Inside the box (grown by the search margin), or anywhere for `None`.
     Box(Option<Bounds>),
-    /// A half-space's plane: unit normal `n` through `at`. The signed distance n · (x − at)
-    /// is the one [`Analytic::closest`] computes, bit for bit.
-    Plane {
-        /// Outward unit normal (world).
-        n: DVec3,
-        /// A point of the plane (world).
-        at: DVec3,
-    },
-    /// A ball: |x − centre| − radius ≤ r, tested squared with [`BALL_SLACK`].
-    Ball {
-        /// Centre (world).
-        centre: DVec3,
-        /// Radius (m).
-        radius: f64,
-    },
+    /// A half-space's plane: the signed distance n · (x − at) ≤ r, the one
+    /// [`Analytic::closest`] computes, bit for bit. A ball: |x − centre| − radius ≤ r, tested
+    /// squared with [`BALL_SLACK`].
+    Surface(Surface),
 }
 
 impl Reach {
@@ -45,14 +55,16 @@ impl Reach {
         }
         let (pose, _, _) = c.poses64();
         match c.analytic() {
-            Some(Analytic::HalfSpace { normal }) => Self::Plane {
+            // As `Analytic::closest` computes them.
+            Some(Analytic::HalfSpace { normal }) => Self::Surface(Surface::Plane {
                 n: pose.basis * normal,
                 at: pose.translation,
-            },
-            Some(Analytic::Sphere { radius }) => Self::Ball {
+            }),
+            Some(Analytic::Sphere { radius }) => Self::Surface(Surface::Ball {
                 centre: pose.translation,
                 radius,
-            },
+                pole: pose.basis.y_axis,
+            }),
             _ => Self::Box(bounds),
         }
     }
@@ -63,8 +75,8 @@ impl Reach {
     pub fn may_touch(&self, x: DVec3, r: f64) -> bool {
         match *self {
             Self::Box(b) => b.is_none_or(|(lo, hi)| x.cmpge(lo).all() && x.cmple(hi).all()),
-            Self::Plane { n, at } => n.dot(x - at) <= r,
-            Self::Ball { centre, radius } => {
+            Self::Surface(Surface::Plane { n, at }) => n.dot(x - at) <= r,
+            Self::Surface(Surface::Ball { centre, radius, .. }) => {
                 let reach = (radius + r) * (1.0 + BALL_SLACK);
                 (x - centre).length_squared() <= reach * reach
             }
@@ -147,14 +159,14 @@ mod tests {
         }))
         .expect("valid");
         let reach = Reach::of(&plane, None);
-        assert!(matches!(reach, Reach::Plane { .. }));
+        assert!(matches!(reach, Reach::Surface(Surface::Plane { .. })));
         let r = 0.01;
         assert!(reach.may_touch(DVec3::new(3.0, r, -2.0), r));
         assert!(!reach.may_touch(DVec3::new(3.0, r + 1e-12, -2.0), r));
         let ball =
             Collider::new(&ColliderDesc::new(ShapeDesc::Sphere { radius: 0.5 })).expect("valid");
         let reach = Reach::of(&ball, None);
-        assert!(matches!(reach, Reach::Ball { .. }));
+        assert!(matches!(reach, Reach::Surface(Surface::Ball { .. })));
         assert!(reach.may_touch(DVec3::new(0.0, 0.51, 0.0), r));
         assert!(!reach.may_touch(DVec3::new(0.0, 0.5101, 0.0), r));
     }

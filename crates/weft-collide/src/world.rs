@@ -20,7 +20,7 @@ use weft_solver::{
 
 use crate::analytic::WorldPose;
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
-use crate::closed_run::{Run, Still, resolve_still};
+use crate::closed_run::{Run, resolve_still, still_surface};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::friction::Friction;
@@ -64,9 +64,6 @@ pub struct CollisionWorld {
     /// Per collider, which particles it can touch at the current pose; refreshed every
     /// substep with `bounds`.
     reach: Vec<Reach>,
-    /// Per collider, the still half-space or ball it is at the current pose, if it is one
-    /// (the fused frame pushes particles out of those a run at a time); refreshed with `reach`.
-    still: Vec<Option<Still>>,
     /// Largest thickness of any particle (m).
     max_thickness: f64,
     fresh: bool,
@@ -101,7 +98,6 @@ impl CollisionWorld {
             self_collision: None,
             bounds: Vec::new(),
             reach: Vec::new(),
-            still: Vec::new(),
             max_thickness: 0.0,
             fresh: true,
             stats: ContactStats::default(),
@@ -186,7 +182,6 @@ impl CollisionWorld {
         self.colliders.push(c);
         self.bounds.push(None);
         self.reach.push(Reach::Box(None));
-        self.still.push(None);
         self.mesh_lists.clear();
         Ok(self.colliders.len() - 1)
     }
@@ -593,10 +588,9 @@ impl SubstepHook for CollisionWorld {
         self.build_grids();
         let t0 = ctx.time - ctx.h;
         let margin = self.search_margin();
-        for (((c, b), reach), still) in (self.colliders.iter_mut())
+        for ((c, b), reach) in (self.colliders.iter_mut())
             .zip(&mut self.bounds)
             .zip(&mut self.reach)
-            .zip(&mut self.still)
         {
             c.set_time(t0, ctx.time);
             *b = c.world_aabb(0.0).map(|a| {
@@ -604,7 +598,6 @@ impl SubstepHook for CollisionWorld {
                 (a.mins.as_dvec3() - m, a.maxs.as_dvec3() + m)
             });
             *reach = Reach::of(c, *b);
-            *still = Still::of(c);
         }
         let reach = 2.0 * self.max_thickness;
         for b in &mut self.bodies {
@@ -714,13 +707,12 @@ impl ParticleContacts for CollisionWorld {
         let r = &self.thickness[start..start + w.len()];
         let n = self.colliders.len();
         let mut total = Contacts::default();
+        let surface = |j: usize| still_surface(&self.colliders[j], &self.reach[j]);
         let (mut k, mut sweep) = (0, fresh);
         while k < n || sweep {
             // Colliders `k..still` particle by particle (after the sweep in the substep's
             // first pass), then collider `still`, if any, a block at a time.
-            let still = (k..n)
-                .find(|&j| self.still[j].is_some() && frames[j].is_none())
-                .unwrap_or(n);
+            let still = (k..n).find(|&j| surface(j).is_some()).unwrap_or(n);
             if still > k || sweep {
                 let pass = each_free(start, &mut x, prev, w, |i, p, before| {
                     self.resolve_particle(&frames, k..still, sweep, i, p, before)
@@ -728,7 +720,7 @@ impl ParticleContacts for CollisionWorld {
                 total = total.merge(pass);
                 sweep = false;
             }
-            if let Some(Some(surface)) = self.still.get(still) {
+            if let Some(surface) = (still < n).then(|| surface(still)).flatten() {
                 let [a, b, c] = &mut x;
                 let run = Run {
                     x: [&mut **a, &mut **b, &mut **c],
@@ -737,7 +729,7 @@ impl ParticleContacts for CollisionWorld {
                     r,
                 };
                 let friction = self.colliders[still].friction();
-                total = total.merge(resolve_still(*surface, friction, run, path));
+                total = total.merge(resolve_still(surface, friction, run, path));
             }
             k = still + 1;
         }
