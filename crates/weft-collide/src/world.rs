@@ -694,17 +694,9 @@ impl ParticleContacts for CollisionWorld {
     /// that particle alone, so the bits are the same): the substep's sweep first, then each
     /// mesh on its grid particle by particle, each still half-space or ball a block of
     /// particles at a time ([`resolve_still`]), any other collider particle by particle.
-    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
+    fn resolve_run(&self, mut run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        let ParticleRun {
-            start,
-            x,
-            prev,
-            w,
-            path,
-        } = run;
-        let mut x = x;
-        let r = &self.thickness[start..start + w.len()];
+        let r = &self.thickness[run.start..run.start + run.w.len()];
         let n = self.colliders.len();
         let mut total = Contacts::default();
         let surface = |j: usize| still_surface(&self.colliders[j], &self.reach[j]);
@@ -714,53 +706,27 @@ impl ParticleContacts for CollisionWorld {
             // first pass), then collider `still`, if any, a block at a time.
             let still = (k..n).find(|&j| surface(j).is_some()).unwrap_or(n);
             if still > k || sweep {
-                let pass = each_free(start, &mut x, prev, w, |i, p, before| {
+                let pass = run.each_free(|i, p, before| {
                     self.resolve_particle(&frames, k..still, sweep, i, p, before)
                 });
                 total = total.merge(pass);
                 sweep = false;
             }
             if let Some(surface) = (still < n).then(|| surface(still)).flatten() {
-                let [a, b, c] = &mut x;
-                let run = Run {
+                let [a, b, c] = &mut run.x;
+                let block = Run {
                     x: [&mut **a, &mut **b, &mut **c],
-                    prev,
-                    w,
+                    prev: run.prev,
+                    w: run.w,
                     r,
                 };
                 let friction = self.colliders[still].friction();
-                total = total.merge(resolve_still(surface, friction, run, path));
+                total = total.merge(resolve_still(surface, friction, block, run.path));
             }
             k = still + 1;
         }
         total
     }
-}
-
-/// Calls `f(i, x, prev)` on every free particle of a run in order (global index from
-/// `start`, position to move, position at the substep's start), stores the moved positions
-/// and merges what `f` returns.
-#[inline(always)]
-fn each_free(
-    start: usize,
-    x: &mut [&mut [f64]; 3],
-    prev: [&[f64]; 3],
-    w: &[f64],
-    mut f: impl FnMut(usize, &mut DVec3, DVec3) -> Contacts,
-) -> Contacts {
-    let mut sum = Contacts::default();
-    for (j, &wj) in w.iter().enumerate() {
-        if wj == 0.0 {
-            continue;
-        }
-        let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
-        let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
-        sum = sum.merge(f(start + j, &mut p, before));
-        for a in 0..3 {
-            x[a][j] = p[a];
-        }
-    }
-    sum
 }
 
 impl CollisionWorld {

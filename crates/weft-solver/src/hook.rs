@@ -85,7 +85,7 @@ pub trait ParticleContacts: Sync {
     /// [`Self::resolve`] on every free particle of `run` (nonzero inverse mass), in order:
     /// one call through a trait object per run of particles; inside it `resolve` is called
     /// directly, so an implementation's per-particle work can inline.
-    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
+    fn resolve_run(&self, mut run: ParticleRun<'_>, fresh: bool) -> Contacts {
         run.each_free(|i, x, prev| self.resolve(i, x, prev, fresh))
     }
 }
@@ -107,12 +107,16 @@ pub struct ParticleRun<'a> {
 impl ParticleRun<'_> {
     /// Calls `f(i, x, prev)` on every free particle of the run in order (global index, position
     /// to move, position at the substep's start), stores the moved positions and merges what
-    /// `f` returns.
+    /// `f` returns. A run may be walked several times (one pass per collider, say).
     #[inline(always)]
-    pub fn each_free(self, mut f: impl FnMut(usize, &mut DVec3, DVec3) -> Contacts) -> Contacts {
+    pub fn each_free(
+        &mut self,
+        mut f: impl FnMut(usize, &mut DVec3, DVec3) -> Contacts,
+    ) -> Contacts {
         let ParticleRun {
             start, x, prev, w, ..
         } = self;
+        let (start, prev, w) = (*start, *prev, *w);
         let mut total = Contacts::default();
         for (j, &wj) in w.iter().enumerate() {
             if wj == 0.0 {
