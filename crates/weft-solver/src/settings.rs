@@ -35,7 +35,8 @@ pub struct Settings {
     /// and so the result, depends on this and the mesh, never on the thread count. The default,
     /// 8,192, gives a 128² cloth one domain per core on two cores; smaller domains mean more
     /// constraints across domains (slower on one or two cores), larger ones fewer domains
-    /// than cores on bigger machines.
+    /// than cores on bigger machines. A cloth of 4,096 particles or more is cut in two at
+    /// least, whatever this says, so that two threads share it.
     pub domain_size: usize,
     /// The kernel path of the constraint sweep: `None` takes `WEFT_SIMD` (`avx512`, `avx2`,
     /// `neon` or `scalar`, read once) or else the widest path the CPU runs; a path the CPU

@@ -256,3 +256,24 @@ fn ragged_rows_chunk_with_dead_lanes_that_touch_no_live_lanes_particle() {
         block.len()
     );
 }
+
+#[test]
+fn a_cloth_of_4096_particles_or_more_is_cut_in_two_at_least() {
+    // 63² = 3,969 particles stay one domain of the default size; 64² = 4,096 and 90² = 8,100
+    // fit in one as well but are halved, so that two threads share them; 128² = 16,384 takes
+    // two by its size alone, and a smaller size still cuts it finer.
+    for (side, size, domains) in [
+        (63, 8192, 1),
+        (64, 8192, 2),
+        (90, 8192, 2),
+        (90, 100_000, 2),
+        (128, 8192, 2),
+        (128, 4096, 4),
+    ] {
+        let (block, n) = block(side, false);
+        let d = Domains::new(&block, n, size, SimdPath::Scalar);
+        assert_eq!(d.stats().domains, domains, "{side}², size {size}");
+        // Every particle lies in exactly one domain.
+        assert_eq!(d.list.iter().map(Domain::len).sum::<usize>(), n);
+    }
+}
