@@ -13,7 +13,7 @@ use crate::shape::ShapeDesc;
 use crate::surface::SurfacePoint;
 
 /// Below this length (m) a direction is taken as undefined and a fixed fallback is used.
-const TINY: f64 = 1e-12;
+pub(crate) const TINY: f64 = 1e-12;
 
 /// A rigid pose in f64: x_world = R x_local + t.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -13,16 +13,13 @@
 use multiversion::multiversion;
 use weft_solver::{Contacts, SimdPath};
 
+use crate::analytic::TINY;
 use crate::collider::Collider;
 use crate::friction::Friction;
 use crate::reach::{BALL_SLACK, Reach, Surface};
 
 /// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
 const LANES: usize = 8;
-
-/// Below this distance from a ball's centre the normal is the ball's pole (as the closed
-/// form's fallback).
-const TINY: f64 = 1e-12;
 
 /// `c`'s surface, if its reach at the current pose is a half-space or ball and it does not move
 /// during the substep: what [`resolve_still`] takes.
@@ -94,7 +91,7 @@ fn run_body(surface: Surface, friction: Friction, run: Run<'_>) -> Contacts {
     let x = [&mut x0[..n], &mut x1[..n], &mut x2[..n]];
     let prev = [&prev[0][..n], &prev[1][..n], &prev[2][..n]];
     let r = &r[..n];
-    let mut total = Tally::default();
+    let mut total = Contacts::default();
     let full = n - n % LANES;
     for s in (0..full).step_by(LANES) {
         let mut xb = [[0.0; LANES]; 3];
@@ -111,38 +108,21 @@ fn run_body(surface: Surface, friction: Friction, run: Run<'_>) -> Contacts {
                 x[a][s..s + LANES].copy_from_slice(&xb[a]);
             }
         }
-        total.add(tally);
+        total = total.merge(tally);
     }
     for i in full..n {
         let mut xb = [[x[0][i]], [x[1][i]], [x[2][i]]];
         let pb = [[prev[0][i]], [prev[1][i]], [prev[2][i]]];
-        total.add(block(&surface, friction, &mut xb, &pb, &[w[i]], &[r[i]]));
+        total = total.merge(block(&surface, friction, &mut xb, &pb, &[w[i]], &[r[i]]));
         for a in 0..3 {
             x[a][i] = xb[a][0];
         }
     }
-    Contacts {
-        contacts: total.contacts,
-        swept: 0,
-        depth: total.deepest,
-    }
+    total
 }
 
-/// Contacts of a block: how many, and the deepest (0 when none).
-#[derive(Clone, Copy, Debug, Default)]
-struct Tally {
-    contacts: usize,
-    deepest: f64,
-}
-
-impl Tally {
-    fn add(&mut self, other: Self) {
-        self.contacts += other.contacts;
-        self.deepest = self.deepest.max(other.deepest);
-    }
-}
-
-/// One block of `L` particles: positions `x` moved in place.
+/// One block of `L` particles: positions `x` moved in place; returns the contacts and the
+/// deepest (0 when none; nothing is swept).
 #[inline(always)]
 fn block<const L: usize>(
     surface: &Surface,
@@ -151,7 +131,7 @@ fn block<const L: usize>(
     prev: &[[f64; L]; 3],
     w: &[f64; L],
     r: &[f64; L],
-) -> Tally {
+) -> Contacts {
     // The closest point's signed distance and normal, and whether the reach test and the
     // closed form's distance test both pass (`Reach::may_touch`, `Analytic::closest`).
     let mut distance = [0.0; L];
@@ -198,7 +178,7 @@ fn block<const L: usize>(
         push[l] = (w[l] != 0.0) & near[l] & (depth[l] > 1e-6 * r[l].max(1e-3));
     }
     if !push.contains(&true) {
-        return Tally::default();
+        return Contacts::default();
     }
     // Pushed out along the normal, then friction on the slip since the substep's start
     // relative to the still surface (Macklin et al. 2014, eq. 24; `Friction::correction`).
@@ -239,11 +219,11 @@ fn block<const L: usize>(
             x[a][l] = if push[l] { done } else { x[a][l] };
         }
     }
-    let mut tally = Tally::default();
+    let mut tally = Contacts::default();
     for l in 0..L {
         if push[l] {
             tally.contacts += 1;
-            tally.deepest = tally.deepest.max(depth[l]);
+            tally.depth = tally.depth.max(depth[l]);
         }
     }
     tally

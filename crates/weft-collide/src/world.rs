@@ -704,7 +704,8 @@ impl ParticleContacts for CollisionWorld {
         while k < n || sweep {
             // Colliders `k..still` particle by particle (after the sweep in the substep's
             // first pass), then collider `still`, if any, a block at a time.
-            let still = (k..n).find(|&j| surface(j).is_some()).unwrap_or(n);
+            let next = (k..n).find_map(|j| surface(j).map(|s| (j, s)));
+            let still = next.map_or(n, |(j, _)| j);
             if still > k || sweep {
                 let pass = run.each_free(|i, p, before| {
                     self.resolve_particle(&frames, k..still, sweep, i, p, before)
@@ -712,7 +713,7 @@ impl ParticleContacts for CollisionWorld {
                 total = total.merge(pass);
                 sweep = false;
             }
-            if let Some(surface) = (still < n).then(|| surface(still)).flatten() {
+            if let Some((_, surface)) = next {
                 let [a, b, c] = &mut run.x;
                 let block = Run {
                     x: [&mut **a, &mut **b, &mut **c],
