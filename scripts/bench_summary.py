@@ -241,8 +241,10 @@ def dressed(r):
     for f, label in [("tshirt: solve + body + self-collision", "solve + body contact + self-collision"),
                      ("tshirt: solve + body", "solve + body contact"),
                      ("tshirt: solve only", "solve only (general loop, no contact)"),
-                     ("tshirt, bend-distance: solve + body + self-collision",
-                      "whole frame, bend-distance instead of dihedral bending")]:
+                     ("tshirt, dihedral: solve + body + self-collision",
+                      "whole frame, dihedral bending instead of the preset's isometric bending"),
+                     ("tshirt, dihedral: solve only",
+                      "solve only, dihedral bending (general loop, no contact)")]:
         print(f"| {label} | {fmt(ms(r, f'dressed walker frame/{f}'))} |")
     print()
     print("| a 12,903-particle sheet draped on the walking walker | ms/frame |")
