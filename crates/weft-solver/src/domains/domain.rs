@@ -60,6 +60,10 @@ pub(crate) struct Domain {
     pub(super) prev: [Vec<f64>; 3],
     /// Inverse masses (1/kg).
     pub(super) w: Vec<f64>,
+    /// Local indices of the particles with no inverse mass (pinned or fixed), in order: after
+    /// the first substep the integration predicts every particle alike and then puts these
+    /// back where they were.
+    pub(super) fixed: Vec<u32>,
     /// The sweep's working state (see [`Rebased`]).
     pub(super) work: Rebased,
     /// Interior constraints in local indices, sorted by colour, group and particle.
@@ -176,8 +180,18 @@ impl Domain {
         }
         self.w.copy_from_slice(w);
         self.work.set_masses(w);
+        self.note_fixed();
         self.work.fresh = false;
         self.work.unfolded = false;
+    }
+
+    /// Lists the particles with no inverse mass ([`Self::fixed`]).
+    fn note_fixed(&mut self) {
+        self.fixed.clear();
+        // Not free exactly where the integration's `w > 0` test fails (NaN included).
+        let free = |w: f64| w > 0.0;
+        let fixed = self.w.iter().enumerate().filter(|&(_, &w)| !free(w));
+        self.fixed.extend(fixed.map(|(i, _)| i as u32));
     }
 
     /// Adds the last sweep's displacement to the f64 positions if it is still pending (each
@@ -506,6 +520,7 @@ fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
     let (ax, av, aw) = (&aos.x[..n], &aos.v[..n], &aos.w[..n]);
     dom.w.copy_from_slice(aw);
     dom.work.set_masses(aw);
+    dom.note_fixed();
     dom.work.unfolded = false;
     let predict = [0, 1, 2].map(|a| Predict::along(step, a));
     let origin = ax.first().map_or([0.0; 3], |p| p.to_array());
@@ -538,8 +553,8 @@ fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
 /// next substep, or the frame's end, computes it again from the positions).
 #[inline(always)]
 fn advance_from<const UNFOLDED: bool>(dom: &mut Domain, step: &Integration<'_>, finish: Finish) {
-    let w = &dom.w[..];
-    let n = w.len();
+    let n = dom.len();
+    let fixed = &dom.fixed;
     for a in 0..3 {
         let (x, prev) = (&mut dom.x[a][..n], &mut dom.prev[a][..n]);
         // The sweep's f32 state (see `Rebased`), relative to the first particle's position
@@ -555,14 +570,21 @@ fn advance_from<const UNFOLDED: bool>(dom: &mut Domain, step: &Integration<'_>, 
         let predict = Predict::along(step, a);
         let origin = if n > 0 { at(x, disp, 0) } else { 0.0 };
         dom.work.origin[a] = origin;
+        // Every particle as a free one (no inverse mass read, no select), ...
         for i in 0..n {
-            let (x0, free) = (at(x, disp, i), w[i] > 0.0);
-            let v0 = finish.velocity(x0, prev[i], free);
+            let x0 = at(x, disp, i);
+            let v0 = finish.velocity(x0, prev[i], true);
             prev[i] = x0;
-            let xi = predict.position(x0, v0, free);
+            let xi = predict.position(x0, v0, true);
             x[i] = xi;
             base[i] = (xi - origin) as f32;
             disp[i] = 0.0;
+        }
+        // ... then the fixed ones back where they started (what `position` keeps for them).
+        for &i in fixed {
+            let x0 = prev[i as usize];
+            x[i as usize] = x0;
+            base[i as usize] = (x0 - origin) as f32;
         }
     }
 }
