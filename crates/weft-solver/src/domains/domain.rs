@@ -264,8 +264,9 @@ impl Domain {
     /// velocities and inverse masses read straight from it), or the previous substep, which it
     /// ends (v = (x − x_prev)/h, then damping v ← v·keep of free particles). Then predicts with
     /// semi-implicit Euler, a = g + c_d (v_wind − v), and applies the pins — the same
-    /// arithmetic, particle by particle, as the solver's general loop. Clears the multipliers
-    /// when `lambda`.
+    /// arithmetic, particle by particle, as the solver's general loop (after the first substep,
+    /// in still air, it takes a = g: the same bits for any finite velocity, see
+    /// `Predict::still_air`). Clears the multipliers when `lambda`.
     pub fn integrate(&mut self, step: &Integration<'_>, start: Start<'_>, lambda: bool) {
         advance(self, step, start);
         let range = self.start..self.start + self.len();
@@ -500,6 +501,20 @@ impl Predict {
         }
     }
 
+    /// No drag (c_d = +0) and gravity not −0 along this axis: then g + c_d (v_wind − v) = g
+    /// exactly for every finite v (c_d (v_wind − v) is ±0, and g + ±0 = g unless g is −0).
+    fn still_air(self) -> bool {
+        self.drag.to_bits() == 0 && self.g.to_bits() != (-0.0f64).to_bits()
+    }
+
+    /// [`Self::position`] of a free particle where [`Self::still_air`]: a = g, the same bits
+    /// for a finite velocity.
+    #[inline(always)]
+    fn position_in_still_air(self, x0: f64, v0: f64) -> f64 {
+        let vi = v0 + self.g * self.h;
+        x0 + vi * self.h
+    }
+
     /// The new position from velocity `v0`, a = g + c_d (v_wind − v0); kept as it was for a
     /// pinned particle.
     #[inline(always)]
@@ -547,6 +562,45 @@ fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
     }
 }
 
+/// One axis of a domain's state, as [`predict_axis`] reads and writes it.
+struct Axis<'a> {
+    x: &'a mut [f64],
+    prev: &'a mut [f64],
+    base: &'a mut [f32],
+    disp: &'a mut [f32],
+}
+
+/// The loop of [`advance_from`] along one axis, every particle as a free one, with
+/// `STILL_AIR` the prediction's form ([`Predict::still_air`]).
+#[inline(always)]
+fn predict_axis<const UNFOLDED: bool, const STILL_AIR: bool>(
+    axis: Axis<'_>,
+    finish: Finish,
+    predict: Predict,
+    origin: f64,
+) {
+    let n = axis.x.len();
+    let (x, prev) = (axis.x, &mut axis.prev[..n]);
+    let (base, disp) = (&mut axis.base[..n], &mut axis.disp[..n]);
+    for i in 0..n {
+        let x0 = if UNFOLDED {
+            x[i] + f64::from(disp[i])
+        } else {
+            x[i]
+        };
+        let v0 = finish.velocity(x0, prev[i], true);
+        prev[i] = x0;
+        let xi = if STILL_AIR {
+            predict.position_in_still_air(x0, v0)
+        } else {
+            predict.position(x0, v0, true)
+        };
+        x[i] = xi;
+        base[i] = (xi - origin) as f32;
+        disp[i] = 0.0;
+    }
+}
+
 /// [`advance_body`] after a substep, adding the pending displacement to each position it reads
 /// when `UNFOLDED`. One pass ending the previous substep and predicting the next: the
 /// velocity update and damping (`Finish::velocity`) kept in a register, never written (the
@@ -560,31 +614,69 @@ fn advance_from<const UNFOLDED: bool>(dom: &mut Domain, step: &Integration<'_>, 
         // The sweep's f32 state (see `Rebased`), relative to the first particle's position
         // at the substep's start.
         let (base, disp) = (&mut dom.work.base[a][..n], &mut dom.work.disp[a][..n]);
-        let at = |x: &[f64], disp: &[f32], i: usize| {
-            if UNFOLDED {
-                x[i] + f64::from(disp[i])
-            } else {
-                x[i]
-            }
-        };
         let predict = Predict::along(step, a);
-        let origin = if n > 0 { at(x, disp, 0) } else { 0.0 };
+        let origin = match (n, UNFOLDED) {
+            (0, _) => 0.0,
+            (_, true) => x[0] + f64::from(disp[0]),
+            (_, false) => x[0],
+        };
         dom.work.origin[a] = origin;
         // Every particle as a free one (no inverse mass read, no select), ...
-        for i in 0..n {
-            let x0 = at(x, disp, i);
-            let v0 = finish.velocity(x0, prev[i], true);
-            prev[i] = x0;
-            let xi = predict.position(x0, v0, true);
-            x[i] = xi;
-            base[i] = (xi - origin) as f32;
-            disp[i] = 0.0;
+        let axis = Axis {
+            x: &mut *x,
+            prev: &mut *prev,
+            base: &mut *base,
+            disp: &mut *disp,
+        };
+        if predict.still_air() {
+            predict_axis::<UNFOLDED, true>(axis, finish, predict, origin);
+        } else {
+            predict_axis::<UNFOLDED, false>(axis, finish, predict, origin);
         }
         // ... then the fixed ones back where they started (what `position` keeps for them).
         for &i in fixed {
             let x0 = prev[i as usize];
             x[i as usize] = x0;
             base[i as usize] = (x0 - origin) as f32;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rand::rng;
+
+    #[test]
+    fn still_air_predicts_the_bits_of_the_full_form_for_finite_velocities() {
+        let predict = |g: f64, drag: f64| Predict {
+            g,
+            wind: 3.0,
+            drag,
+            h: 1.0 / 600.0,
+        };
+        // Drag, or a gravity of −0 (−0 + (+0) = +0), keep the full form.
+        assert!(predict(-9.81, 0.0).still_air() && predict(0.0, 0.0).still_air());
+        assert!(!predict(-9.81, 0.2).still_air() && !predict(-9.81, -0.0).still_air());
+        assert!(!predict(-0.0, 0.0).still_air());
+        let mut r = rng(7);
+        for g in [-9.81, 0.0, 1e-300, 4.5] {
+            let p = predict(g, 0.0);
+            for k in 0..2000 {
+                // Velocities either side of the wind's, zeros of both signs among them.
+                let v0 = match k {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => 3.0,
+                    _ => r() * 10f64.powi(k % 9 - 4),
+                };
+                let x0 = r() * 4.0;
+                assert_eq!(
+                    p.position_in_still_air(x0, v0).to_bits(),
+                    p.position(x0, v0, true).to_bits(),
+                    "g {g}, x0 {x0}, v0 {v0}"
+                );
+            }
         }
     }
 }

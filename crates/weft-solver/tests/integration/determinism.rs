@@ -91,6 +91,11 @@ fn results_are_bit_identical_across_thread_counts() {
 /// A flag in linear wind with a moving pin, global and XPBD damping, and a dragged corner:
 /// everything the fused frame handles.
 fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
+    fusable_in(method, threads, active, false)
+}
+
+/// [`fusable`], in still air if `still` (no drag: the fused prediction then takes a = g).
+fn fusable_in(method: Method, threads: usize, active: bool, still: bool) -> Vec<[u64; 3]> {
     in_pool(threads, || {
         let (mut b, mesh) = fusable_flag((40, 40), flag_settings(method, 200));
         b.add_kinematic_pin(
@@ -102,6 +107,11 @@ fn fusable(method: Method, threads: usize, active: bool) -> Vec<[u64; 3]> {
         )
         .expect("valid pin");
         let mut s = b.build();
+        if still {
+            let mut forces = *s.forces();
+            forces.wind = Wind::default();
+            s.set_forces(forces).expect("valid forces");
+        }
         assert!(s.runs_fused(), "the fused side really runs fused");
         assert!(s.domain_stats().domains > 1 && s.domain_stats().links > 0);
         let corner = 40 * 40 - 1;
@@ -131,5 +141,18 @@ fn fused_frames_match_the_general_loop_bit_for_bit() {
         // domains each on three threads, of four workers on four (links above the slots).
         assert_eq!(fused, fusable(method, 3, false), "{method}, 3 threads");
         assert_eq!(fused, fusable(method, 4, false), "{method}, 4 threads");
+        // In still air the fused prediction drops the drag term (a = g exactly).
+        let still = fusable_in(method, 1, false, true);
+        assert_eq!(
+            still,
+            fusable_in(method, 1, true, true),
+            "{method}, still air"
+        );
+        assert_eq!(
+            still,
+            fusable_in(method, 2, false, true),
+            "{method}, still air"
+        );
+        assert_ne!(still, fused, "{method}: the wind made a difference");
     }
 }
