@@ -528,11 +528,12 @@ impl Predict {
 
 /// [`advance_body`] at a frame's start: positions, velocities and inverse masses read from the
 /// particle store as they are used (no copy into the domain first; the velocities are never
-/// kept: later substeps compute them from the positions).
+/// kept: later substeps compute them from the positions). Like [`advance_from`], every
+/// particle is predicted as a free one and the fixed ones are put back after.
 #[inline(always)]
 fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
     let n = dom.len();
-    let (ax, av, aw) = (&aos.x[..n], &aos.v[..n], &aos.w[..n]);
+    let (ax, aw) = (&aos.x[..n], &aos.w[..n]);
     dom.w.copy_from_slice(aw);
     dom.work.set_masses(aw);
     dom.note_fixed();
@@ -545,16 +546,62 @@ fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
     let [p0s, p1s, p2s] = &mut dom.prev;
     let [b0s, b1s, b2s] = &mut dom.work.base;
     let [d0s, d1s, d2s] = &mut dom.work.disp;
-    let x = [&mut x0s[..n], &mut x1s[..n], &mut x2s[..n]];
-    let prev = [&mut p0s[..n], &mut p1s[..n], &mut p2s[..n]];
-    let base = [&mut b0s[..n], &mut b1s[..n], &mut b2s[..n]];
-    let disp = [&mut d0s[..n], &mut d1s[..n], &mut d2s[..n]];
+    let axes = Axes {
+        x: [&mut x0s[..n], &mut x1s[..n], &mut x2s[..n]],
+        prev: [&mut p0s[..n], &mut p1s[..n], &mut p2s[..n]],
+        base: [&mut b0s[..n], &mut b1s[..n], &mut b2s[..n]],
+        disp: [&mut d0s[..n], &mut d1s[..n], &mut d2s[..n]],
+    };
+    if predict.iter().all(|p| p.still_air()) {
+        predict_loaded::<true>(axes, aos, predict, origin);
+    } else {
+        predict_loaded::<false>(axes, aos, predict, origin);
+    }
+    // The fixed particles back where they started (what `position` keeps for them).
+    for &i in &dom.fixed {
+        let i = i as usize;
+        for a in 0..3 {
+            let x0 = dom.prev[a][i];
+            dom.x[a][i] = x0;
+            dom.work.base[a][i] = (x0 - origin[a]) as f32;
+        }
+    }
+}
+
+/// A domain's state along every axis, as [`predict_loaded`] writes it.
+struct Axes<'a> {
+    x: [&'a mut [f64]; 3],
+    prev: [&'a mut [f64]; 3],
+    base: [&'a mut [f32]; 3],
+    disp: [&'a mut [f32]; 3],
+}
+
+/// The loop of [`advance_load`], every particle as a free one, with `STILL_AIR` the
+/// prediction's form along every axis ([`Predict::still_air`]).
+#[inline(always)]
+fn predict_loaded<const STILL_AIR: bool>(
+    axes: Axes<'_>,
+    aos: &AosChunk<'_>,
+    predict: [Predict; 3],
+    origin: [f64; 3],
+) {
+    let Axes {
+        x,
+        prev,
+        base,
+        disp,
+    } = axes;
+    let n = x[0].len();
+    let (ax, av) = (&aos.x[..n], &aos.v[..n]);
     for i in 0..n {
-        let free = aw[i] > 0.0;
         let (p, v) = (ax[i].to_array(), av[i].to_array());
         for a in 0..3 {
             prev[a][i] = p[a];
-            let xi = predict[a].position(p[a], v[a], free);
+            let xi = if STILL_AIR {
+                predict[a].position_in_still_air(p[a], v[a])
+            } else {
+                predict[a].position(p[a], v[a], true)
+            };
             x[a][i] = xi;
             base[a][i] = (xi - origin[a]) as f32;
             disp[a][i] = 0.0;
