@@ -515,14 +515,13 @@ impl Predict {
         x0 + vi * self.h
     }
 
-    /// The new position from velocity `v0`, a = g + c_d (v_wind − v0); kept as it was for a
-    /// pinned particle.
+    /// The new position of a free particle from velocity `v0`, a = g + c_d (v_wind − v0)
+    /// (the fixed ones are put back after: see [`put_back_fixed`]).
     #[inline(always)]
-    fn position(self, x0: f64, v0: f64, free: bool) -> f64 {
+    fn position(self, x0: f64, v0: f64) -> f64 {
         let acc = self.g + self.drag * (self.wind - v0);
         let vi = v0 + acc * self.h;
-        let xi = x0 + vi * self.h;
-        if free { xi } else { x0 }
+        x0 + vi * self.h
     }
 }
 
@@ -546,70 +545,50 @@ fn advance_load(dom: &mut Domain, step: &Integration<'_>, aos: &AosChunk<'_>) {
     let [p0s, p1s, p2s] = &mut dom.prev;
     let [b0s, b1s, b2s] = &mut dom.work.base;
     let [d0s, d1s, d2s] = &mut dom.work.disp;
-    let axes = Axes {
-        x: [&mut x0s[..n], &mut x1s[..n], &mut x2s[..n]],
-        prev: [&mut p0s[..n], &mut p1s[..n], &mut p2s[..n]],
-        base: [&mut b0s[..n], &mut b1s[..n], &mut b2s[..n]],
-        disp: [&mut d0s[..n], &mut d1s[..n], &mut d2s[..n]],
-    };
+    let mut axes = [
+        Axis::of(x0s, p0s, b0s, d0s, n),
+        Axis::of(x1s, p1s, b1s, d1s, n),
+        Axis::of(x2s, p2s, b2s, d2s, n),
+    ];
     if predict.iter().all(|p| p.still_air()) {
-        predict_loaded::<true>(axes, aos, predict, origin);
+        predict_loaded::<true>(&mut axes, aos, predict, origin);
     } else {
-        predict_loaded::<false>(axes, aos, predict, origin);
+        predict_loaded::<false>(&mut axes, aos, predict, origin);
     }
-    // The fixed particles back where they started (what `position` keeps for them).
-    for &i in &dom.fixed {
-        let i = i as usize;
-        for a in 0..3 {
-            let x0 = dom.prev[a][i];
-            dom.x[a][i] = x0;
-            dom.work.base[a][i] = (x0 - origin[a]) as f32;
-        }
+    for (axis, origin) in axes.iter_mut().zip(origin) {
+        put_back_fixed(&dom.fixed, axis, origin);
     }
-}
-
-/// A domain's state along every axis, as [`predict_loaded`] writes it.
-struct Axes<'a> {
-    x: [&'a mut [f64]; 3],
-    prev: [&'a mut [f64]; 3],
-    base: [&'a mut [f32]; 3],
-    disp: [&'a mut [f32]; 3],
 }
 
 /// The loop of [`advance_load`], every particle as a free one, with `STILL_AIR` the
 /// prediction's form along every axis ([`Predict::still_air`]).
 #[inline(always)]
 fn predict_loaded<const STILL_AIR: bool>(
-    axes: Axes<'_>,
+    axes: &mut [Axis<'_>; 3],
     aos: &AosChunk<'_>,
     predict: [Predict; 3],
     origin: [f64; 3],
 ) {
-    let Axes {
-        x,
-        prev,
-        base,
-        disp,
-    } = axes;
-    let n = x[0].len();
+    let n = axes[0].x.len();
     let (ax, av) = (&aos.x[..n], &aos.v[..n]);
     for i in 0..n {
         let (p, v) = (ax[i].to_array(), av[i].to_array());
-        for a in 0..3 {
-            prev[a][i] = p[a];
+        for (a, axis) in axes.iter_mut().enumerate() {
+            axis.prev[i] = p[a];
             let xi = if STILL_AIR {
                 predict[a].position_in_still_air(p[a], v[a])
             } else {
-                predict[a].position(p[a], v[a], true)
+                predict[a].position(p[a], v[a])
             };
-            x[a][i] = xi;
-            base[a][i] = (xi - origin[a]) as f32;
-            disp[a][i] = 0.0;
+            axis.x[i] = xi;
+            axis.base[i] = (xi - origin[a]) as f32;
+            axis.disp[i] = 0.0;
         }
     }
 }
 
-/// One axis of a domain's state, as [`predict_axis`] reads and writes it.
+/// One axis of a domain's state, as the prediction reads and writes it, every slice cut to
+/// the domain's particle count.
 struct Axis<'a> {
     x: &'a mut [f64],
     prev: &'a mut [f64],
@@ -617,17 +596,44 @@ struct Axis<'a> {
     disp: &'a mut [f32],
 }
 
+impl<'a> Axis<'a> {
+    fn of(
+        x: &'a mut [f64],
+        prev: &'a mut [f64],
+        base: &'a mut [f32],
+        disp: &'a mut [f32],
+        n: usize,
+    ) -> Self {
+        Self {
+            x: &mut x[..n],
+            prev: &mut prev[..n],
+            base: &mut base[..n],
+            disp: &mut disp[..n],
+        }
+    }
+}
+
+/// Puts the `fixed` particles back where they started the substep (their previous position),
+/// after a loop that predicted them as free ones.
+fn put_back_fixed(fixed: &[u32], axis: &mut Axis<'_>, origin: f64) {
+    for &i in fixed {
+        let x0 = axis.prev[i as usize];
+        axis.x[i as usize] = x0;
+        axis.base[i as usize] = (x0 - origin) as f32;
+    }
+}
+
 /// The loop of [`advance_from`] along one axis, every particle as a free one, with
 /// `STILL_AIR` the prediction's form ([`Predict::still_air`]).
 #[inline(always)]
 fn predict_axis<const UNFOLDED: bool, const STILL_AIR: bool>(
-    axis: Axis<'_>,
+    axis: &mut Axis<'_>,
     finish: Finish,
     predict: Predict,
     origin: f64,
 ) {
     let n = axis.x.len();
-    let (x, prev) = (axis.x, &mut axis.prev[..n]);
+    let (x, prev) = (&mut *axis.x, &mut axis.prev[..n]);
     let (base, disp) = (&mut axis.base[..n], &mut axis.disp[..n]);
     for i in 0..n {
         let x0 = if UNFOLDED {
@@ -640,7 +646,7 @@ fn predict_axis<const UNFOLDED: bool, const STILL_AIR: bool>(
         let xi = if STILL_AIR {
             predict.position_in_still_air(x0, v0)
         } else {
-            predict.position(x0, v0, true)
+            predict.position(x0, v0)
         };
         x[i] = xi;
         base[i] = (xi - origin) as f32;
@@ -657,35 +663,30 @@ fn advance_from<const UNFOLDED: bool>(dom: &mut Domain, step: &Integration<'_>, 
     let n = dom.len();
     let fixed = &dom.fixed;
     for a in 0..3 {
-        let (x, prev) = (&mut dom.x[a][..n], &mut dom.prev[a][..n]);
         // The sweep's f32 state (see `Rebased`), relative to the first particle's position
         // at the substep's start.
-        let (base, disp) = (&mut dom.work.base[a][..n], &mut dom.work.disp[a][..n]);
+        let mut axis = Axis::of(
+            &mut dom.x[a],
+            &mut dom.prev[a],
+            &mut dom.work.base[a],
+            &mut dom.work.disp[a],
+            n,
+        );
         let predict = Predict::along(step, a);
         let origin = match (n, UNFOLDED) {
             (0, _) => 0.0,
-            (_, true) => x[0] + f64::from(disp[0]),
-            (_, false) => x[0],
+            (_, true) => axis.x[0] + f64::from(axis.disp[0]),
+            (_, false) => axis.x[0],
         };
         dom.work.origin[a] = origin;
-        // Every particle as a free one (no inverse mass read, no select), ...
-        let axis = Axis {
-            x: &mut *x,
-            prev: &mut *prev,
-            base: &mut *base,
-            disp: &mut *disp,
-        };
+        // Every particle as a free one (no inverse mass read, no select), then the fixed ones
+        // back.
         if predict.still_air() {
-            predict_axis::<UNFOLDED, true>(axis, finish, predict, origin);
+            predict_axis::<UNFOLDED, true>(&mut axis, finish, predict, origin);
         } else {
-            predict_axis::<UNFOLDED, false>(axis, finish, predict, origin);
+            predict_axis::<UNFOLDED, false>(&mut axis, finish, predict, origin);
         }
-        // ... then the fixed ones back where they started (what `position` keeps for them).
-        for &i in fixed {
-            let x0 = prev[i as usize];
-            x[i as usize] = x0;
-            base[i as usize] = (x0 - origin) as f32;
-        }
+        put_back_fixed(fixed, &mut axis, origin);
     }
 }
 
@@ -720,7 +721,7 @@ mod tests {
                 let x0 = r() * 4.0;
                 assert_eq!(
                     p.position_in_still_air(x0, v0).to_bits(),
-                    p.position(x0, v0, true).to_bits(),
+                    p.position(x0, v0).to_bits(),
                     "g {g}, x0 {x0}, v0 {v0}"
                 );
             }
