@@ -104,14 +104,18 @@ fn steady(reps: usize, s: &mut Solver, w: Option<&mut CollisionWorld>) -> (Optio
     (None, median(wall))
 }
 
+/// A world holding only the mesh scene's ground, for `solver`.
+fn ground_alone(solver: &Solver) -> CollisionWorld {
+    let mut w = CollisionWorld::new(solver);
+    w.add_collider(&ground(-SPHERE_RADIUS)).expect("ground");
+    w
+}
+
 /// The static scenes stepped continuously, in three rounds alternating between them.
 fn steady_frames(reps: usize) {
     let (solver, mesh) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
     let (sphere_solver, sphere) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
-    let mut ground_only = CollisionWorld::new(&solver);
-    ground_only
-        .add_collider(&ground(-SPHERE_RADIUS))
-        .expect("ground");
+    let ground_only = ground_alone(&solver);
     let mut cases = [
         ("bare solve (mesh scene)", solver.clone(), None),
         ("ground alone", solver.clone(), Some(ground_only)),
@@ -158,8 +162,7 @@ fn main() {
         }
         Some("ground") => {
             let (mut s, _) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
-            let mut w = CollisionWorld::new(&s);
-            w.add_collider(&ground(-SPHERE_RADIUS)).expect("ground");
+            let mut w = ground_alone(&s);
             show("ground alone", steady(reps, &mut s, Some(&mut w)));
             return;
         }
@@ -181,10 +184,7 @@ fn main() {
     }
     let (solver, mesh_world) = in_contact(icosphere_drop(Method::Xpbd, 128).expect("scene"));
     let (sphere_solver, sphere_world) = in_contact(sphere_drop(Method::Xpbd, 128).expect("scene"));
-    let mut ground_world = CollisionWorld::new(&solver);
-    ground_world
-        .add_collider(&ground(-SPHERE_RADIUS))
-        .expect("ground");
+    let ground_world = ground_alone(&solver);
     let (mesh_alone, sphere_alone) = balls_alone(&solver, &sphere_solver).expect("each ball alone");
     println!(
         "solver kernel path: {} (WEFT_SIMD=avx512|avx2|scalar forces one)",
