@@ -24,12 +24,13 @@ use crate::closed_run::{Run, resolve_still, still_surface};
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::friction::Friction;
-use crate::reach::{Bounds, Reach};
+use crate::reach::{Bounds, Reach, Surface};
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::deforming::MeshAnimation;
 use crate::trimesh::grid_contacts::GridParticles;
+use crate::trimesh::grid_run::resolve_grid_run;
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -692,42 +693,67 @@ impl ParticleContacts for CollisionWorld {
     /// [`Self::resolve`] on every free particle of the run, collider by collider (each
     /// particle meets the colliders in the same order, and what one particle meets depends on
     /// that particle alone, so the bits are the same): the substep's sweep first, then each
-    /// mesh on its grid particle by particle, each still half-space or ball a block of
-    /// particles at a time ([`resolve_still`]), any other collider particle by particle.
+    /// still half-space or ball a block of particles at a time ([`resolve_still`]), each still
+    /// mesh on its grid in the world's frame a block at a time too ([`resolve_grid_run`]), any
+    /// other collider particle by particle.
     fn resolve_run(&self, mut run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
         let r = &self.thickness[run.start..run.start + run.w.len()];
         let n = self.colliders.len();
         let mut total = Contacts::default();
-        let surface = |j: usize| still_surface(&self.colliders[j], &self.reach[j]);
+        // Collider j's block form, if it has one.
+        let blocked = |j: usize| match still_surface(&self.colliders[j], &self.reach[j]) {
+            Some(s) => Some(Blocked::Surface(s)),
+            None => match &frames[j] {
+                Some((frame, grid)) if frame.settles() => Some(Blocked::Mesh(frame, *grid)),
+                _ => None,
+            },
+        };
         let (mut k, mut sweep) = (0, fresh);
         while k < n || sweep {
-            // Colliders `k..still` particle by particle (after the sweep in the substep's
-            // first pass), then collider `still`, if any, a block at a time.
-            let next = (k..n).find_map(|j| surface(j).map(|s| (j, s)));
-            let still = next.map_or(n, |(j, _)| j);
-            if still > k || sweep {
+            // Colliders `k..stop` particle by particle (after the sweep in the substep's
+            // first pass), then collider `stop`, if any, a block at a time.
+            let next = (k..n).find_map(|j| blocked(j).map(|b| (j, b)));
+            let stop = next.as_ref().map_or(n, |(j, _)| *j);
+            if stop > k {
                 let pass = run.each_free(|i, p, before| {
-                    self.resolve_particle(&frames, k..still, sweep, i, p, before)
+                    self.resolve_particle(&frames, k..stop, sweep, i, p, before)
                 });
                 total = total.merge(pass);
                 sweep = false;
+            } else if sweep {
+                total.swept += self.sweep_run(&frames, &mut run, r);
+                sweep = false;
             }
-            if let Some((_, surface)) = next {
-                let [a, b, c] = &mut run.x;
-                let block = Run {
-                    x: [&mut **a, &mut **b, &mut **c],
-                    prev: run.prev,
-                    w: run.w,
-                    r,
-                };
-                let friction = self.colliders[still].friction();
-                total = total.merge(resolve_still(surface, friction, block, run.path));
+            match next {
+                Some((_, Blocked::Surface(surface))) => {
+                    let [a, b, c] = &mut run.x;
+                    let block = Run {
+                        x: [&mut **a, &mut **b, &mut **c],
+                        prev: run.prev,
+                        w: run.w,
+                        r,
+                    };
+                    let friction = self.colliders[stop].friction();
+                    total = total.merge(resolve_still(surface, friction, block, run.path));
+                }
+                Some((_, Blocked::Mesh(frame, grid))) => {
+                    total = total.merge(resolve_grid_run(frame, grid, r, &mut run));
+                }
+                None => {}
             }
-            k = still + 1;
+            k = stop + 1;
         }
         total
     }
+}
+
+/// A collider that a run takes a block of particles at a time.
+enum Blocked<'f, 'a> {
+    /// A still half-space or ball.
+    Surface(Surface),
+    /// A still mesh on its grid, in the world's frame.
+    Mesh(&'f MeshFrame<'a>, GridRef<'a>),
 }
 
 impl CollisionWorld {
@@ -736,6 +762,38 @@ impl CollisionWorld {
         (self.colliders.iter().enumerate())
             .map(|(k, c)| Some((mesh_frame(c, fresh)?, self.grid(k)?)))
             .collect()
+    }
+
+    /// The substep's sweep (as [`sweep_one`]) of every free particle of `run`, thickness `r`,
+    /// alone: a particle whose path is shorter than half its thickness (most) costs a few
+    /// loads and a comparison, read straight from the run's arrays.
+    fn sweep_run(
+        &self,
+        frames: &[Option<(MeshFrame<'_>, GridRef<'_>)>],
+        run: &mut ParticleRun<'_>,
+        r: &[f64],
+    ) -> usize {
+        let mesh = |k: usize| frames[k].is_some();
+        let n = run.w.len();
+        let (w, prev, r) = (run.w, run.prev, &r[..n]);
+        let [x0, x1, x2] = &mut run.x;
+        let (x0, x1, x2) = (&mut x0[..n], &mut x1[..n], &mut x2[..n]);
+        let (p0, p1, p2) = (&prev[0][..n], &prev[1][..n], &prev[2][..n]);
+        let mut swept = 0;
+        for j in 0..n {
+            let slow = 0.5 * r[j].max(1e-6);
+            let d = [x0[j] - p0[j], x1[j] - p1[j], x2[j] - p2[j]];
+            // As `sweep_one`'s test (glam's dot order), NaN included.
+            if w[j] == 0.0 || (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2] <= slow * slow {
+                continue;
+            }
+            let mut x = DVec3::new(x0[j], x1[j], x2[j]);
+            let from = DVec3::new(p0[j], p1[j], p2[j]);
+            let (colliders, bounds, parry) = (&self.colliders, &self.bounds, self.parry_meshes);
+            swept += sweep_path(colliders, bounds, mesh, parry, from, &mut x, r[j]);
+            (x0[j], x1[j], x2[j]) = (x.x, x.y, x.z);
+        }
+        swept
     }
 
     /// [`ParticleContacts::resolve`] with the frames of [`Self::grid_frames`], against colliders

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use super::MeshGeometry;
 use super::closest::closest_on_triangle;
+use super::grid_run::FaceCert;
 
 /// Cells of a grid at most (a 16 MB offset table); coarser cells beyond.
 const MAX_CELLS: usize = 1 << 22;
@@ -33,15 +34,25 @@ pub(crate) enum Side {
 #[derive(Clone, Debug)]
 pub(crate) struct ContactGrid {
     origin: DVec3,
+    h: f64,
     inv_h: f64,
+    /// The reach the grid was built for.
+    reach: f64,
+    /// The mesh's box.
+    bounds: (DVec3, DVec3),
     dims: [usize; 3],
     /// Cell c lists `tris[starts[c] .. starts[c + 1]]`.
     starts: Vec<u32>,
     tris: Vec<u32>,
     side: Vec<Side>,
+    /// Per cell, how many cells away (Chebyshev, at most 255) the nearest cell listing a
+    /// triangle is: 0 for those.
+    gap: Vec<u8>,
     /// Per triangle, a lower bound (sought up to twice the reach of a cell's farthest
     /// point) on its distance to any triangle that reaches in front of its plane.
     clearance: Vec<f64>,
+    /// Per triangle, what the first test of `grid_run` reads.
+    certs: Vec<FaceCert>,
 }
 
 impl ContactGrid {
@@ -144,16 +155,25 @@ impl ContactGrid {
         if mesh.closed() {
             label_inside(&mut side, dims);
         }
+        let gap = gaps(&starts, dims);
         // Sought as far as a particle with triangles in its cell may be from them.
         let clearance = clearances(mesh, 2.0 * (within + half_diagonal));
+        let certs = (mesh.faces.iter().zip(&clearance))
+            .map(|(f, &clear)| FaceCert::new(f.corners, f.normal, clear))
+            .collect();
         Some(Self {
             origin,
+            h,
             inv_h,
+            reach,
+            bounds: (lo, hi),
+            gap,
             dims,
             starts,
             tris,
             side,
             clearance,
+            certs,
         })
     }
 
@@ -191,6 +211,33 @@ impl ContactGrid {
     pub fn clearance(&self, t: usize) -> f64 {
         self.clearance.get(t).copied().unwrap_or(0.0)
     }
+
+    /// A lower bound on the distance from `x`, in `cell` (as [`Self::cell`] finds it), to
+    /// every triangle: a cell listing none is farther than the reach from them at each of its
+    /// points, so a point whose cell is k cells (Chebyshev) from the nearest listing one is
+    /// at least the reach plus k − 1 cells away; outside the grid, the distance to the mesh's
+    /// box.
+    pub fn clear_distance(&self, cell: Option<usize>, x: DVec3) -> f64 {
+        match cell {
+            Some(c) => match self.gap[c] {
+                0 => 0.0,
+                k => {
+                    (self.reach + f64::from(k - 1) * self.h) * (1.0 - 1e-9) - 1e-9 * (1.0 + self.h)
+                }
+            },
+            None => {
+                let (lo, hi) = self.bounds;
+                let outside = (lo - x).max(x - hi).max(DVec3::ZERO);
+                outside.length() * (1.0 - 1e-9)
+            }
+        }
+    }
+
+    /// Per triangle (storage order), what the first test of `grid_run` reads.
+    #[inline]
+    pub fn certs(&self) -> &[FaceCert] {
+        &self.certs
+    }
 }
 
 /// Each triangle's [`ContactGrid::clearance`], sought up to `cap`: from the triangle's
@@ -226,6 +273,53 @@ fn clearances(mesh: &MeshGeometry, cap: f64) -> Vec<f64> {
             clear
         })
         .collect()
+}
+
+/// Per cell of a grid of `dims` whose cell c lists `starts[c + 1] − starts[c]` triangles,
+/// the Chebyshev distance in cells to the nearest cell that lists any (0 for those, 255 at
+/// most; 255 everywhere if none does), by a breadth-first search over the 26 neighbours.
+fn gaps(starts: &[u32], dims: [usize; 3]) -> Vec<u8> {
+    let total = dims[0] * dims[1] * dims[2];
+    let mut gap = vec![u8::MAX; total];
+    let mut front: Vec<usize> = (0..total).filter(|&c| starts[c + 1] > starts[c]).collect();
+    for &c in &front {
+        gap[c] = 0;
+    }
+    let mut next = Vec::new();
+    for k in 1..u8::MAX {
+        for &c in &front {
+            let (i, j, l) = (
+                c % dims[0],
+                (c / dims[0]) % dims[1],
+                c / (dims[0] * dims[1]),
+            );
+            for dl in -1i64..=1 {
+                for dj in -1i64..=1 {
+                    for di in -1i64..=1 {
+                        let (a, b, d) = (i as i64 + di, j as i64 + dj, l as i64 + dl);
+                        if a < 0 || b < 0 || d < 0 {
+                            continue;
+                        }
+                        let (a, b, d) = (a as usize, b as usize, d as usize);
+                        if a >= dims[0] || b >= dims[1] || d >= dims[2] {
+                            continue;
+                        }
+                        let n = (d * dims[1] + b) * dims[0] + a;
+                        if gap[n] == u8::MAX {
+                            gap[n] = k;
+                            next.push(n);
+                        }
+                    }
+                }
+            }
+        }
+        if next.is_empty() {
+            break;
+        }
+        std::mem::swap(&mut front, &mut next);
+        next.clear();
+    }
+    gap
 }
 
 /// Relabels as inside every cell that no triangle's box meets and that no path of such cells

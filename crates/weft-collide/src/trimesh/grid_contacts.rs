@@ -10,6 +10,7 @@ use super::MeshPoint;
 use super::candidates::{MeshFrame, Outcome, ROUNDS};
 use super::closest::{Feature, closest_on_triangle};
 use super::contact_grid::{ContactGrid, Side};
+use super::grid_run::{Block, FaceCert, Settled, settle};
 use super::normals::NONE;
 
 /// Triangles a particle's contact walks across from the one it touched last, at most.
@@ -26,6 +27,10 @@ pub(crate) struct GridParticles {
     side: Vec<AtomicU8>,
     /// Where the last projection left each particle (collider frame), as f64 bits.
     last: Vec<[AtomicU64; 3]>,
+    /// Each particle's clear ball (collider frame), as f64 bits: a centre and a radius
+    /// (NaN: none) such that no point of the ball is within the particle's thickness of the
+    /// mesh.
+    ball: Vec<[AtomicU64; 4]>,
 }
 
 impl GridParticles {
@@ -35,10 +40,28 @@ impl GridParticles {
             hint: (0..n).map(|_| AtomicU32::new(u32::MAX)).collect(),
             side: (0..n).map(|_| AtomicU8::new(0)).collect(),
             last: (0..n).map(|_| [0; 3].map(AtomicU64::new)).collect(),
+            ball: (0..n)
+                .map(|_| [0.0, 0.0, 0.0, f64::NAN].map(|v| AtomicU64::new(v.to_bits())))
+                .collect(),
         }
     }
 
-    fn hint(&self, i: usize) -> u32 {
+    /// Particle `i`'s clear ball: centre and radius (NaN: none).
+    pub(super) fn ball(&self, i: usize) -> (DVec3, f64) {
+        let [x, y, z, r] = self.ball[i]
+            .each_ref()
+            .map(|a| f64::from_bits(a.load(Relaxed)));
+        (DVec3::new(x, y, z), r)
+    }
+
+    fn set_ball(&self, i: usize, at: DVec3, radius: f64) {
+        for (slot, v) in self.ball[i].iter().zip([at.x, at.y, at.z, radius]) {
+            slot.store(v.to_bits(), Relaxed);
+        }
+    }
+
+    /// The triangle particle `i` touched last (`u32::MAX`: none).
+    pub(super) fn hint(&self, i: usize) -> u32 {
         self.hint[i].load(Relaxed)
     }
 
@@ -57,7 +80,8 @@ impl GridParticles {
         self.side[i].store(inside.map_or(0, |b| 1 + u8::from(b)), Relaxed);
     }
 
-    fn last(&self, i: usize) -> DVec3 {
+    /// Where the last projection left particle `i`.
+    pub(super) fn last(&self, i: usize) -> DVec3 {
         let [x, y, z] = &self.last[i];
         DVec3::new(
             f64::from_bits(x.load(Relaxed)),
@@ -89,6 +113,11 @@ impl Clone for GridParticles {
                 .iter()
                 .map(|l| [0, 1, 2].map(|k| AtomicU64::new(l[k].load(Relaxed))))
                 .collect(),
+            ball: self
+                .ball
+                .iter()
+                .map(|l| [0, 1, 2, 3].map(|k| AtomicU64::new(l[k].load(Relaxed))))
+                .collect(),
         }
     }
 }
@@ -104,6 +133,102 @@ impl MeshFrame<'_> {
     /// unseen, since a crossing ends within r of the surface unless its path is r/2 or longer,
     /// and such paths are swept.
     pub(crate) fn resolve_in_grid(
+        &self,
+        (grid, state): (&ContactGrid, &GridParticles),
+        i: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        r: f64,
+    ) -> Outcome {
+        // The first test, as a block of one (`grid_run`): the same bits as in a run.
+        if self.settles() {
+            let cert = grid.certs().get(state.hint(i) as usize);
+            let mut b = Block::<1>::new();
+            let from = self.path_start(prev, || state.last(i));
+            for k in 0..3 {
+                b.x[k][0] = x[k];
+                b.from[k][0] = from[k];
+                b.prev[k][0] = prev[k];
+            }
+            b.r[0] = r;
+            b.live[0] = true;
+            let (anchor, ball) = state.ball(i);
+            for k in 0..3 {
+                b.anchor[k][0] = anchor[k];
+            }
+            b.ball[0] = ball;
+            b.gather(0, cert.unwrap_or(&FaceCert::NONE));
+            let mut settled = [Settled::Open];
+            let tally = settle(&mut b, self.friction, &mut settled);
+            let moved = DVec3::new(b.x[0][0], b.x[1][0], b.x[2][0]);
+            match settled[0] {
+                Settled::Open => {}
+                Settled::Done => {
+                    *x = moved;
+                    self.settled_in_grid(state, i, moved);
+                    return Outcome {
+                        contacts: tally.contacts,
+                        depth: tally.depth,
+                        swept: 0,
+                    };
+                }
+                Settled::Rounds => {
+                    *x = moved;
+                    let o = self.rounds_after_settle((grid, state), i, prev, x, from, r);
+                    return Outcome {
+                        contacts: tally.contacts + o.contacts,
+                        depth: tally.depth.max(o.depth),
+                        swept: o.swept,
+                    };
+                }
+            }
+        }
+        self.walk_in_grid((grid, state), i, prev, x, r)
+    }
+
+    /// Whether the first test of `grid_run` applies: the mesh's frame is the world's and its
+    /// surface still over the substep.
+    #[inline]
+    pub(crate) fn settles(&self) -> bool {
+        self.identity && self.still && !self.geometry.moving
+    }
+
+    /// Where a particle's path starts (see [`MeshFrame::local_path`]).
+    #[inline]
+    pub(crate) fn path_start(&self, prev: DVec3, last: impl FnOnce() -> DVec3) -> DVec3 {
+        if self.fresh {
+            self.to_local(self.prev_pose, prev)
+        } else {
+            last()
+        }
+    }
+
+    /// Records a particle settled by the first test at `x`: outside, left there.
+    #[inline]
+    pub(crate) fn settled_in_grid(&self, state: &GridParticles, i: usize, x: DVec3) {
+        state.set_side(i, Some(false));
+        state.set_last(i, x);
+    }
+
+    /// The cell's contact rounds for a particle that the first test pushed out of its face
+    /// (now at `x`, on the path from `from`) and that slipped too far to be settled.
+    pub(crate) fn rounds_after_settle(
+        &self,
+        (grid, state): (&ContactGrid, &GridParticles),
+        i: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        from: DVec3,
+        r: f64,
+    ) -> Outcome {
+        state.set_side(i, Some(false));
+        let xl = *x;
+        self.rounds_in_grid((grid, state), i, prev, x, xl, from, r, Outcome::default())
+    }
+
+    /// [`Self::resolve_in_grid`] past the first test: the sweep of a long path, the walk from
+    /// the triangle touched last, then the cell.
+    pub(crate) fn walk_in_grid(
         &self,
         (grid, state): (&ContactGrid, &GridParticles),
         i: usize,
@@ -238,6 +363,11 @@ impl MeshFrame<'_> {
             let side = grid.side(cell);
             if list.is_empty() && side == Side::Outside {
                 state.set_side(i, Some(false));
+                // Clear while it stays within its cell's distance from the mesh, less r.
+                let clear = grid.clear_distance(cell, xl) - r;
+                if clear > 0.0 {
+                    state.set_ball(i, xl, clear);
+                }
                 break;
             }
             let scan = self.scan(list, state.hint(i), xl, r);

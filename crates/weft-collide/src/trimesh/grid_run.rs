@@ -1,0 +1,466 @@
+//! A still mesh's contacts on its grid for a run of particles side by side: each particle's
+//! first test, against the triangle it touched last, a block of [`LANES`] particles at a
+//! time in struct-of-arrays, every branch a select. A particle that the triangle settles
+//! (clear of the mesh, or pushed out of its face) is done here; the others go on to the walk
+//! and the cell of `grid_contacts`, particle by particle. The one-particle path starts with
+//! the same test ([`settle`] with one lane), so the bits do not depend on where a particle
+//! falls in a block.
+
+// Lane and axis loops index several arrays in step; written as index loops on purpose so
+// that each compiles to one vector operation per axis.
+#![allow(clippy::needless_range_loop)]
+
+use glam::DVec3;
+use multiversion::multiversion;
+use weft_solver::{Contacts, ParticleRun, SimdPath};
+
+use super::candidates::{MeshFrame, Outcome};
+use super::contact_grid::ContactGrid;
+use super::grid_contacts::GridParticles;
+use crate::friction::Friction;
+
+/// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
+const LANES: usize = 8;
+
+/// What the first test reads of one triangle, two cache lines: a corner, the unit normal,
+/// the clearance and the triangle's edge lines (unit in-plane outward normals, in f32, with
+/// the rounding margin they need).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub(crate) struct FaceCert {
+    /// Corner a (m).
+    a: [f64; 3],
+    /// Unit normal; zero for a degenerate triangle.
+    n: [f64; 3],
+    /// [`ContactGrid::clearance`]; negative where the triangle settles nothing.
+    clear: f64,
+    /// e₁ · (b − a): edge 1 (b → c) passes through b; edges 0 and 2 pass through a.
+    c1: f64,
+    /// 10⁻⁶ of the longest edge: with 10⁻⁶ of |x − a|₁, more than the f32 edge normals'
+    /// rounding moves an edge line at x.
+    slack: f64,
+    /// Unit in-plane outward normal of edge k (corners k, k + 1), per axis.
+    e: [[f32; 3]; 3],
+}
+
+impl FaceCert {
+    /// The record of a triangle that settles nothing: every particle goes on to the walk.
+    pub const NONE: Self = Self {
+        a: [0.0; 3],
+        n: [0.0; 3],
+        clear: -1.0,
+        c1: 0.0,
+        slack: 0.0,
+        e: [[0.0; 3]; 3],
+    };
+
+    /// The record of the triangle with `corners`, unit `normal` and `clearance`.
+    pub fn new(corners: [DVec3; 3], normal: DVec3, clearance: f64) -> Self {
+        if normal == DVec3::ZERO {
+            return Self::NONE;
+        }
+        let [a, b, _] = corners;
+        let edge = |k: usize| {
+            let e = (corners[(k + 1) % 3] - corners[k]).cross(normal);
+            e.normalize_or_zero().as_vec3()
+        };
+        let e = [edge(0), edge(1), edge(2)];
+        let longest = (0..3)
+            .map(|k| (corners[(k + 1) % 3] - corners[k]).length())
+            .fold(0.0, f64::max);
+        Self {
+            a: a.to_array(),
+            n: normal.to_array(),
+            clear: clearance,
+            c1: e[1].as_dvec3().dot(b - a),
+            slack: 1e-6 * longest,
+            e: e.map(|v| v.to_array()),
+        }
+    }
+}
+
+/// What the first test did with a lane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum Settled {
+    /// Not settled: the walk and the cell follow, from the particle as it was.
+    #[default]
+    Open,
+    /// Clear, or pushed out of the face with room to spare: nothing more to do.
+    Done,
+    /// Pushed out of the face, then slipped far enough that the cell must be scanned.
+    Rounds,
+}
+
+/// A block of `L` particles and the triangles they touched last, struct-of-arrays.
+pub(crate) struct Block<const L: usize> {
+    /// Positions (the mesh's frame is the world's), moved in place.
+    pub x: [[f64; L]; 3],
+    /// Where each path starts: the substep's start, or the last projection.
+    pub from: [[f64; L]; 3],
+    /// Positions at the substep's start.
+    pub prev: [[f64; L]; 3],
+    /// Thickness (m).
+    pub r: [f64; L],
+    /// Whether the lane takes part (a free particle).
+    pub live: [bool; L],
+    /// Where each particle's clear ball is centred (`GridParticles::ball`).
+    pub anchor: [[f64; L]; 3],
+    /// Its radius; NaN where there is none.
+    pub ball: [f64; L],
+    /// The lanes' triangles, gathered per field.
+    a: [[f64; L]; 3],
+    n: [[f64; L]; 3],
+    clear: [f64; L],
+    c1: [f64; L],
+    slack: [f64; L],
+    e: [[[f64; L]; 3]; 3],
+}
+
+impl<const L: usize> Block<L> {
+    /// An empty block: no lane takes part.
+    pub fn new() -> Self {
+        Self {
+            x: [[0.0; L]; 3],
+            from: [[0.0; L]; 3],
+            prev: [[0.0; L]; 3],
+            r: [0.0; L],
+            live: [false; L],
+            anchor: [[0.0; L]; 3],
+            ball: [f64::NAN; L],
+            a: [[0.0; L]; 3],
+            n: [[0.0; L]; 3],
+            clear: [-1.0; L],
+            c1: [0.0; L],
+            slack: [0.0; L],
+            e: [[[0.0; L]; 3]; 3],
+        }
+    }
+
+    /// Gives lane `l` the triangle record `f`.
+    #[inline(always)]
+    pub fn gather(&mut self, l: usize, f: &FaceCert) {
+        for k in 0..3 {
+            self.a[k][l] = f.a[k];
+            self.n[k][l] = f.n[k];
+            for j in 0..3 {
+                self.e[j][k][l] = f64::from(f.e[j][k]);
+            }
+        }
+        self.clear[l] = f.clear;
+        self.c1[l] = f.c1;
+        self.slack[l] = f.slack;
+    }
+}
+
+/// The first test of every live lane against its triangle, with the mesh still and its frame
+/// the world's; moves the lanes it pushes, and returns what it did per lane with the
+/// contacts made. A lane is settled where its path lies in its clear ball (no point of the
+/// ball is within r of the mesh, so neither a contact nor a crossing), or where its path is
+/// shorter than r/2 (so no sweep is due) and either
+///
+/// - it is r or more in front of the plane and near enough to corner a that every triangle
+///   in front of the plane is beyond r (`ContactGrid::clearance`): clear; or
+/// - its projection lies inside the face, in front, with d + r (d the distance, at least r)
+///   within the clearance: the face is nearest of all within r, and a particle nearer than r
+///   is pushed along the normal to r, then slid back by Coulomb friction against the still
+///   surface (Macklin et al. 2014, eq. 24; `Friction::correction`). If the slip may have
+///   carried it past the clearance, the cell is scanned next ([`Settled::Rounds`]).
+#[inline(always)]
+pub(crate) fn settle<const L: usize>(
+    b: &mut Block<L>,
+    friction: Friction,
+    out: &mut [Settled; L],
+) -> Contacts {
+    let mut s = [0.0; L];
+    let mut clear = [false; L];
+    let mut settled = [false; L];
+    for l in 0..L {
+        let p = [
+            b.x[0][l] - b.from[0][l],
+            b.x[1][l] - b.from[1][l],
+            b.x[2][l] - b.from[2][l],
+        ];
+        let half = 0.5 * b.r[l];
+        let short = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] <= half * half;
+        let v = [
+            b.x[0][l] - b.a[0][l],
+            b.x[1][l] - b.a[1][l],
+            b.x[2][l] - b.a[2][l],
+        ];
+        let h = b.n[0][l] * v[0] + b.n[1][l] * v[1] + b.n[2][l] * v[2];
+        let to_a = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        let r = b.r[l];
+        let room = b.clear[l] - r;
+        let margin = 1e-6 * (v[0].abs() + v[1].abs() + v[2].abs()) + b.slack[l];
+        let line = |k: usize| b.e[k][0][l] * v[0] + b.e[k][1][l] * v[1] + b.e[k][2][l] * v[2];
+        let inside = line(0) < -margin && line(1) - b.c1[l] < -margin && line(2) < -margin;
+        let live = b.live[l] & short;
+        let (ball, o) = (b.ball[l], [b.anchor[0][l], b.anchor[1][l], b.anchor[2][l]]);
+        let (q, f) = (
+            [b.x[0][l] - o[0], b.x[1][l] - o[1], b.x[2][l] - o[2]],
+            [
+                b.from[0][l] - o[0],
+                b.from[1][l] - o[1],
+                b.from[2][l] - o[2],
+            ],
+        );
+        let in_ball = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= ball * ball)
+            & (f[0] * f[0] + f[1] * f[1] + f[2] * f[2] <= ball * ball);
+        s[l] = h;
+        clear[l] =
+            (b.live[l] & in_ball) | (live & (h >= r) & (room >= 0.0) & (to_a <= room * room));
+        settled[l] = live & inside & (h > 1e-12) & (h.max(r) + r <= b.clear[l]);
+    }
+    let mut depth = [0.0; L];
+    let mut push = [false; L];
+    for l in 0..L {
+        depth[l] = b.r[l] - s[l];
+        push[l] = settled[l] & !clear[l] & (depth[l] > 1e-6 * b.r[l].max(1e-3));
+        out[l] = if clear[l] | settled[l] {
+            Settled::Done
+        } else {
+            Settled::Open
+        };
+    }
+    if !push.contains(&true) {
+        return Contacts::default();
+    }
+    // Pushed out along the normal, then friction on the slip since the substep's start.
+    let mut moved = [[0.0; L]; 3];
+    let mut rel = [[0.0; L]; 3];
+    for k in 0..3 {
+        for l in 0..L {
+            moved[k][l] = b.x[k][l] + b.n[k][l] * depth[l];
+            rel[k][l] = moved[k][l] - b.prev[k][l];
+        }
+    }
+    let mut along = [0.0; L];
+    for l in 0..L {
+        along[l] = b.n[0][l] * rel[0][l] + b.n[1][l] * rel[1][l] + b.n[2][l] * rel[2][l];
+    }
+    let mut t = [[0.0; L]; 3];
+    for k in 0..3 {
+        for l in 0..L {
+            t[k][l] = rel[k][l] - b.n[k][l] * along[l];
+        }
+    }
+    let mut scale = [0.0; L];
+    let mut no_slip = [false; L];
+    for l in 0..L {
+        let slip2 = t[0][l] * t[0][l] + t[1][l] * t[1][l] + t[2][l] * t[2][l];
+        let grip = friction.static_coefficient * depth[l];
+        let sliding = (friction.dynamic_coefficient * depth[l] / slip2.sqrt()).min(1.0);
+        // Sticking: t itself (t · 1 = t exactly).
+        scale[l] = if slip2 < grip * grip { 1.0 } else { sliding };
+        no_slip[l] = slip2 <= 0.0;
+    }
+    let mut slip2 = [0.0; L];
+    for k in 0..3 {
+        for l in 0..L {
+            // No slip: the correction is +0 (t · 0 may be −0).
+            let correction = if no_slip[l] { 0.0 } else { t[k][l] * scale[l] };
+            slip2[l] += correction * correction;
+            b.x[k][l] = if push[l] {
+                moved[k][l] - correction
+            } else {
+                b.x[k][l]
+            };
+        }
+    }
+    let mut tally = Contacts::default();
+    for l in 0..L {
+        if push[l] {
+            // Pushed to r off the face, then slipped across its normal: still clear of the
+            // triangles in front if within the clearance less r.
+            let room = b.clear[l] - 2.0 * b.r[l];
+            if slip2[l] > room * room {
+                out[l] = Settled::Rounds;
+            }
+            tally.contacts += 1;
+            tally.depth = tally.depth.max(depth[l]);
+        }
+    }
+    tally
+}
+
+/// Every free particle of `run` against the still mesh of `frame` on `grid` (its frame the
+/// world's): [`settle`] a block at a time, then each particle it left open through
+/// `MeshFrame::resolve_in_grid`'s walk, in order. Compiled for the run's kernel path (every
+/// path gives the same bits).
+pub(crate) fn resolve_grid_run(
+    frame: &MeshFrame<'_>,
+    grid: (&ContactGrid, &GridParticles),
+    r: &[f64],
+    run: &mut ParticleRun<'_>,
+) -> Contacts {
+    match run.path {
+        SimdPath::Avx512 => run_avx512(frame, grid, r, run),
+        SimdPath::Avx2 => run_avx2(frame, grid, r, run),
+        SimdPath::Neon => run_neon(frame, grid, r, run),
+        SimdPath::Scalar => run_scalar(frame, grid, r, run),
+    }
+}
+
+/// [`resolve_grid_run`] compiled for AVX-512 (the baseline build where the CPU lacks it).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
+fn run_avx512<'a, 'b, 'c>(
+    frame: &'b MeshFrame<'a>,
+    grid: (&'b ContactGrid, &'b GridParticles),
+    r: &'b [f64],
+    run: &'b mut ParticleRun<'c>,
+) -> Contacts {
+    run_body(frame, grid, r, run)
+}
+
+/// [`resolve_grid_run`] compiled for AVX2 and FMA.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn run_avx2<'a, 'b, 'c>(
+    frame: &'b MeshFrame<'a>,
+    grid: (&'b ContactGrid, &'b GridParticles),
+    r: &'b [f64],
+    run: &'b mut ParticleRun<'c>,
+) -> Contacts {
+    run_body(frame, grid, r, run)
+}
+
+/// [`resolve_grid_run`] compiled for NEON.
+#[multiversion(targets("aarch64+neon"))]
+fn run_neon<'a, 'b, 'c>(
+    frame: &'b MeshFrame<'a>,
+    grid: (&'b ContactGrid, &'b GridParticles),
+    r: &'b [f64],
+    run: &'b mut ParticleRun<'c>,
+) -> Contacts {
+    run_body(frame, grid, r, run)
+}
+
+/// [`resolve_grid_run`] compiled for the baseline target.
+#[inline(never)]
+fn run_scalar<'a, 'b, 'c>(
+    frame: &'b MeshFrame<'a>,
+    grid: (&'b ContactGrid, &'b GridParticles),
+    r: &'b [f64],
+    run: &'b mut ParticleRun<'c>,
+) -> Contacts {
+    run_body(frame, grid, r, run)
+}
+
+#[inline(always)]
+fn run_body(
+    frame: &MeshFrame<'_>,
+    (grid, state): (&ContactGrid, &GridParticles),
+    r: &[f64],
+    run: &mut ParticleRun<'_>,
+) -> Contacts {
+    let start = run.start;
+    let n = run.w.len();
+    let w = run.w;
+    let prev = [&run.prev[0][..n], &run.prev[1][..n], &run.prev[2][..n]];
+    let r = &r[..n];
+    let [x0, x1, x2] = &mut run.x;
+    let x = [&mut x0[..n], &mut x1[..n], &mut x2[..n]];
+    let certs = grid.certs();
+    let friction = frame.friction;
+    let mut total = Contacts::default();
+    let full = n - n % LANES;
+    let mut b = Block::<LANES>::new();
+    let mut settled = [Settled::Open; LANES];
+    for s in (0..full).step_by(LANES) {
+        for k in 0..3 {
+            b.x[k].copy_from_slice(&x[k][s..s + LANES]);
+            b.prev[k].copy_from_slice(&prev[k][s..s + LANES]);
+        }
+        b.r.copy_from_slice(&r[s..s + LANES]);
+        for l in 0..LANES {
+            let i = start + s + l;
+            let from = frame.path_start(b.prev_at(l), || state.last(i));
+            for k in 0..3 {
+                b.from[k][l] = from[k];
+            }
+            let (anchor, ball) = state.ball(i);
+            for k in 0..3 {
+                b.anchor[k][l] = anchor[k];
+            }
+            b.ball[l] = ball;
+            b.live[l] = w[s + l] != 0.0;
+            let t = state.hint(i) as usize;
+            b.gather(l, certs.get(t).unwrap_or(&FaceCert::NONE));
+        }
+        total = total.merge(settle(&mut b, friction, &mut settled));
+        for l in 0..LANES {
+            let i = start + s + l;
+            let (mut p, before) = (b.at(l), b.prev_at(l));
+            let out = match settled[l] {
+                Settled::Done => {
+                    frame.settled_in_grid(state, i, p);
+                    continue;
+                }
+                Settled::Rounds => frame.rounds_after_settle(
+                    (grid, state),
+                    i,
+                    before,
+                    &mut p,
+                    b.start_at(l),
+                    b.r[l],
+                ),
+                Settled::Open if w[s + l] == 0.0 => continue,
+                Settled::Open => frame.walk_in_grid((grid, state), i, before, &mut p, b.r[l]),
+            };
+            for k in 0..3 {
+                x[k][s + l] = p[k];
+            }
+            total = total.merge(out.into());
+        }
+        // The block's own pushes.
+        for l in 0..LANES {
+            if settled[l] == Settled::Done {
+                for k in 0..3 {
+                    x[k][s + l] = b.x[k][l];
+                }
+            }
+        }
+    }
+    for j in full..n {
+        if w[j] == 0.0 {
+            continue;
+        }
+        let mut p = DVec3::new(x[0][j], x[1][j], x[2][j]);
+        let before = DVec3::new(prev[0][j], prev[1][j], prev[2][j]);
+        let out = frame.resolve_in_grid((grid, state), start + j, before, &mut p, r[j]);
+        for k in 0..3 {
+            x[k][j] = p[k];
+        }
+        total = total.merge(out.into());
+    }
+    total
+}
+
+impl<const L: usize> Block<L> {
+    /// Lane `l`'s position.
+    #[inline(always)]
+    fn at(&self, l: usize) -> DVec3 {
+        DVec3::new(self.x[0][l], self.x[1][l], self.x[2][l])
+    }
+
+    /// Lane `l`'s position at the substep's start.
+    #[inline(always)]
+    fn prev_at(&self, l: usize) -> DVec3 {
+        DVec3::new(self.prev[0][l], self.prev[1][l], self.prev[2][l])
+    }
+
+    /// Lane `l`'s path start.
+    #[inline(always)]
+    fn start_at(&self, l: usize) -> DVec3 {
+        DVec3::new(self.from[0][l], self.from[1][l], self.from[2][l])
+    }
+}
+
+impl From<Outcome> for Contacts {
+    fn from(o: Outcome) -> Self {
+        Self {
+            contacts: o.contacts,
+            swept: o.swept,
+            depth: o.depth,
+        }
+    }
+}
