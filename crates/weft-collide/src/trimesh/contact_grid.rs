@@ -51,7 +51,8 @@ pub(crate) struct ContactGrid {
     /// Per triangle, a lower bound (sought up to twice the reach of a cell's farthest
     /// point) on its distance to any triangle that reaches in front of its plane.
     clearance: Vec<f64>,
-    /// Per triangle, what the first test of `grid_run` reads.
+    /// Per triangle, what the first test of `grid_run` reads, then a record that settles
+    /// nothing.
     certs: Vec<FaceCert>,
 }
 
@@ -158,8 +159,10 @@ impl ContactGrid {
         let gap = gaps(&starts, dims);
         // Sought as far as a particle with triangles in its cell may be from them.
         let clearance = clearances(mesh, 2.0 * (within + half_diagonal));
+        // One more record, settling nothing, for the particles that touched no triangle.
         let certs = (mesh.faces.iter().zip(&clearance))
             .map(|(f, &clear)| FaceCert::new(f.corners, f.normal, clear))
+            .chain([FaceCert::NONE])
             .collect();
         Some(Self {
             origin,
@@ -233,7 +236,8 @@ impl ContactGrid {
         }
     }
 
-    /// Per triangle (storage order), what the first test of `grid_run` reads.
+    /// Per triangle (storage order), what the first test of `grid_run` reads, then
+    /// [`FaceCert::NONE`].
     #[inline]
     pub fn certs(&self) -> &[FaceCert] {
         &self.certs

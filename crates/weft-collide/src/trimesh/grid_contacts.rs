@@ -10,7 +10,7 @@ use super::MeshPoint;
 use super::candidates::{MeshFrame, Outcome, ROUNDS};
 use super::closest::{Feature, closest_on_triangle};
 use super::contact_grid::{ContactGrid, Side};
-use super::grid_run::{Block, FaceCert, Settled, settle};
+use super::grid_run::{Block, Settled, settle};
 use super::normals::NONE;
 
 /// Triangles a particle's contact walks across from the one it touched last, at most.
@@ -142,7 +142,7 @@ impl MeshFrame<'_> {
     ) -> Outcome {
         // The first test, as a block of one (`grid_run`): the same bits as in a run.
         if self.settles() {
-            let cert = grid.certs().get(state.hint(i) as usize);
+            let t = state.hint(i) as usize;
             let mut b = Block::<1>::new();
             let from = self.path_start(prev, || state.last(i));
             for k in 0..3 {
@@ -157,7 +157,7 @@ impl MeshFrame<'_> {
                 b.anchor[k][0] = anchor[k];
             }
             b.ball[0] = ball;
-            b.gather(0, cert.unwrap_or(&FaceCert::NONE));
+            b.gather_all(grid.certs(), [t]);
             let mut settled = [Settled::Open];
             let tally = settle(&mut b, self.friction, &mut settled);
             let moved = DVec3::new(b.x[0][0], b.x[1][0], b.x[2][0]);

@@ -22,60 +22,59 @@ use crate::friction::Friction;
 /// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
 const LANES: usize = 8;
 
-/// What the first test reads of one triangle, two cache lines: a corner, the unit normal,
-/// the clearance and the triangle's edge lines (unit in-plane outward normals, in f32, with
-/// the rounding margin they need).
+/// What the first test reads of one triangle, in f64, two cache lines: a corner, the unit
+/// normal, the in-plane dual basis of the edges (barycentric coordinates β = u · (x − a),
+/// γ = v · (x − a) of x's projection) and the clearance, as one array so that a block reads
+/// each field of its lanes' triangles together.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-pub(crate) struct FaceCert {
-    /// Corner a (m).
-    a: [f64; 3],
-    /// Unit normal; zero for a degenerate triangle.
-    n: [f64; 3],
-    /// [`ContactGrid::clearance`]; negative where the triangle settles nothing.
-    clear: f64,
-    /// e₁ · (b − a): edge 1 (b → c) passes through b; edges 0 and 2 pass through a.
-    c1: f64,
-    /// 10⁻⁶ of the longest edge: with 10⁻⁶ of |x − a|₁, more than the f32 edge normals'
-    /// rounding moves an edge line at x.
-    slack: f64,
-    /// Unit in-plane outward normal of edge k (corners k, k + 1), per axis.
-    e: [[f32; 3]; 3],
-}
+pub(crate) struct FaceCert([f64; 16]);
+
+/// Where each field of a [`FaceCert`] starts: corner a, unit normal n, the dual vectors u and
+/// v (each three axes), then the clearance.
+const A: usize = 0;
+const N: usize = 3;
+const U: usize = 6;
+const V: usize = 9;
+const CLEAR: usize = 12;
+/// Fields a block gathers.
+const FIELDS: usize = 13;
+
+/// Projections nearer than this (barycentric) to an edge are left to the walk.
+const INSIDE: f64 = 1e-9;
 
 impl FaceCert {
     /// The record of a triangle that settles nothing: every particle goes on to the walk.
-    pub const NONE: Self = Self {
-        a: [0.0; 3],
-        n: [0.0; 3],
-        clear: -1.0,
-        c1: 0.0,
-        slack: 0.0,
-        e: [[0.0; 3]; 3],
+    pub const NONE: Self = {
+        let mut f = [0.0; 16];
+        f[CLEAR] = -1.0;
+        Self(f)
     };
 
-    /// The record of the triangle with `corners`, unit `normal` and `clearance`.
+    /// The record of the triangle with `corners`, unit `normal` and `clearance`: with
+    /// e₁ = b − a, e₂ = c − a and m = e₁ × e₂, u = (e₂ × m) / |m|² and v = (m × e₁) / |m|²
+    /// (so u · e₁ = v · e₂ = 1, u · e₂ = v · e₁ = 0, both in the plane). A degenerate triangle,
+    /// or one so thin that rounding of β and γ at the clearance's reach could pass 10⁻¹²,
+    /// settles nothing.
     pub fn new(corners: [DVec3; 3], normal: DVec3, clearance: f64) -> Self {
-        if normal == DVec3::ZERO {
+        let [a, b, c] = corners;
+        let (e1, e2) = (b - a, c - a);
+        let m = e1.cross(e2);
+        let m2 = m.length_squared();
+        if normal == DVec3::ZERO || !(m2 > 0.0) {
             return Self::NONE;
         }
-        let [a, b, _] = corners;
-        let edge = |k: usize| {
-            let e = (corners[(k + 1) % 3] - corners[k]).cross(normal);
-            e.normalize_or_zero().as_vec3()
-        };
-        let e = [edge(0), edge(1), edge(2)];
-        let longest = (0..3)
-            .map(|k| (corners[(k + 1) % 3] - corners[k]).length())
-            .fold(0.0, f64::max);
-        Self {
-            a: a.to_array(),
-            n: normal.to_array(),
-            clear: clearance,
-            c1: e[1].as_dvec3().dot(b - a),
-            slack: 1e-6 * longest,
-            e: e.map(|v| v.to_array()),
+        let (u, v) = (e2.cross(m) / m2, m.cross(e1) / m2);
+        let reach = (u.length() + v.length()) * (clearance.max(0.0) + e1.length() + e2.length());
+        if !(reach < 1e3) {
+            return Self::NONE;
         }
+        let mut f = [0.0; 16];
+        for (at, w) in [(A, a), (N, normal), (U, u), (V, v)] {
+            f[at..at + 3].copy_from_slice(&w.to_array());
+        }
+        f[CLEAR] = clearance;
+        Self(f)
     }
 }
 
@@ -107,13 +106,9 @@ pub(crate) struct Block<const L: usize> {
     pub anchor: [[f64; L]; 3],
     /// Its radius; NaN where there is none.
     pub ball: [f64; L],
-    /// The lanes' triangles, gathered per field.
-    a: [[f64; L]; 3],
-    n: [[f64; L]; 3],
-    clear: [f64; L],
-    c1: [f64; L],
-    slack: [f64; L],
-    e: [[[f64; L]; 3]; 3],
+
+    /// The lanes' triangles, gathered per field ([`FaceCert`]'s order).
+    f: [[f64; L]; FIELDS],
 }
 
 impl<const L: usize> Block<L> {
@@ -127,28 +122,48 @@ impl<const L: usize> Block<L> {
             live: [false; L],
             anchor: [[0.0; L]; 3],
             ball: [f64::NAN; L],
-            a: [[0.0; L]; 3],
-            n: [[0.0; L]; 3],
-            clear: [-1.0; L],
-            c1: [0.0; L],
-            slack: [0.0; L],
-            e: [[[0.0; L]; 3]; 3],
+            f: std::array::from_fn(|k| [FaceCert::NONE.0[k]; L]),
         }
     }
 
     /// Gives lane `l` the triangle record `f`.
     #[inline(always)]
     pub fn gather(&mut self, l: usize, f: &FaceCert) {
-        for k in 0..3 {
-            self.a[k][l] = f.a[k];
-            self.n[k][l] = f.n[k];
-            for j in 0..3 {
-                self.e[j][k][l] = f64::from(f.e[j][k]);
+        for k in 0..FIELDS {
+            self.f[k][l] = f.0[k];
+        }
+    }
+
+    /// Gives each lane l the record `certs[t[l]]`, or the last record where t[l] is past it
+    /// (the grid keeps [`FaceCert::NONE`] there), field by field.
+    #[inline(always)]
+    pub fn gather_all(&mut self, certs: &[FaceCert], t: [usize; L]) {
+        let Some(last) = certs.len().checked_sub(1) else {
+            for l in 0..L {
+                self.gather(l, &FaceCert::NONE);
+            }
+            return;
+        };
+        let at: [&FaceCert; L] = std::array::from_fn(|l| &certs[t[l].min(last)]);
+        for k in 0..FIELDS {
+            for l in 0..L {
+                self.f[k][l] = at[l].0[k];
             }
         }
-        self.clear[l] = f.clear;
-        self.c1[l] = f.c1;
-        self.slack[l] = f.slack;
+    }
+}
+
+impl<const L: usize> Block<L> {
+    /// Whether each lane's path lies in its clear ball (NaN radius: none does).
+    #[inline(always)]
+    pub fn in_ball(&self) -> [bool; L] {
+        std::array::from_fn(|l| {
+            let (ball, o) = (self.ball[l], [0, 1, 2].map(|k| self.anchor[k][l]));
+            let q = [0, 1, 2].map(|k| self.x[k][l] - o[k]);
+            let e = [0, 1, 2].map(|k| self.from[k][l] - o[k]);
+            (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= ball * ball)
+                & (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] <= ball * ball)
+        })
     }
 }
 
@@ -174,6 +189,7 @@ pub(crate) fn settle<const L: usize>(
     let mut s = [0.0; L];
     let mut clear = [false; L];
     let mut settled = [false; L];
+    let in_ball = b.in_ball();
     for l in 0..L {
         let p = [
             b.x[0][l] - b.from[0][l],
@@ -182,34 +198,20 @@ pub(crate) fn settle<const L: usize>(
         ];
         let half = 0.5 * b.r[l];
         let short = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] <= half * half;
-        let v = [
-            b.x[0][l] - b.a[0][l],
-            b.x[1][l] - b.a[1][l],
-            b.x[2][l] - b.a[2][l],
-        ];
-        let h = b.n[0][l] * v[0] + b.n[1][l] * v[1] + b.n[2][l] * v[2];
+        let f = |k: usize| b.f[k][l];
+        let v = [b.x[0][l] - f(A), b.x[1][l] - f(A + 1), b.x[2][l] - f(A + 2)];
+        let dot = |at: usize| f(at) * v[0] + f(at + 1) * v[1] + f(at + 2) * v[2];
+        let h = dot(N);
         let to_a = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
         let r = b.r[l];
-        let room = b.clear[l] - r;
-        let margin = 1e-6 * (v[0].abs() + v[1].abs() + v[2].abs()) + b.slack[l];
-        let line = |k: usize| b.e[k][0][l] * v[0] + b.e[k][1][l] * v[1] + b.e[k][2][l] * v[2];
-        let inside = line(0) < -margin && line(1) - b.c1[l] < -margin && line(2) < -margin;
+        let room = f(CLEAR) - r;
+        let (beta, gamma) = (dot(U), dot(V));
+        let inside = (beta > INSIDE) & (gamma > INSIDE) & (beta + gamma < 1.0 - INSIDE);
         let live = b.live[l] & short;
-        let (ball, o) = (b.ball[l], [b.anchor[0][l], b.anchor[1][l], b.anchor[2][l]]);
-        let (q, f) = (
-            [b.x[0][l] - o[0], b.x[1][l] - o[1], b.x[2][l] - o[2]],
-            [
-                b.from[0][l] - o[0],
-                b.from[1][l] - o[1],
-                b.from[2][l] - o[2],
-            ],
-        );
-        let in_ball = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= ball * ball)
-            & (f[0] * f[0] + f[1] * f[1] + f[2] * f[2] <= ball * ball);
         s[l] = h;
         clear[l] =
-            (b.live[l] & in_ball) | (live & (h >= r) & (room >= 0.0) & (to_a <= room * room));
-        settled[l] = live & inside & (h > 1e-12) & (h.max(r) + r <= b.clear[l]);
+            (b.live[l] & in_ball[l]) | (live & (h >= r) & (room >= 0.0) & (to_a <= room * room));
+        settled[l] = live & inside & (h > 1e-12) & (h.max(r) + r <= f(CLEAR));
     }
     let mut depth = [0.0; L];
     let mut push = [false; L];
@@ -230,18 +232,18 @@ pub(crate) fn settle<const L: usize>(
     let mut rel = [[0.0; L]; 3];
     for k in 0..3 {
         for l in 0..L {
-            moved[k][l] = b.x[k][l] + b.n[k][l] * depth[l];
+            moved[k][l] = b.x[k][l] + b.f[N + k][l] * depth[l];
             rel[k][l] = moved[k][l] - b.prev[k][l];
         }
     }
     let mut along = [0.0; L];
     for l in 0..L {
-        along[l] = b.n[0][l] * rel[0][l] + b.n[1][l] * rel[1][l] + b.n[2][l] * rel[2][l];
+        along[l] = b.f[N][l] * rel[0][l] + b.f[N + 1][l] * rel[1][l] + b.f[N + 2][l] * rel[2][l];
     }
     let mut t = [[0.0; L]; 3];
     for k in 0..3 {
         for l in 0..L {
-            t[k][l] = rel[k][l] - b.n[k][l] * along[l];
+            t[k][l] = rel[k][l] - b.f[N + k][l] * along[l];
         }
     }
     let mut scale = [0.0; L];
@@ -272,7 +274,7 @@ pub(crate) fn settle<const L: usize>(
         if push[l] {
             // Pushed to r off the face, then slipped across its normal: still clear of the
             // triangles in front if within the clearance less r.
-            let room = b.clear[l] - 2.0 * b.r[l];
+            let room = b.f[CLEAR][l] - 2.0 * b.r[l];
             if slip2[l] > room * room {
                 out[l] = Settled::Rounds;
             }
@@ -371,6 +373,7 @@ fn run_body(
             b.prev[k].copy_from_slice(&prev[k][s..s + LANES]);
         }
         b.r.copy_from_slice(&r[s..s + LANES]);
+        let mut t = [0usize; LANES];
         for l in 0..LANES {
             let i = start + s + l;
             let from = frame.path_start(b.prev_at(l), || state.last(i));
@@ -383,9 +386,19 @@ fn run_body(
             }
             b.ball[l] = ball;
             b.live[l] = w[s + l] != 0.0;
-            let t = state.hint(i) as usize;
-            b.gather(l, certs.get(t).unwrap_or(&FaceCert::NONE));
+            t[l] = state.hint(i) as usize;
         }
+        let in_ball = b.in_ball();
+        if (0..LANES).all(|l| in_ball[l] | !b.live[l]) {
+            // Nothing within r of any path: no triangle to read.
+            for l in 0..LANES {
+                if b.live[l] {
+                    frame.settled_in_grid(state, start + s + l, b.at(l));
+                }
+            }
+            continue;
+        }
+        b.gather_all(certs, t);
         total = total.merge(settle(&mut b, friction, &mut settled));
         for l in 0..LANES {
             let i = start + s + l;
