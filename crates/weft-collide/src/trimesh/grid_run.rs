@@ -363,6 +363,8 @@ fn run_body(
     let x = [&mut x0[..n], &mut x1[..n], &mut x2[..n]];
     let certs = grid.certs();
     let friction = frame.friction;
+    // The path starts at the substep's start (the frame's world frame is the mesh's).
+    let fresh = frame.fresh;
     let mut total = Contacts::default();
     let full = n - n % LANES;
     let mut b = Block::<LANES>::new();
@@ -373,12 +375,17 @@ fn run_body(
             b.prev[k].copy_from_slice(&prev[k][s..s + LANES]);
         }
         b.r.copy_from_slice(&r[s..s + LANES]);
+        if fresh {
+            b.from = b.prev;
+        }
         let mut t = [0usize; LANES];
         for l in 0..LANES {
             let i = start + s + l;
-            let from = frame.path_start(b.prev_at(l), || state.last(i));
-            for k in 0..3 {
-                b.from[k][l] = from[k];
+            if !fresh {
+                let from = state.last(i);
+                for k in 0..3 {
+                    b.from[k][l] = from[k];
+                }
             }
             let (anchor, ball) = state.ball(i);
             for k in 0..3 {
@@ -400,6 +407,11 @@ fn run_body(
         }
         b.gather_all(certs, t);
         total = total.merge(settle(&mut b, friction, &mut settled));
+        // The block's own pushes (the other lanes' positions as they were), then the lanes it
+        // left to the walk and the cell, one by one.
+        for k in 0..3 {
+            x[k][s..s + LANES].copy_from_slice(&b.x[k]);
+        }
         for l in 0..LANES {
             let i = start + s + l;
             let (mut p, before) = (b.at(l), b.prev_at(l));
@@ -423,14 +435,6 @@ fn run_body(
                 x[k][s + l] = p[k];
             }
             total = total.merge(out.into());
-        }
-        // The block's own pushes.
-        for l in 0..LANES {
-            if settled[l] == Settled::Done {
-                for k in 0..3 {
-                    x[k][s + l] = b.x[k][l];
-                }
-            }
         }
     }
     for j in full..n {
