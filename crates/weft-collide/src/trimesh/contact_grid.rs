@@ -216,16 +216,21 @@ impl ContactGrid {
     }
 
     /// A lower bound on the distance from `x`, in `cell` (as [`Self::cell`] finds it), to
-    /// every triangle: a cell listing none is farther than the reach from them at each of its
-    /// points, so a point whose cell is k cells (Chebyshev) from the nearest listing one is
-    /// at least the reach plus k − 1 cells away; outside the grid, the distance to the mesh's
-    /// box.
+    /// every triangle. Every point of a cell listing none is farther than the reach from
+    /// them, and a point of a cell k cells (Chebyshev) from the nearest listing one is at
+    /// least the reach plus k − 1 cells away; `x` is as far again as it is from its cell's
+    /// faces (a path from it to a triangle leaves the cell first). Outside the grid, the
+    /// distance to the mesh's box. Zero in a listing cell.
     pub fn clear_distance(&self, cell: Option<usize>, x: DVec3) -> f64 {
         match cell {
             Some(c) => match self.gap[c] {
                 0 => 0.0,
                 k => {
-                    (self.reach + f64::from(k - 1) * self.h) * (1.0 - 1e-9) - 1e-9 * (1.0 + self.h)
+                    let f = (x - self.origin) * self.inv_h;
+                    let frac = f - f.floor();
+                    let inner = frac.min(DVec3::ONE - frac).min_element().max(0.0) * self.h;
+                    let d = inner + self.reach + f64::from(k - 1) * self.h;
+                    d * (1.0 - 1e-9) - 1e-9 * (1.0 + self.h)
                 }
             },
             None => {

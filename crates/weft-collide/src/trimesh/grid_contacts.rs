@@ -253,7 +253,15 @@ impl MeshFrame<'_> {
         // The triangle touched last, or one a few edges across from it towards the particle,
         // settles the contact alone where its face is nearest and no triangle in front of its
         // plane is near (see `ContactGrid::clearance`).
-        let mut t = state.hint(i) as usize;
+        // A particle whose cell lists no triangle, outside, is clear (most that reach here
+        // away from the surface): no walk.
+        let cell = grid.cell(xl);
+        if grid.side(cell) == Side::Outside && cell.is_none_or(|c| grid.list(c).is_empty()) {
+            self.clear_in_cell((grid, state), i, cell, xl, r);
+            return out;
+        }
+        let hint = state.hint(i) as usize;
+        let mut t = hint;
         for _ in 0..WALK {
             let Some(f) = g.faces.get(t) else { break };
             let [a, b, c] = f.corners;
@@ -267,6 +275,10 @@ impl MeshFrame<'_> {
             } {
                 state.set_side(i, Some(false));
                 state.set_last(i, xl);
+                if t != hint {
+                    // Where the next substep's first test starts.
+                    state.set_hint(i, t as u32);
+                }
                 return out;
             }
             let q = closest_on_triangle(xl, a, b, c);
@@ -342,6 +354,25 @@ impl MeshFrame<'_> {
         self.rounds_in_grid((grid, state), i, prev, x, xl, from, r, out)
     }
 
+    /// Records particle `i` at `xl` (thickness `r`) clear in `cell`, which lists no triangle
+    /// and lies outside: outside, left there, with a clear ball while it stays within its
+    /// cell's distance from the mesh, less r.
+    fn clear_in_cell(
+        &self,
+        (grid, state): (&ContactGrid, &GridParticles),
+        i: usize,
+        cell: Option<usize>,
+        xl: DVec3,
+        r: f64,
+    ) {
+        state.set_side(i, Some(false));
+        state.set_last(i, xl);
+        let clear = grid.clear_distance(cell, xl) - r;
+        if clear > 0.0 {
+            state.set_ball(i, xl, clear);
+        }
+    }
+
     /// The contact rounds of [`Self::resolve_in_grid`] through the particle's cell, from
     /// local position `xl` on the path from `from`, adding to `out`.
     #[allow(clippy::too_many_arguments)]
@@ -362,13 +393,8 @@ impl MeshFrame<'_> {
             let list = cell.map_or(&[][..], |c| grid.list(c));
             let side = grid.side(cell);
             if list.is_empty() && side == Side::Outside {
-                state.set_side(i, Some(false));
-                // Clear while it stays within its cell's distance from the mesh, less r.
-                let clear = grid.clear_distance(cell, xl) - r;
-                if clear > 0.0 {
-                    state.set_ball(i, xl, clear);
-                }
-                break;
+                self.clear_in_cell((grid, state), i, cell, xl, r);
+                return out;
             }
             let scan = self.scan(list, state.hint(i), xl, r);
             let scanned_at = xl;

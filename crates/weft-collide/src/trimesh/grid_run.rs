@@ -61,12 +61,12 @@ impl FaceCert {
         let (e1, e2) = (b - a, c - a);
         let m = e1.cross(e2);
         let m2 = m.length_squared();
-        if normal == DVec3::ZERO || !(m2 > 0.0) {
+        if normal == DVec3::ZERO || m2.is_nan() || m2 <= 0.0 {
             return Self::NONE;
         }
         let (u, v) = (e2.cross(m) / m2, m.cross(e1) / m2);
         let reach = (u.length() + v.length()) * (clearance.max(0.0) + e1.length() + e2.length());
-        if !(reach < 1e3) {
+        if reach.is_nan() || reach >= 1e3 {
             return Self::NONE;
         }
         let mut f = [0.0; 16];
