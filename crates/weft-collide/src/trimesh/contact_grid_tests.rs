@@ -228,3 +228,76 @@ fn contacts_through_the_grid_are_those_through_the_lists_on_a_closed_mesh() {
 fn contacts_through_the_grid_are_those_through_the_lists_on_an_open_sheet() {
     grid_matches_lists(&bumpy_sheet(), 25);
 }
+
+#[test]
+fn the_gap_is_the_chebyshev_distance_to_the_nearest_listing_cell() {
+    let g = geometry(&bumpy_sphere());
+    let grid = ContactGrid::new(&g, 0.02).expect("small grid");
+    let [nx, ny, nz] = grid.dims;
+    let listing: Vec<[usize; 3]> = (0..nz)
+        .flat_map(|k| (0..ny).flat_map(move |j| (0..nx).map(move |i| [i, j, k])))
+        .filter(|&[i, j, k]| {
+            let c = (k * ny + j) * nx + i;
+            grid.starts[c + 1] > grid.starts[c]
+        })
+        .collect();
+    assert!(!listing.is_empty());
+    let mut rng = Rng(26);
+    let mut far = 0;
+    for _ in 0..400 {
+        let cell = [nx, ny, nz].map(|d| (rng.next() * d as f64) as usize % d);
+        let chebyshev = listing
+            .iter()
+            .map(|l| (0..3).map(|a| l[a].abs_diff(cell[a])).max().unwrap_or(0))
+            .min()
+            .unwrap_or(usize::MAX);
+        let c = (cell[2] * ny + cell[1]) * nx + cell[0];
+        assert_eq!(
+            usize::from(grid.gap[c]),
+            chebyshev.min(255),
+            "cell {cell:?}"
+        );
+        far += usize::from(chebyshev >= 2);
+    }
+    assert!(far > 50, "only {far} cells two or more from the surface");
+}
+
+#[test]
+fn a_clear_ball_holds_no_point_within_reach_of_the_mesh() {
+    let mut rng = Rng(27);
+    for (m, reach) in [(bumpy_sphere(), 0.02), (bumpy_sheet(), 0.01)] {
+        let g = geometry(&m);
+        let grid = ContactGrid::new(&g, reach).expect("small grid");
+        let (mut near, mut far, mut beyond) = (0, 0, 0);
+        for k in 0..6000 {
+            // Around the mesh, and (one in four) beyond the grid.
+            let x = if k % 4 == 0 {
+                rng.cube(3.0)
+            } else {
+                points(&g, &mut rng, 1, 0.15)[0]
+            };
+            let cell = grid.cell(x);
+            if grid.side(cell) != Side::Outside || cell.is_some_and(|c| !grid.list(c).is_empty()) {
+                continue;
+            }
+            let bound = grid.clear_distance(cell, x);
+            let least = (0..g.faces.len())
+                .map(|t| distance(&g, t, x))
+                .fold(f64::INFINITY, f64::min);
+            assert!(least >= bound, "{x}: nearest triangle {least} < {bound}");
+            assert!(
+                bound > reach * (1.0 - 1e-6) || cell.is_none(),
+                "{x}: {bound}"
+            );
+            match cell {
+                None => beyond += 1,
+                Some(c) if grid.gap[c] >= 2 => far += 1,
+                Some(_) => near += 1,
+            }
+        }
+        assert!(
+            near > 100 && far > 100 && beyond > 100,
+            "{near} next to the surface, {far} farther, {beyond} beyond the grid"
+        );
+    }
+}

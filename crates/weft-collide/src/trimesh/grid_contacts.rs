@@ -444,3 +444,20 @@ impl MeshFrame<'_> {
         out
     }
 }
+
+#[cfg(test)]
+impl GridParticles {
+    /// Every particle's state, as bits, to compare two runs.
+    pub(crate) fn snapshot(&self) -> Vec<(u32, u8, [u64; 3], [u64; 4])> {
+        (0..self.hint.len())
+            .map(|i| {
+                (
+                    self.hint[i].load(Relaxed),
+                    self.side[i].load(Relaxed),
+                    self.last[i].each_ref().map(|a| a.load(Relaxed)),
+                    self.ball[i].each_ref().map(|a| a.load(Relaxed)),
+                )
+            })
+            .collect()
+    }
+}

@@ -481,3 +481,7 @@ impl From<Outcome> for Contacts {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "grid_run_tests.rs"]
+mod tests;

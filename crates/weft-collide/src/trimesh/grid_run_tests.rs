@@ -1,0 +1,135 @@
+//! A run of particles through the block path against the same particles one at a time.
+
+use glam::{DQuat, DVec3};
+use weft_solver::{Contacts, ParticleRun, SimdPath};
+
+use super::resolve_grid_run;
+use crate::analytic::WorldPose;
+use crate::analytic_vs_parry::Rng;
+use crate::friction::Friction;
+use crate::mesh::TriangleMesh;
+use crate::trimesh::MeshGeometry;
+use crate::trimesh::candidates::MeshFrame;
+use crate::trimesh::contact_grid::ContactGrid;
+use crate::trimesh::grid_contacts::GridParticles;
+use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
+
+/// Positions, per axis.
+type Axes = [Vec<f64>; 3];
+
+/// Particles about mesh `g`: near its surface on either side, on it, deep inside (one in
+/// six), and far away (one in five), thickness `r`.
+fn particles(g: &MeshGeometry, rng: &mut Rng, n: usize, r: f64) -> Vec<DVec3> {
+    (0..n)
+        .map(|k| {
+            if k % 5 == 0 {
+                return rng.cube(1.5);
+            }
+            let dir = rng.cube(1.0).normalize_or(DVec3::Y);
+            let p = g.nearest(dir, f64::INFINITY).expect("nearest");
+            let h = if k % 6 == 0 { -3.0 } else { 2.5 * rng.next() };
+            p.closest.point + p.normal * r * h
+        })
+        .collect()
+}
+
+fn axes(p: &[DVec3]) -> Axes {
+    [0, 1, 2].map(|k| p.iter().map(|v| v[k]).collect())
+}
+
+/// Steps particles about `m` for several substeps (two passes each: the substep's first and
+/// one more), moving them towards the mesh's centre and sideways in between, once through
+/// `resolve_grid_run` on kernel path `path` (in runs of uneven length) and once particle by
+/// particle through `resolve_in_grid`; the positions, the totals and every particle's state
+/// must agree to the bit.
+fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath) {
+    let g = MeshGeometry::new(&m.vertices, &m.triangles);
+    let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+    let r = 0.02;
+    let grid = ContactGrid::new(&g, r).expect("small grid");
+    let friction = Friction::new(0.8, 0.6);
+    let mut rng = Rng(seed);
+    let n = 1003;
+    let (one, many) = (GridParticles::new(n), GridParticles::new(n));
+    let start = particles(&g, &mut rng, n, r);
+    let w: Vec<f64> = (0..n)
+        .map(|i| if i % 11 == 0 { 0.0 } else { 1.0 })
+        .collect();
+    let thickness = vec![r; n];
+    let (mut a, mut b) = (start.clone(), axes(&start));
+    let (mut contacts, mut settled_any) = (0, false);
+    for step in 0..10 {
+        let prev = a.clone();
+        let prev_axes = axes(&prev);
+        for (j, p) in a.iter_mut().enumerate() {
+            if w[j] != 0.0 {
+                *p += -*p * 0.02 + rng.cube(0.004);
+                for k in 0..3 {
+                    b[k][j] = p[k];
+                }
+            }
+        }
+        for fresh in [true, false] {
+            let mut frame = MeshFrame::still(&g, &pose, friction);
+            frame.fresh = fresh;
+            assert!(frame.settles());
+            let mut expected = Contacts::default();
+            for j in 0..n {
+                if w[j] != 0.0 {
+                    let o = frame.resolve_in_grid((&grid, &one), j, prev[j], &mut a[j], r);
+                    expected = expected.merge(o.into());
+                }
+            }
+            let mut total = Contacts::default();
+            // Runs of 0..100, 100..613 and 613..1003: full blocks and remainders.
+            for (s, e) in [(0, 100), (100, 613), (613, n)] {
+                let [x0, x1, x2] = &mut b;
+                let mut run = ParticleRun {
+                    start: s,
+                    x: [&mut x0[s..e], &mut x1[s..e], &mut x2[s..e]],
+                    prev: [0, 1, 2].map(|k| &prev_axes[k][s..e]),
+                    w: &w[s..e],
+                    path,
+                };
+                let o = resolve_grid_run(&frame, (&grid, &many), &thickness[s..e], &mut run);
+                total = total.merge(o);
+            }
+            for j in 0..n {
+                for k in 0..3 {
+                    assert_eq!(
+                        a[j][k].to_bits(),
+                        b[k][j].to_bits(),
+                        "{path:?}, step {step}, fresh {fresh}, particle {j}, axis {k}"
+                    );
+                }
+            }
+            assert_eq!(total.contacts, expected.contacts, "{path:?}, step {step}");
+            assert_eq!(total.swept, expected.swept, "{path:?}, step {step}");
+            assert_eq!(total.depth.to_bits(), expected.depth.to_bits());
+            assert!(
+                one.snapshot() == many.snapshot(),
+                "{path:?}, step {step}: state"
+            );
+            contacts += total.contacts;
+            settled_any |= total.contacts > 0;
+        }
+    }
+    assert!(
+        settled_any && contacts > 1000,
+        "{path:?}: {contacts} contacts"
+    );
+}
+
+#[test]
+fn a_run_moves_each_particle_as_the_one_particle_path_does_bit_for_bit() {
+    for path in [
+        SimdPath::Avx512,
+        SimdPath::Avx2,
+        SimdPath::Neon,
+        SimdPath::Scalar,
+    ] {
+        run_matches_particles(&bumpy_sphere(), 31, path);
+        run_matches_particles(&TriangleMesh::icosphere(0.5, 4), 32, path);
+        run_matches_particles(&bumpy_sheet(), 33, path);
+    }
+}
