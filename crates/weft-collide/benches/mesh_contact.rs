@@ -8,6 +8,9 @@
 //!   f32 projection (the path before Weft's own); `sphere` the same cloth after 30 frames on
 //!   `sphere_drop`'s analytic sphere of the same size and the ground, `sphere_alone` on the
 //!   sphere only.
+//! - `static_mesh_draped/16384`: the same after 120 frames (2 s), when the cloth has come to
+//!   rest over the ball and on the ground, not still sliding off it as at 30 frames: the bare
+//!   solve, the mesh and ground, and the analytic sphere and ground.
 //! - `deforming_mesh/8100`: a 90² cloth on `breathing_drop`'s deforming ball of 5,120
 //!   triangles (vertices set, faces and BVH refitted and contacts swept every substep),
 //!   against its own constraint solve.
@@ -30,6 +33,9 @@ use weft_solver::{Method, Solver};
 /// Frames stepped before timing: the cloth has fallen onto the collider.
 const PREROLL: usize = 30;
 
+/// Frames stepped before timing the draped cloth: it has come to rest.
+const DRAPED: usize = 120;
+
 fn quick(g: &mut BenchmarkGroup<'_, WallTime>) {
     g.sample_size(10)
         .sampling_mode(SamplingMode::Flat)
@@ -37,8 +43,13 @@ fn quick(g: &mut BenchmarkGroup<'_, WallTime>) {
         .measurement_time(Duration::from_secs(2));
 }
 
-fn in_contact(mut scene: (Solver, CollisionWorld)) -> (Solver, CollisionWorld) {
-    for _ in 0..PREROLL {
+fn in_contact(scene: (Solver, CollisionWorld)) -> (Solver, CollisionWorld) {
+    after(PREROLL, scene)
+}
+
+/// `scene` after `frames` frames.
+fn after(frames: usize, mut scene: (Solver, CollisionWorld)) -> (Solver, CollisionWorld) {
+    for _ in 0..frames {
         scene.0.step_with(&mut scene.1).expect("stable");
     }
     scene
@@ -78,6 +89,22 @@ fn static_mesh(c: &mut Criterion) {
     g.finish();
 }
 
+fn draped_mesh(c: &mut Criterion) {
+    let n = 128;
+    let (solver, world) = after(DRAPED, icosphere_drop(Method::Xpbd, n).expect("scene"));
+    let (sphere_solver, sphere_world) = after(DRAPED, sphere_drop(Method::Xpbd, n).expect("scene"));
+    let mut g = c.benchmark_group(format!("static_mesh_draped/{}", n * n));
+    quick(&mut g);
+    g.throughput(Throughput::Elements((n * n) as u64));
+    g.bench_function("constraint_solve", |b| step_copies(b, &solver));
+    g.bench_function("mesh", |b| step_with_copies(b, &solver, &world));
+    g.bench_function("sphere_solve", |b| step_copies(b, &sphere_solver));
+    g.bench_function("sphere", |b| {
+        step_with_copies(b, &sphere_solver, &sphere_world)
+    });
+    g.finish();
+}
+
 fn deforming_mesh(c: &mut Criterion) {
     let n = 90;
     let (solver, world) = in_contact(breathing_drop(Method::Xpbd, n).expect("scene"));
@@ -89,5 +116,5 @@ fn deforming_mesh(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, static_mesh, deforming_mesh);
+criterion_group!(benches, static_mesh, draped_mesh, deforming_mesh);
 criterion_main!(benches);
