@@ -165,7 +165,7 @@ impl MeshFrame<'_> {
                 Settled::Open => {}
                 Settled::Done => {
                     *x = moved;
-                    self.settled_in_grid(state, i, moved);
+                    self.settled_in_grid(state, i, moved, b.new_ball[0]);
                     return Outcome {
                         contacts: tally.contacts,
                         depth: tally.depth,
@@ -203,11 +203,15 @@ impl MeshFrame<'_> {
         }
     }
 
-    /// Records a particle settled by the first test at `x`: outside, left there.
+    /// Records a particle settled by the first test at `x`: outside, left there, with a new
+    /// clear ball about `x` of radius `ball` unless NaN.
     #[inline]
-    pub(crate) fn settled_in_grid(&self, state: &GridParticles, i: usize, x: DVec3) {
+    pub(crate) fn settled_in_grid(&self, state: &GridParticles, i: usize, x: DVec3, ball: f64) {
         state.set_side(i, Some(false));
         state.set_last(i, x);
+        if !ball.is_nan() {
+            state.set_ball(i, x, ball);
+        }
     }
 
     /// The cell's contact rounds for a particle that the first test pushed out of its face

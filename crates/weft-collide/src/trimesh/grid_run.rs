@@ -106,6 +106,9 @@ pub(crate) struct Block<const L: usize> {
     pub anchor: [[f64; L]; 3],
     /// Its radius; NaN where there is none.
     pub ball: [f64; L],
+    /// A new clear ball about the lane's position, where the triangle's test cleared it
+    /// outside its ball: the radius, or NaN.
+    pub new_ball: [f64; L],
 
     /// The lanes' triangles, gathered per field ([`FaceCert`]'s order).
     f: [[f64; L]; FIELDS],
@@ -122,6 +125,7 @@ impl<const L: usize> Block<L> {
             live: [false; L],
             anchor: [[0.0; L]; 3],
             ball: [f64::NAN; L],
+            new_ball: [f64::NAN; L],
             f: std::array::from_fn(|k| [FaceCert::NONE.0[k]; L]),
         }
     }
@@ -189,6 +193,8 @@ pub(crate) fn settle<const L: usize>(
     let mut s = [0.0; L];
     let mut clear = [false; L];
     let mut settled = [false; L];
+    // How far past r from the mesh the triangle's test proves each lane to be.
+    let mut spare = [0.0; L];
     let in_ball = b.in_ball();
     for l in 0..L {
         let p = [
@@ -212,6 +218,10 @@ pub(crate) fn settle<const L: usize>(
         clear[l] =
             (b.live[l] & in_ball[l]) | (live & (h >= r) & (room >= 0.0) & (to_a <= room * room));
         settled[l] = live & inside & (h > 1e-12) & (h.max(r) + r <= f(CLEAR));
+        // Triangles behind the plane are h or more away, those in front the clearance less
+        // the distance to this triangle (h over the face, at most |x − a| anywhere).
+        let near = if inside { h } else { to_a.sqrt() };
+        spare[l] = h.min(f(CLEAR) - near) - r;
     }
     let mut depth = [0.0; L];
     let mut push = [false; L];
@@ -222,6 +232,14 @@ pub(crate) fn settle<const L: usize>(
             Settled::Done
         } else {
             Settled::Open
+        };
+        // A clear ball about a lane the triangle cleared outside its ball: no triangle is
+        // within r of any point within `spare` of it.
+        let fresh = (clear[l] | settled[l]) & !push[l] & !in_ball[l] & (spare[l] > 0.0);
+        b.new_ball[l] = if fresh {
+            spare[l] * (1.0 - 1e-9)
+        } else {
+            f64::NAN
         };
     }
     if !push.contains(&true) {
@@ -400,7 +418,7 @@ fn run_body(
             // Nothing within r of any path: no triangle to read.
             for l in 0..LANES {
                 if b.live[l] {
-                    frame.settled_in_grid(state, start + s + l, b.at(l));
+                    frame.settled_in_grid(state, start + s + l, b.at(l), f64::NAN);
                 }
             }
             continue;
@@ -417,7 +435,7 @@ fn run_body(
             let (mut p, before) = (b.at(l), b.prev_at(l));
             let out = match settled[l] {
                 Settled::Done => {
-                    frame.settled_in_grid(state, i, p);
+                    frame.settled_in_grid(state, i, p, b.new_ball[l]);
                     continue;
                 }
                 Settled::Rounds => frame.rounds_after_settle(
