@@ -15,7 +15,7 @@ use weft_solver::{Contacts, SimdPath};
 
 use crate::analytic::TINY;
 use crate::collider::Collider;
-use crate::friction::Friction;
+use crate::friction::{Friction, push_lanes};
 use crate::reach::{BALL_SLACK, Reach, Surface};
 
 /// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
@@ -181,44 +181,9 @@ fn block<const L: usize>(
         return Contacts::default();
     }
     // Pushed out along the normal, then friction on the slip since the substep's start
-    // relative to the still surface (Macklin et al. 2014, eq. 24; `Friction::correction`).
-    let mut moved = [[0.0; L]; 3];
-    let mut rel = [[0.0; L]; 3];
-    for a in 0..3 {
-        for l in 0..L {
-            moved[a][l] = x[a][l] + normal[a][l] * depth[l];
-            rel[a][l] = moved[a][l] - prev[a][l];
-        }
-    }
-    let mut along = [0.0; L];
-    for l in 0..L {
-        along[l] = normal[0][l] * rel[0][l] + normal[1][l] * rel[1][l] + normal[2][l] * rel[2][l];
-    }
-    let mut t = [[0.0; L]; 3];
-    for a in 0..3 {
-        for l in 0..L {
-            t[a][l] = rel[a][l] - normal[a][l] * along[l];
-        }
-    }
-    let mut scale = [0.0; L];
-    let mut no_slip = [false; L];
-    for l in 0..L {
-        let slip2 = t[0][l] * t[0][l] + t[1][l] * t[1][l] + t[2][l] * t[2][l];
-        let grip = friction.static_coefficient * depth[l];
-        let sliding = (friction.dynamic_coefficient * depth[l] / slip2.sqrt()).min(1.0);
-        // Sticking: t itself (t · 1 = t exactly).
-        scale[l] = if slip2 < grip * grip { 1.0 } else { sliding };
-        no_slip[l] = slip2 <= 0.0;
-    }
-    for a in 0..3 {
-        for l in 0..L {
-            // No slip: the correction is +0 (t · 0 may be −0, which would turn a −0
-            // position into +0).
-            let correction = if no_slip[l] { 0.0 } else { t[a][l] * scale[l] };
-            let done = moved[a][l] - correction;
-            x[a][l] = if push[l] { done } else { x[a][l] };
-        }
-    }
+    // relative to the still surface.
+    let [n0, n1, n2] = &normal;
+    (*x, _) = push_lanes(friction, x, prev, [n0, n1, n2], &depth, &push);
     let mut tally = Contacts::default();
     for l in 0..L {
         if push[l] {

@@ -79,6 +79,68 @@ impl Friction {
     }
 }
 
+/// The push-out and friction of `L` contacts side by side against a still surface, every
+/// branch a select so that the compiler keeps them in vector registers: each lane's position
+/// `x` moved by `depth` along its unit `normal`, then its slip since `prev` across the normal
+/// corrected as [`Friction::correction`] does (Macklin et al. 2014, eq. 24), operation for
+/// operation. Returns the new positions (a lane whose `push` is false keeps its own) and each
+/// lane's correction, squared.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+pub(crate) fn push_lanes<const L: usize>(
+    friction: Friction,
+    x: &[[f64; L]; 3],
+    prev: &[[f64; L]; 3],
+    normal: [&[f64; L]; 3],
+    depth: &[f64; L],
+    push: &[bool; L],
+) -> ([[f64; L]; 3], [f64; L]) {
+    let mut moved = [[0.0; L]; 3];
+    let mut rel = [[0.0; L]; 3];
+    for a in 0..3 {
+        for l in 0..L {
+            moved[a][l] = x[a][l] + normal[a][l] * depth[l];
+            rel[a][l] = moved[a][l] - prev[a][l];
+        }
+    }
+    let mut along = [0.0; L];
+    for l in 0..L {
+        along[l] = normal[0][l] * rel[0][l] + normal[1][l] * rel[1][l] + normal[2][l] * rel[2][l];
+    }
+    let mut t = [[0.0; L]; 3];
+    for a in 0..3 {
+        for l in 0..L {
+            t[a][l] = rel[a][l] - normal[a][l] * along[l];
+        }
+    }
+    let mut scale = [0.0; L];
+    let mut no_slip = [false; L];
+    for l in 0..L {
+        let slip2 = t[0][l] * t[0][l] + t[1][l] * t[1][l] + t[2][l] * t[2][l];
+        let grip = friction.static_coefficient * depth[l];
+        let sliding = (friction.dynamic_coefficient * depth[l] / slip2.sqrt()).min(1.0);
+        // Sticking: t itself (t · 1 = t exactly).
+        scale[l] = if slip2 < grip * grip { 1.0 } else { sliding };
+        no_slip[l] = slip2 <= 0.0;
+    }
+    let mut out = *x;
+    let mut slip2 = [0.0; L];
+    for a in 0..3 {
+        for l in 0..L {
+            // No slip: the correction is +0 (t · 0 may be −0, which would turn a −0
+            // position into +0).
+            let correction = if no_slip[l] { 0.0 } else { t[a][l] * scale[l] };
+            slip2[l] += correction * correction;
+            out[a][l] = if push[l] {
+                moved[a][l] - correction
+            } else {
+                x[a][l]
+            };
+        }
+    }
+    (out, slip2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,7 +17,7 @@ use weft_solver::{Contacts, ParticleRun, SimdPath};
 use super::candidates::{MeshFrame, Outcome};
 use super::contact_grid::ContactGrid;
 use super::grid_contacts::GridParticles;
-use crate::friction::Friction;
+use crate::friction::{Friction, push_lanes};
 
 /// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
 const LANES: usize = 8;
@@ -246,47 +246,9 @@ pub(crate) fn settle<const L: usize>(
         return Contacts::default();
     }
     // Pushed out along the normal, then friction on the slip since the substep's start.
-    let mut moved = [[0.0; L]; 3];
-    let mut rel = [[0.0; L]; 3];
-    for k in 0..3 {
-        for l in 0..L {
-            moved[k][l] = b.x[k][l] + b.f[N + k][l] * depth[l];
-            rel[k][l] = moved[k][l] - b.prev[k][l];
-        }
-    }
-    let mut along = [0.0; L];
-    for l in 0..L {
-        along[l] = b.f[N][l] * rel[0][l] + b.f[N + 1][l] * rel[1][l] + b.f[N + 2][l] * rel[2][l];
-    }
-    let mut t = [[0.0; L]; 3];
-    for k in 0..3 {
-        for l in 0..L {
-            t[k][l] = rel[k][l] - b.f[N + k][l] * along[l];
-        }
-    }
-    let mut scale = [0.0; L];
-    let mut no_slip = [false; L];
-    for l in 0..L {
-        let slip2 = t[0][l] * t[0][l] + t[1][l] * t[1][l] + t[2][l] * t[2][l];
-        let grip = friction.static_coefficient * depth[l];
-        let sliding = (friction.dynamic_coefficient * depth[l] / slip2.sqrt()).min(1.0);
-        // Sticking: t itself (t · 1 = t exactly).
-        scale[l] = if slip2 < grip * grip { 1.0 } else { sliding };
-        no_slip[l] = slip2 <= 0.0;
-    }
-    let mut slip2 = [0.0; L];
-    for k in 0..3 {
-        for l in 0..L {
-            // No slip: the correction is +0 (t · 0 may be −0).
-            let correction = if no_slip[l] { 0.0 } else { t[k][l] * scale[l] };
-            slip2[l] += correction * correction;
-            b.x[k][l] = if push[l] {
-                moved[k][l] - correction
-            } else {
-                b.x[k][l]
-            };
-        }
-    }
+    let normal = [&b.f[N], &b.f[N + 1], &b.f[N + 2]];
+    let (moved, slip2) = push_lanes(friction, &b.x, &b.prev, normal, &depth, &push);
+    b.x = moved;
     let mut tally = Contacts::default();
     for l in 0..L {
         if push[l] {
