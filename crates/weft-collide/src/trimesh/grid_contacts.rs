@@ -10,7 +10,7 @@ use super::MeshPoint;
 use super::candidates::{MeshFrame, Outcome, ROUNDS};
 use super::closest::{Feature, closest_on_triangle};
 use super::contact_grid::{ContactGrid, Side};
-use super::grid_run::{Block, Settled, settle};
+use super::grid_run::{Block, Placement, Settled, settle};
 use super::normals::NONE;
 
 /// Triangles a particle's contact walks across from the one it touched last, at most.
@@ -143,13 +143,16 @@ impl MeshFrame<'_> {
         // The first test, as a block of one (`grid_run`): the same bits as in a run.
         if self.settles() {
             let t = state.hint(i) as usize;
+            let place = Placement::of(self);
             let mut b = Block::<1>::new();
-            let from = self.path_start(prev, || state.last(i));
-            for k in 0..3 {
-                b.x[k][0] = x[k];
-                b.from[k][0] = from[k];
-                b.prev[k][0] = prev[k];
-            }
+            let (wx, wp) = (x.to_array().map(|v| [v]), prev.to_array().map(|v| [v]));
+            b.x = place.local(&wx);
+            b.prev = place.local(&wp);
+            b.from = if self.fresh {
+                b.prev
+            } else {
+                state.last(i).to_array().map(|v| [v])
+            };
             b.r[0] = r;
             b.live[0] = true;
             let (anchor, ball) = state.ball(i);
@@ -158,14 +161,17 @@ impl MeshFrame<'_> {
             }
             b.ball[0] = ball;
             b.gather_all(grid.certs(), [t]);
+            let before = b.x;
             let mut settled = [Settled::Open];
             let tally = settle(&mut b, self.friction, &mut settled);
-            let moved = DVec3::new(b.x[0][0], b.x[1][0], b.x[2][0]);
+            let moved = place.world(&wx, &before, &b.x, &b.pushed);
+            let local = DVec3::new(b.x[0][0], b.x[1][0], b.x[2][0]);
+            let from = DVec3::new(b.from[0][0], b.from[1][0], b.from[2][0]);
             match settled[0] {
                 Settled::Open => {}
                 Settled::Done => {
-                    *x = moved;
-                    self.settled_in_grid(state, i, moved, b.new_ball[0]);
+                    *x = DVec3::new(moved[0][0], moved[1][0], moved[2][0]);
+                    self.settled_in_grid(state, i, local, b.new_ball[0]);
                     return Outcome {
                         contacts: tally.contacts,
                         depth: tally.depth,
@@ -173,8 +179,8 @@ impl MeshFrame<'_> {
                     };
                 }
                 Settled::Rounds => {
-                    *x = moved;
-                    let o = self.rounds_after_settle((grid, state), i, prev, x, from, r);
+                    *x = DVec3::new(moved[0][0], moved[1][0], moved[2][0]);
+                    let o = self.rounds_after_settle((grid, state), i, prev, (x, local), from, r);
                     return Outcome {
                         contacts: tally.contacts + o.contacts,
                         depth: tally.depth.max(o.depth),
@@ -186,21 +192,11 @@ impl MeshFrame<'_> {
         self.walk_in_grid((grid, state), i, prev, x, r)
     }
 
-    /// Whether the first test of `grid_run` applies: the mesh's frame is the world's and its
-    /// surface still over the substep.
+    /// Whether the first test of `grid_run` applies: the mesh (its pose and its surface) is
+    /// still over the substep.
     #[inline]
     pub(crate) fn settles(&self) -> bool {
-        self.identity && self.still && !self.geometry.moving
-    }
-
-    /// Where a particle's path starts (see [`MeshFrame::local_path`]).
-    #[inline]
-    pub(crate) fn path_start(&self, prev: DVec3, last: impl FnOnce() -> DVec3) -> DVec3 {
-        if self.fresh {
-            self.to_local(self.prev_pose, prev)
-        } else {
-            last()
-        }
+        self.still && !self.geometry.moving
     }
 
     /// Records a particle settled by the first test at `x`: outside, left there, with a new
@@ -215,18 +211,18 @@ impl MeshFrame<'_> {
     }
 
     /// The cell's contact rounds for a particle that the first test pushed out of its face
-    /// (now at `x`, on the path from `from`) and that slipped too far to be settled.
+    /// (now at world `x`, `xl` in the mesh's frame, on the path from `from`) and that slipped
+    /// too far to be settled.
     pub(crate) fn rounds_after_settle(
         &self,
         (grid, state): (&ContactGrid, &GridParticles),
         i: usize,
         prev: DVec3,
-        x: &mut DVec3,
+        (x, xl): (&mut DVec3, DVec3),
         from: DVec3,
         r: f64,
     ) -> Outcome {
         state.set_side(i, Some(false));
-        let xl = *x;
         self.rounds_in_grid((grid, state), i, prev, x, xl, from, r, Outcome::default())
     }
 

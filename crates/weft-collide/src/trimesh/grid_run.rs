@@ -78,6 +78,70 @@ impl FaceCert {
     }
 }
 
+/// A still mesh's pose as a block reads it: the world's frame, or a basis B (columns) and a
+/// translation t, local = Bᵀ (x − t).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Placement {
+    identity: bool,
+    basis: [[f64; 3]; 3],
+    shift: [f64; 3],
+}
+
+impl Placement {
+    /// `frame`'s pose (its end pose; the mesh is still over the substep).
+    pub fn of(frame: &MeshFrame<'_>) -> Self {
+        let b = frame.pose.basis;
+        Self {
+            identity: frame.identity,
+            basis: [b.x_axis, b.y_axis, b.z_axis].map(|c| c.to_array()),
+            shift: frame.pose.translation.to_array(),
+        }
+    }
+
+    /// The lanes' world positions `w` in the mesh's frame.
+    #[inline(always)]
+    pub fn local<const L: usize>(&self, w: &[[f64; L]; 3]) -> [[f64; L]; 3] {
+        if self.identity {
+            return *w;
+        }
+        let mut out = [[0.0; L]; 3];
+        for l in 0..L {
+            let d = [0, 1, 2].map(|a| w[a][l] - self.shift[a]);
+            for k in 0..3 {
+                let c = &self.basis[k];
+                out[k][l] = c[0] * d[0] + c[1] * d[1] + c[2] * d[2];
+            }
+        }
+        out
+    }
+
+    /// World positions `w` of lanes the block moved from `old` to `new` in the mesh's frame
+    /// (lanes `moved` false keep theirs): w + B (new − old), or `new` in the world's frame.
+    #[inline(always)]
+    pub fn world<const L: usize>(
+        &self,
+        w: &[[f64; L]; 3],
+        old: &[[f64; L]; 3],
+        new: &[[f64; L]; 3],
+        moved: &[bool; L],
+    ) -> [[f64; L]; 3] {
+        let mut out = *w;
+        for l in 0..L {
+            let d = [0, 1, 2].map(|k| new[k][l] - old[k][l]);
+            for a in 0..3 {
+                let shifted = if self.identity {
+                    new[a][l]
+                } else {
+                    let b = &self.basis;
+                    w[a][l] + (b[0][a] * d[0] + b[1][a] * d[1] + b[2][a] * d[2])
+                };
+                out[a][l] = if moved[l] { shifted } else { w[a][l] };
+            }
+        }
+        out
+    }
+}
+
 /// What the first test did with a lane.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) enum Settled {
@@ -106,6 +170,8 @@ pub(crate) struct Block<const L: usize> {
     pub anchor: [[f64; L]; 3],
     /// Its radius; NaN where there is none.
     pub ball: [f64; L],
+    /// Whether the block moved the lane.
+    pub pushed: [bool; L],
     /// A new clear ball about the lane's position, where the triangle's test cleared it
     /// outside its ball: the radius, or NaN.
     pub new_ball: [f64; L],
@@ -125,6 +191,7 @@ impl<const L: usize> Block<L> {
             live: [false; L],
             anchor: [[0.0; L]; 3],
             ball: [f64::NAN; L],
+            pushed: [false; L],
             new_ball: [f64::NAN; L],
             f: std::array::from_fn(|k| [FaceCert::NONE.0[k]; L]),
         }
@@ -242,6 +309,7 @@ pub(crate) fn settle<const L: usize>(
             f64::NAN
         };
     }
+    b.pushed = push;
     if !push.contains(&true) {
         return Contacts::default();
     }
@@ -349,11 +417,16 @@ fn run_body(
     let full = n - n % LANES;
     let mut b = Block::<LANES>::new();
     let mut settled = [Settled::Open; LANES];
+    let place = Placement::of(frame);
+    let (mut wx, mut wp) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
     for s in (0..full).step_by(LANES) {
         for k in 0..3 {
-            b.x[k].copy_from_slice(&x[k][s..s + LANES]);
-            b.prev[k].copy_from_slice(&prev[k][s..s + LANES]);
+            wx[k].copy_from_slice(&x[k][s..s + LANES]);
+            wp[k].copy_from_slice(&prev[k][s..s + LANES]);
         }
+        // In the mesh's frame (the substep's start and end poses are the same).
+        b.x = place.local(&wx);
+        b.prev = place.local(&wp);
         b.r.copy_from_slice(&r[s..s + LANES]);
         if fresh {
             b.from = b.prev;
@@ -386,30 +459,33 @@ fn run_body(
             continue;
         }
         b.gather_all(certs, t);
+        let before = b.x;
         total = total.merge(settle(&mut b, friction, &mut settled));
         // The block's own pushes (the other lanes' positions as they were), then the lanes it
-        // left to the walk and the cell, one by one.
+        // left to the walk and the cell, one by one (in the world's frame).
+        let moved = place.world(&wx, &before, &b.x, &b.pushed);
         for k in 0..3 {
-            x[k][s..s + LANES].copy_from_slice(&b.x[k]);
+            x[k][s..s + LANES].copy_from_slice(&moved[k]);
         }
         for l in 0..LANES {
             let i = start + s + l;
-            let (mut p, before) = (b.at(l), b.prev_at(l));
+            let mut p = DVec3::new(moved[0][l], moved[1][l], moved[2][l]);
+            let start_pos = DVec3::new(wp[0][l], wp[1][l], wp[2][l]);
             let out = match settled[l] {
                 Settled::Done => {
-                    frame.settled_in_grid(state, i, p, b.new_ball[l]);
+                    frame.settled_in_grid(state, i, b.at(l), b.new_ball[l]);
                     continue;
                 }
                 Settled::Rounds => frame.rounds_after_settle(
                     (grid, state),
                     i,
-                    before,
-                    &mut p,
+                    start_pos,
+                    (&mut p, b.at(l)),
                     b.start_at(l),
                     b.r[l],
                 ),
                 Settled::Open if w[s + l] == 0.0 => continue,
-                Settled::Open => frame.walk_in_grid((grid, state), i, before, &mut p, b.r[l]),
+                Settled::Open => frame.walk_in_grid((grid, state), i, start_pos, &mut p, b.r[l]),
             };
             for k in 0..3 {
                 x[k][s + l] = p[k];
@@ -437,12 +513,6 @@ impl<const L: usize> Block<L> {
     #[inline(always)]
     fn at(&self, l: usize) -> DVec3 {
         DVec3::new(self.x[0][l], self.x[1][l], self.x[2][l])
-    }
-
-    /// Lane `l`'s position at the substep's start.
-    #[inline(always)]
-    fn prev_at(&self, l: usize) -> DVec3 {
-        DVec3::new(self.prev[0][l], self.prev[1][l], self.prev[2][l])
     }
 
     /// Lane `l`'s path start.

@@ -37,21 +37,31 @@ fn axes(p: &[DVec3]) -> Axes {
     [0, 1, 2].map(|k| p.iter().map(|v| v[k]).collect())
 }
 
-/// Steps particles about `m` for several substeps (two passes each: the substep's first and
+/// Steps particles about `m` (at the origin, or `placed` elsewhere and turned) for several
+/// substeps (two passes each: the substep's first and
 /// one more), moving them towards the mesh's centre and sideways in between, once through
 /// `resolve_grid_run` on kernel path `path` (in runs of uneven length) and once particle by
 /// particle through `resolve_in_grid`; the positions, the totals and every particle's state
 /// must agree to the bit.
-fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath) {
+fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath, placed: bool) {
     let g = MeshGeometry::new(&m.vertices, &m.triangles);
-    let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+    // At the origin, or moved and turned (still over the substep either way).
+    let pose = if placed {
+        let turn = DQuat::from_rotation_z(0.4) * DQuat::from_rotation_x(-0.9);
+        WorldPose::new(DVec3::new(0.3, -1.2, 0.7), turn)
+    } else {
+        WorldPose::new(DVec3::ZERO, DQuat::IDENTITY)
+    };
     let r = 0.02;
     let grid = ContactGrid::new(&g, r).expect("small grid");
     let friction = Friction::new(0.8, 0.6);
     let mut rng = Rng(seed);
     let n = 1003;
     let (one, many) = (GridParticles::new(n), GridParticles::new(n));
-    let start = particles(&g, &mut rng, n, r);
+    let start: Vec<DVec3> = particles(&g, &mut rng, n, r)
+        .into_iter()
+        .map(|p| pose.transform_point(p))
+        .collect();
     let w: Vec<f64> = (0..n)
         .map(|i| if i % 11 == 0 { 0.0 } else { 1.0 })
         .collect();
@@ -63,7 +73,7 @@ fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath) {
         let prev_axes = axes(&prev);
         for (j, p) in a.iter_mut().enumerate() {
             if w[j] != 0.0 {
-                *p += -*p * 0.02 + rng.cube(0.004);
+                *p += (pose.translation - *p) * 0.02 + rng.cube(0.004);
                 for k in 0..3 {
                     b[k][j] = p[k];
                 }
@@ -72,6 +82,7 @@ fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath) {
         for fresh in [true, false] {
             let mut frame = MeshFrame::still(&g, &pose, friction);
             frame.fresh = fresh;
+            frame.identity = !placed;
             assert!(frame.settles());
             let mut expected = Contacts::default();
             for j in 0..n {
@@ -128,8 +139,10 @@ fn a_run_moves_each_particle_as_the_one_particle_path_does_bit_for_bit() {
         SimdPath::Neon,
         SimdPath::Scalar,
     ] {
-        run_matches_particles(&bumpy_sphere(), 31, path);
-        run_matches_particles(&TriangleMesh::icosphere(0.5, 4), 32, path);
-        run_matches_particles(&bumpy_sheet(), 33, path);
+        for placed in [false, true] {
+            run_matches_particles(&bumpy_sphere(), 31, path, placed);
+            run_matches_particles(&TriangleMesh::icosphere(0.5, 4), 32, path, placed);
+            run_matches_particles(&bumpy_sheet(), 33, path, placed);
+        }
     }
 }
