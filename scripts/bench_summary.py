@@ -199,15 +199,20 @@ def self_vs_solve(r):
 
 def mesh_contact(r):
     print("## Triangle-mesh contact (`crates/weft-collide/benches/mesh_contact.rs`, XPBD, "
-          "each cloth stepped 30 frames into contact first)\n")
-    print("| `static_mesh/16384`: 128² cloth on a 20,480-triangle sphere mesh + ground | ms/frame |")
-    print("|---|---|")
+          "each cloth stepped 30 frames into contact first, or 120 to rest for the draped group)\n")
+    print("| 128² cloth on a 20,480-triangle sphere mesh + ground | `static_mesh/16384`: landing, "
+          "ms/frame | `static_mesh_draped/16384`: draped, ms/frame |")
+    print("|---|---|---|")
     for f, label in [("constraint_solve", "constraint solve (same state, no collisions)"),
                      ("mesh", "mesh, Weft's f64 path"),
+                     ("mesh_alone", "mesh alone (no ground)"),
                      ("mesh_parry", "mesh, parry's f32 projection"),
                      ("sphere_solve", "constraint solve of the analytic-sphere scene"),
-                     ("sphere", "analytic sphere + ground")]:
-        print(f"| {label} | {fmt(ms(r, f'static_mesh/16384/{f}'))} |")
+                     ("sphere", "analytic sphere + ground"),
+                     ("sphere_alone", "analytic sphere alone")]:
+        landing = fmt(ms(r, f'static_mesh/16384/{f}'))
+        draped = fmt(ms(r, f'static_mesh_draped/16384/{f}'))
+        print(f"| {label} | {landing} | {draped} |")
     print()
     print("| `deforming_mesh/8100`: 90² cloth on a breathing 5,120-triangle ball | ms/frame |")
     print("|---|---|")
