@@ -478,11 +478,18 @@ fn sweep_one(
     x: &mut DVec3,
     r: f64,
 ) -> usize {
-    let slow = 0.5 * r.max(1e-6);
-    if (*x - from).length_squared() <= slow * slow {
+    if short_path(*x, from, r) {
         return 0;
     }
     sweep_path(colliders, bounds, own, parry, from, x, r)
+}
+
+/// Whether the path `from → x` of a particle of thickness `r` is shorter than half the
+/// thickness, so no sweep is due (false for a path that is not a number).
+#[inline(always)]
+fn short_path(x: DVec3, from: DVec3, r: f64) -> bool {
+    let slow = 0.5 * r.max(1e-6);
+    (x - from).length_squared() <= slow * slow
 }
 
 /// [`sweep_one`] for a path of half the thickness or longer.
@@ -693,8 +700,8 @@ impl ParticleContacts for CollisionWorld {
     /// [`Self::resolve`] on every free particle of the run, collider by collider (each
     /// particle meets the colliders in the same order, and what one particle meets depends on
     /// that particle alone, so the bits are the same): the substep's sweep first, then each
-    /// still half-space or ball a block of particles at a time ([`resolve_still`]), each still
-    /// mesh on its grid in the world's frame a block at a time too ([`resolve_grid_run`]), any
+    /// still half-space or ball a block of particles at a time ([`resolve_still`]), each mesh
+    /// still over the substep on its grid a block at a time too ([`resolve_grid_run`]), any
     /// other collider particle by particle.
     fn resolve_run(&self, mut run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
@@ -752,7 +759,7 @@ impl ParticleContacts for CollisionWorld {
 enum Blocked<'f, 'a> {
     /// A still half-space or ball.
     Surface(Surface),
-    /// A still mesh on its grid, in the world's frame.
+    /// A mesh still over the substep, on its grid.
     Mesh(&'f MeshFrame<'a>, GridRef<'a>),
 }
 
@@ -766,7 +773,7 @@ impl CollisionWorld {
 
     /// The substep's sweep (as [`sweep_one`]) of every free particle of `run`, thickness `r`,
     /// alone: a particle whose path is shorter than half its thickness (most) costs a few
-    /// loads and a comparison, read straight from the run's arrays.
+    /// loads and a comparison, read straight from the run's arrays (no closure per particle).
     fn sweep_run(
         &self,
         frames: &[Option<(MeshFrame<'_>, GridRef<'_>)>],
@@ -781,14 +788,11 @@ impl CollisionWorld {
         let (p0, p1, p2) = (&prev[0][..n], &prev[1][..n], &prev[2][..n]);
         let mut swept = 0;
         for j in 0..n {
-            let slow = 0.5 * r[j].max(1e-6);
-            let d = [x0[j] - p0[j], x1[j] - p1[j], x2[j] - p2[j]];
-            // As `sweep_one`'s test (glam's dot order), NaN included.
-            if w[j] == 0.0 || (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2] <= slow * slow {
-                continue;
-            }
             let mut x = DVec3::new(x0[j], x1[j], x2[j]);
             let from = DVec3::new(p0[j], p1[j], p2[j]);
+            if w[j] == 0.0 || short_path(x, from, r[j]) {
+                continue;
+            }
             let (colliders, bounds, parry) = (&self.colliders, &self.bounds, self.parry_meshes);
             swept += sweep_path(colliders, bounds, mesh, parry, from, &mut x, r[j]);
             (x0[j], x1[j], x2[j]) = (x.x, x.y, x.z);
@@ -822,9 +826,7 @@ impl CollisionWorld {
         {
             if let Some((frame, grid)) = frame {
                 let o = frame.resolve_in_grid(*grid, i, prev, x, r);
-                out.contacts += o.contacts;
-                out.depth = out.depth.max(o.depth);
-                out.swept += o.swept;
+                out = out.merge(o.into());
             } else if reach.may_touch(*x, r) {
                 let (n, depth) = resolve_one(c, parry, prev, x, r);
                 out.contacts += n;

@@ -25,6 +25,7 @@ use super::ccd::{Crossing, moving_crossing, segment_crossing};
 use super::closest::closest_on_triangle;
 use crate::analytic::WorldPose;
 use crate::friction::Friction;
+use weft_solver::Contacts;
 
 /// Skin of a list, as a fraction of the particle's thickness r: lists are built with radius
 /// r (1 + SKIN) beyond the particle's own substep path.
@@ -153,6 +154,16 @@ pub(crate) struct Outcome {
     pub depth: f64,
     /// Crossings stopped.
     pub swept: usize,
+}
+
+impl From<Outcome> for Contacts {
+    fn from(o: Outcome) -> Self {
+        Self {
+            contacts: o.contacts,
+            swept: o.swept,
+            depth: o.depth,
+        }
+    }
 }
 
 impl MeshFrame<'_> {

@@ -142,24 +142,10 @@ impl MeshFrame<'_> {
     ) -> Outcome {
         // The first test, as a block of one (`grid_run`): the same bits as in a run.
         if self.settles() {
-            let t = state.hint(i) as usize;
             let place = Placement::of(self);
             let mut b = Block::<1>::new();
             let (wx, wp) = (x.to_array().map(|v| [v]), prev.to_array().map(|v| [v]));
-            b.x = place.local(&wx);
-            b.prev = place.local(&wp);
-            b.from = if self.fresh {
-                b.prev
-            } else {
-                state.last(i).to_array().map(|v| [v])
-            };
-            b.r[0] = r;
-            b.live[0] = true;
-            let (anchor, ball) = state.ball(i);
-            for k in 0..3 {
-                b.anchor[k][0] = anchor[k];
-            }
-            b.ball[0] = ball;
+            let [t] = b.load(self, state, &place, (&wx, &wp), (&[r], [true]), i);
             b.gather_all(grid.certs(), [t]);
             let before = b.x;
             let mut settled = [Settled::Open];
@@ -199,8 +185,8 @@ impl MeshFrame<'_> {
         self.still && !self.geometry.moving
     }
 
-    /// Records a particle settled by the first test at `x`: outside, left there, with a new
-    /// clear ball about `x` of radius `ball` unless NaN.
+    /// Records a particle found clear or settled at `x` (the mesh's frame): outside, left
+    /// there, with a new clear ball about `x` of radius `ball` unless NaN.
     #[inline]
     pub(crate) fn settled_in_grid(&self, state: &GridParticles, i: usize, x: DVec3, ball: f64) {
         state.set_side(i, Some(false));
@@ -273,8 +259,7 @@ impl MeshFrame<'_> {
                 let room = grid.clearance(t) - r;
                 room >= 0.0 && to_a <= room * room
             } {
-                state.set_side(i, Some(false));
-                state.set_last(i, xl);
+                self.settled_in_grid(state, i, xl, f64::NAN);
                 if t != hint {
                     // Where the next substep's first test starts.
                     state.set_hint(i, t as u32);
@@ -365,12 +350,9 @@ impl MeshFrame<'_> {
         xl: DVec3,
         r: f64,
     ) {
-        state.set_side(i, Some(false));
-        state.set_last(i, xl);
         let clear = grid.clear_distance(cell, xl) - r;
-        if clear > 0.0 {
-            state.set_ball(i, xl, clear);
-        }
+        let ball = if clear > 0.0 { clear } else { f64::NAN };
+        self.settled_in_grid(state, i, xl, ball);
     }
 
     /// The contact rounds of [`Self::resolve_in_grid`] through the particle's cell, from

@@ -14,7 +14,7 @@ use glam::DVec3;
 use multiversion::multiversion;
 use weft_solver::{Contacts, ParticleRun, SimdPath};
 
-use super::candidates::{MeshFrame, Outcome};
+use super::candidates::MeshFrame;
 use super::contact_grid::ContactGrid;
 use super::grid_contacts::GridParticles;
 use crate::friction::{Friction, push_lanes};
@@ -156,11 +156,11 @@ pub(crate) enum Settled {
 
 /// A block of `L` particles and the triangles they touched last, struct-of-arrays.
 pub(crate) struct Block<const L: usize> {
-    /// Positions (the mesh's frame is the world's), moved in place.
+    /// Positions in the mesh's frame, moved in place.
     pub x: [[f64; L]; 3],
     /// Where each path starts: the substep's start, or the last projection.
     pub from: [[f64; L]; 3],
-    /// Positions at the substep's start.
+    /// Positions at the substep's start, in the mesh's frame.
     pub prev: [[f64; L]; 3],
     /// Thickness (m).
     pub r: [f64; L],
@@ -238,8 +238,8 @@ impl<const L: usize> Block<L> {
     }
 }
 
-/// The first test of every live lane against its triangle, with the mesh still and its frame
-/// the world's; moves the lanes it pushes, and returns what it did per lane with the
+/// The first test of every live lane against its triangle, with the mesh still over the
+/// substep (positions in its frame); moves the lanes it pushes, and returns what it did per lane with the
 /// contacts made. A lane is settled where its path lies in its clear ball (no point of the
 /// ball is within r of the mesh, so neither a contact nor a crossing), or where its path is
 /// shorter than r/2 (so no sweep is due) and either
@@ -333,8 +333,8 @@ pub(crate) fn settle<const L: usize>(
     tally
 }
 
-/// Every free particle of `run` against the still mesh of `frame` on `grid` (its frame the
-/// world's): [`settle`] a block at a time, then each particle it left open through
+/// Every free particle of `run` against the mesh of `frame`, still over the substep, on
+/// `grid`: [`settle`] a block at a time, each lane taken into the mesh's frame and back, then each particle it left open through
 /// `MeshFrame::resolve_in_grid`'s walk, in order. Compiled for the run's kernel path (every
 /// path gives the same bits).
 pub(crate) fn resolve_grid_run(
@@ -411,8 +411,6 @@ fn run_body(
     let x = [&mut x0[..n], &mut x1[..n], &mut x2[..n]];
     let certs = grid.certs();
     let friction = frame.friction;
-    // The path starts at the substep's start (the frame's world frame is the mesh's).
-    let fresh = frame.fresh;
     let mut total = Contacts::default();
     let full = n - n % LANES;
     let mut b = Block::<LANES>::new();
@@ -424,30 +422,12 @@ fn run_body(
             wx[k].copy_from_slice(&x[k][s..s + LANES]);
             wp[k].copy_from_slice(&prev[k][s..s + LANES]);
         }
-        // In the mesh's frame (the substep's start and end poses are the same).
-        b.x = place.local(&wx);
-        b.prev = place.local(&wp);
-        b.r.copy_from_slice(&r[s..s + LANES]);
-        if fresh {
-            b.from = b.prev;
-        }
-        let mut t = [0usize; LANES];
+        let (mut live, mut rb) = ([false; LANES], [0.0; LANES]);
         for l in 0..LANES {
-            let i = start + s + l;
-            if !fresh {
-                let from = state.last(i);
-                for k in 0..3 {
-                    b.from[k][l] = from[k];
-                }
-            }
-            let (anchor, ball) = state.ball(i);
-            for k in 0..3 {
-                b.anchor[k][l] = anchor[k];
-            }
-            b.ball[l] = ball;
-            b.live[l] = w[s + l] != 0.0;
-            t[l] = state.hint(i) as usize;
+            live[l] = w[s + l] != 0.0;
         }
+        rb.copy_from_slice(&r[s..s + LANES]);
+        let t = b.load(frame, state, &place, (&wx, &wp), (&rb, live), start + s);
         let in_ball = b.in_ball();
         if (0..LANES).all(|l| in_ball[l] | !b.live[l]) {
             // Nothing within r of any path: no triangle to read.
@@ -509,6 +489,47 @@ fn run_body(
 }
 
 impl<const L: usize> Block<L> {
+    /// Loads the lanes of particles `i0 .. i0 + L` (global indices) at world positions `wx`,
+    /// `wp` at the substep's start, thickness `r`, taking part where `live`: positions and path
+    /// starts in the mesh's frame (the substep's start and end poses are the same), clear
+    /// balls. Returns the triangles they touched last. The block path and the one-particle
+    /// path load alike through this.
+    #[inline(always)]
+    pub fn load(
+        &mut self,
+        frame: &MeshFrame<'_>,
+        state: &GridParticles,
+        place: &Placement,
+        (wx, wp): (&[[f64; L]; 3], &[[f64; L]; 3]),
+        (r, live): (&[f64; L], [bool; L]),
+        i0: usize,
+    ) -> [usize; L] {
+        self.x = place.local(wx);
+        self.prev = place.local(wp);
+        self.r = *r;
+        self.live = live;
+        if frame.fresh {
+            self.from = self.prev;
+        }
+        let mut t = [0usize; L];
+        for l in 0..L {
+            let i = i0 + l;
+            if !frame.fresh {
+                let from = state.last(i);
+                for k in 0..3 {
+                    self.from[k][l] = from[k];
+                }
+            }
+            let (anchor, ball) = state.ball(i);
+            for k in 0..3 {
+                self.anchor[k][l] = anchor[k];
+            }
+            self.ball[l] = ball;
+            t[l] = state.hint(i) as usize;
+        }
+        t
+    }
+
     /// Lane `l`'s position.
     #[inline(always)]
     fn at(&self, l: usize) -> DVec3 {
@@ -519,16 +540,6 @@ impl<const L: usize> Block<L> {
     #[inline(always)]
     fn start_at(&self, l: usize) -> DVec3 {
         DVec3::new(self.from[0][l], self.from[1][l], self.from[2][l])
-    }
-}
-
-impl From<Outcome> for Contacts {
-    fn from(o: Outcome) -> Self {
-        Self {
-            contacts: o.contacts,
-            swept: o.swept,
-            depth: o.depth,
-        }
     }
 }
 
