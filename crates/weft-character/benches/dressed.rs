@@ -134,6 +134,7 @@ fn bench(c: &mut Criterion) {
                         time: t + settings.h() * f64::from(k + 1),
                         h: settings.h(),
                         substep: k,
+                        frame_end: t + settings.h() * f64::from(settings.substeps),
                     };
                     world.begin_substep(&ctx, &p);
                     world.project(&ctx, &mut p);

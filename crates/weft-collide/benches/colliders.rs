@@ -109,6 +109,7 @@ fn hook_calls(world: &mut CollisionWorld, solver: &Solver, particles: &mut weft_
             time: solver.time() + h * f64::from(substep + 1),
             h,
             substep,
+            frame_end: solver.time() + h * f64::from(s.substeps),
         };
         world.begin_substep(&ctx, particles);
         for _ in 0..s.iterations {

@@ -45,6 +45,7 @@ fn ctx() -> SubstepContext {
         time: s.h(),
         h: s.h(),
         substep: 0,
+        frame_end: s.h(),
     }
 }
 

@@ -101,8 +101,10 @@ pub struct Collider {
     mesh: Option<Box<MeshGeometry>>,
     /// What moves a deforming mesh's vertices.
     animation: Option<Arc<dyn MeshAnimation>>,
-    /// The animation's output for the substep's end.
+    /// The animation's output for the frame's end.
     next_vertices: Vec<DVec3>,
+    /// The frame a deforming mesh moves across: its start and end times (s).
+    frame: (f64, f64),
 }
 
 impl std::fmt::Debug for Collider {
@@ -165,13 +167,15 @@ impl Collider {
             mesh,
             animation: None,
             next_vertices: Vec::new(),
+            frame: (0.0, 0.0),
         })
     }
 
     /// A deforming triangle-mesh collider: `desc`'s mesh, whose vertices (in the collider's
     /// frame, which still follows `desc`'s placement and motion) `animation` gives at every
-    /// substep's end. Its acceleration structure is refitted, not rebuilt, and contacts are
-    /// swept against the moving triangles.
+    /// frame's end; they move linearly across the frame's substeps. Its acceleration
+    /// structure is refitted once a frame to the boxes the triangles sweep, not rebuilt, and
+    /// contacts are swept against the moving triangles.
     pub fn deforming(
         desc: &ColliderDesc,
         animation: Arc<dyn MeshAnimation>,
@@ -273,20 +277,40 @@ impl Collider {
         self.friction
     }
 
-    /// Moves the collider to its poses at the start (`t0`) and end (`t1`) of a substep (s).
+    /// Moves the collider to its poses at the start (`t0`) and end (`t1`) of a substep (s),
+    /// a frame of its own.
     pub fn set_time(&mut self, t0: f64, t1: f64) {
+        self.set_time_in_frame(t0, t1, t1);
+    }
+
+    /// [`Self::set_time`] for a substep of the frame that ends at `frame_end` (s): a
+    /// deforming mesh's animation is evaluated at the frame's end when a frame starts, and
+    /// its vertices move there linearly over the frame's substeps (as its rigid pose moves
+    /// along its motion at every substep).
+    pub fn set_time_in_frame(&mut self, t0: f64, t1: f64, frame_end: f64) {
         self.prev_pose = compose(self.motion.transform(t0), &self.rest);
         self.pose = compose(self.motion.transform(t1), &self.rest);
         self.prev_pose64 = carry(self.motion, t0, &self.rest64);
         self.pose64 = carry(self.motion, t1, &self.rest64);
         self.still = self.pose64 == self.prev_pose64;
         if let (Some(animation), Some(mesh)) = (&self.animation, self.mesh.as_mut()) {
-            let next = &mut self.next_vertices;
-            animation.vertices_at(t1, &mesh.rest, next);
-            if !next.iter().all(|v| v.is_finite()) {
-                next.copy_from_slice(&mesh.end); // a bad frame: hold the last good one
+            let (start, end) = self.frame;
+            if frame_end != end || !(start..end).contains(&t0) {
+                self.frame = (t0, frame_end);
+                let next = &mut self.next_vertices;
+                animation.vertices_at(frame_end, &mesh.rest, next);
+                if !next.iter().all(|v| v.is_finite()) {
+                    next.copy_from_slice(&mesh.end); // a bad frame: hold the last good one
+                }
+                mesh.begin_frame(next);
             }
-            mesh.advance(next);
+            let (start, end) = self.frame;
+            let w = if t1 >= end {
+                1.0
+            } else {
+                ((t1 - start) / (end - start)).clamp(0.0, 1.0)
+            };
+            mesh.advance_to(w);
             self.local_aabb = self.mesh_aabb();
         }
     }
@@ -584,5 +608,44 @@ mod tests {
         // parry's f32 pose, which the queries of hulls and compounds use, agrees.
         let (t, r) = (c.pose().translation, c.pose().rotation);
         assert!(m.abs_diff_eq(Mat4::from_rotation_translation(r, t), 1e-6));
+    }
+
+    /// A deforming mesh's animation is evaluated once a frame, at its end; across the frame's
+    /// substeps its vertices move linearly from where the last frame left them to there,
+    /// reaching the animation's output to the bit at the frame's end.
+    #[test]
+    fn a_deforming_mesh_moves_linearly_across_each_frame() {
+        use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+        let calls = Arc::new(AtomicUsize::new(0));
+        let counted = calls.clone();
+        // Far from linear in time: each vertex scaled by 1 + t².
+        let grow = move |t: f64, rest: &[DVec3], out: &mut [DVec3]| {
+            counted.fetch_add(1, Relaxed);
+            for (o, v) in out.iter_mut().zip(rest) {
+                *o = *v * (1.0 + t * t);
+            }
+        };
+        let desc = ColliderDesc::new(ShapeDesc::TriMesh(TriangleMesh::icosphere(0.5, 1)));
+        let mut c = Collider::deforming(&desc, Arc::new(grow)).expect("deforming mesh");
+        let rest = c.mesh().expect("a mesh").rest.clone();
+        let (frames, substeps, dt) = (3, 4, 0.1);
+        calls.store(0, Relaxed);
+        for f in 0..frames {
+            let (t0, t1) = (f as f64 * dt, (f + 1) as f64 * dt);
+            for k in 0..substeps {
+                let (a, b) = (k as f64 / substeps as f64, (k + 1) as f64 / substeps as f64);
+                c.set_time_in_frame(t0 + a * dt, t0 + b * dt, t1);
+                let s = (1.0 + t0 * t0) + ((1.0 + t1 * t1) - (1.0 + t0 * t0)) * b;
+                for (v, r) in c.mesh_vertices().expect("vertices").iter().zip(&rest) {
+                    let want = *r * s;
+                    if k + 1 == substeps {
+                        assert_eq!(*v, *r * (1.0 + t1 * t1), "frame {f}'s end");
+                    } else {
+                        assert!((*v - want).length() < 1e-14, "frame {f}, substep {k}");
+                    }
+                }
+            }
+        }
+        assert_eq!(calls.load(Relaxed), frames, "one evaluation a frame");
     }
 }

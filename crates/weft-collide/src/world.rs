@@ -600,7 +600,7 @@ impl SubstepHook for CollisionWorld {
             .zip(&mut self.bounds)
             .zip(&mut self.reach)
         {
-            c.set_time(t0, ctx.time);
+            c.set_time_in_frame(t0, ctx.time, ctx.frame_end);
             *b = c.world_aabb(0.0).map(|a| {
                 let m = DVec3::splat(margin);
                 (a.mins.as_dvec3() - m, a.maxs.as_dvec3() + m)

@@ -17,6 +17,8 @@ pub struct SubstepContext {
     pub h: f64,
     /// Substep number inside the frame, from 0.
     pub substep: u32,
+    /// Simulated time at the end of the frame (s): the last substep's `time`, to the bit.
+    pub frame_end: f64,
 }
 
 /// Acts on the particles inside every substep; the collision crate implements it.

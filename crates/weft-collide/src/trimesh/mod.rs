@@ -37,9 +37,15 @@ pub(crate) struct Face {
 }
 
 impl Face {
-    fn new(corners: [DVec3; 3]) -> (Self, Planes) {
+    /// The face with `corners`, its normal worked out.
+    fn at(corners: [DVec3; 3]) -> Self {
         let normal = face_normal(corners[0], corners[1], corners[2]);
-        (Self { corners, normal }, Planes::new(corners, normal))
+        Self { corners, normal }
+    }
+
+    fn new(corners: [DVec3; 3]) -> (Self, Planes) {
+        let f = Self::at(corners);
+        (f, Planes::new(corners, f.normal))
     }
 }
 
@@ -82,6 +88,16 @@ impl Planes {
         let h = (d(0).abs() - margin).max(0.0);
         let beyond = (d(4).max(d(8)).max(d(12)) - margin).max(0.0);
         h * h + beyond * beyond
+    }
+}
+
+/// `m` (finite, not negative) as f32, rounded up.
+fn widen(m: f64) -> f32 {
+    let m32 = m as f32;
+    if f64::from(m32) < m {
+        f32::from_bits(m32.to_bits() + 1)
+    } else {
+        m32
     }
 }
 
@@ -129,6 +145,12 @@ pub(crate) struct MeshGeometry {
     pub travel_before: f64,
     /// Whether the vertices moved in the current substep.
     pub moving: bool,
+    /// A deforming mesh's frame: its vertices at the frame's start and end, between which
+    /// they move linearly over the frame's substeps (empty until the first frame).
+    frame: (Vec<DVec3>, Vec<DVec3>),
+    /// A bound on how far any vertex has still to move before the frame's end (m): the
+    /// planes are the frame end's, so every bound on them is this much less.
+    slack: f64,
 }
 
 impl MeshGeometry {
@@ -161,6 +183,8 @@ impl MeshGeometry {
             travel: 0.0,
             travel_before: 0.0,
             moving: false,
+            frame: (Vec::new(), Vec::new()),
+            slack: 0.0,
         };
         (geometry.faces, geometry.planes) = geometry.compute_faces();
         geometry.set_margin(extent);
@@ -168,16 +192,17 @@ impl MeshGeometry {
     }
 
     /// The rounding margin for particles near a mesh within `extent` of the origin: a few
-    /// f32 ulps of the largest coordinate (with the lists' reach, 1 m).
+    /// f32 ulps of the largest coordinate (with the lists' reach, 1 m), and the vertices'
+    /// travel still to come in the frame.
     fn set_margin(&mut self, extent: f64) {
         self.extent = extent;
-        self.margin = (1e-6 * (extent + 1.0)) as f32;
+        self.margin = widen(1e-6 * (extent + 1.0) + self.slack);
     }
 
     /// The rounding margin of [`Planes::distance_squared_bound`] for a particle at `x`,
     /// anywhere: as [`Self::margin`] with x's own size added.
     fn margin_at(&self, x: DVec3) -> f32 {
-        (1e-6 * (self.extent + x.abs().max_element() + 1.0)) as f32
+        widen(1e-6 * (self.extent + x.abs().max_element() + 1.0) + self.slack)
     }
 
     fn compute_faces(&self) -> (Vec<Face>, Vec<Planes>) {
@@ -194,42 +219,82 @@ impl MeshGeometry {
         self.topology.closed
     }
 
-    /// Starts a substep with the surface moving from the current vertices to `next`
-    /// (same length, finite; checked by the caller): refits the BVH to the swept boxes.
-    pub fn advance(&mut self, next: &[DVec3]) {
-        std::mem::swap(&mut self.start, &mut self.end);
-        self.end.copy_from_slice(next);
-        let moved = self
-            .start
-            .iter()
-            .zip(&self.end)
-            .map(|(a, b)| (*b - *a).length_squared())
-            .fold(0.0, f64::max)
-            .sqrt();
-        self.moving = moved > 0.0;
-        self.travel_before = self.travel;
-        self.travel += moved;
-        if !self.moving {
-            return;
-        }
-        (self.faces, self.planes) = self.compute_faces();
-        let extent = self
-            .end
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
-        self.set_margin(extent);
-        let (start, end, triangles) = (&self.start, &self.end, &self.triangles);
+    /// Starts a frame over which the surface moves linearly from the current vertices to
+    /// `to` (same length, finite; checked by the caller): the planes become the frame end's
+    /// and the BVH is refitted to the boxes swept over the frame, so that both hold for every
+    /// substep of it (the planes' bounds less the travel still to come, [`Self::slack`]).
+    pub fn begin_frame(&mut self, to: &[DVec3]) {
+        let (from, end) = &mut self.frame;
+        from.clone_from(&self.end);
+        end.clear();
+        end.extend_from_slice(to);
+        let (from, end) = (&self.frame.0, &self.frame.1);
+        let triangles = &self.triangles;
+        self.planes = triangles
+            .par_iter()
+            .with_min_len(1024)
+            .map(|t| {
+                let [a, b, c] = t.map(|i| end[i as usize]);
+                Planes::new([a, b, c], face_normal(a, b, c))
+            })
+            .collect();
         self.bvh.refit(|i| {
             let t = triangles[i];
             let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
             for v in t {
-                for p in [start[v as usize], end[v as usize]] {
+                for p in [from[v as usize], end[v as usize]] {
                     lo = lo.min(p);
                     hi = hi.max(p);
                 }
             }
             (lo, hi)
         });
+        let extent = (from.iter().chain(end)).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+        self.slack = Self::remaining(&self.end, end);
+        self.set_margin(extent);
+    }
+
+    /// How far any of `now` has still to go to `end`, rounded up.
+    fn remaining(now: &[DVec3], end: &[DVec3]) -> f64 {
+        let d2 = (now.iter().zip(end))
+            .map(|(a, b)| (*b - *a).length_squared())
+            .fold(0.0, f64::max);
+        d2.sqrt() * (1.0 + 1e-12)
+    }
+
+    /// Starts a substep that ends at fraction `w` (0 < w ≤ 1) of the frame begun last
+    /// ([`Self::begin_frame`]): the vertices there (the frame's end ones, to the bit, at 1),
+    /// the faces at them, and the travel bounds.
+    pub fn advance_to(&mut self, w: f64) {
+        let (from, end) = (&self.frame.0, &self.frame.1);
+        std::mem::swap(&mut self.start, &mut self.end);
+        let mut moved = 0.0f64;
+        for (((now, before), a), b) in self.end.iter_mut().zip(&self.start).zip(from).zip(end) {
+            *now = if w >= 1.0 { *b } else { *a + (*b - *a) * w };
+            moved = moved.max((*now - *before).length_squared());
+        }
+        let moved = moved.sqrt();
+        self.moving = moved > 0.0;
+        self.travel_before = self.travel;
+        self.travel += moved;
+        self.slack = Self::remaining(&self.end, end);
+        self.set_margin(self.extent);
+        if !self.moving {
+            return;
+        }
+        let now = &self.end;
+        self.faces = self
+            .triangles
+            .par_iter()
+            .with_min_len(1024)
+            .map(|t| Face::at(t.map(|i| now[i as usize])))
+            .collect();
+    }
+
+    /// Moves the surface to `next` at once (a frame of one substep).
+    pub fn advance(&mut self, next: &[DVec3]) {
+        self.begin_frame(next);
+        self.advance_to(1.0);
     }
 
     /// Triangle `t`'s corners at the start of the substep.

@@ -11,10 +11,26 @@ use super::vs_parry::bumpy_sphere;
 use crate::analytic_vs_parry::Rng;
 use crate::mesh::TriangleMesh;
 
-/// A bumpy sphere, and a convex icosphere (from far above a face, its interior is nearest).
-fn meshes() -> [MeshGeometry; 2] {
-    [bumpy_sphere(), TriangleMesh::icosphere(0.5, 3)]
-        .map(|m| MeshGeometry::new(&m.vertices, &m.triangles))
+/// A bumpy sphere, a convex icosphere (from far above a face, its interior is nearest), and
+/// the bumpy sphere a third of the way through a frame in which its vertices move up to 5 cm
+/// in and out (its planes are the frame end's: their bounds must allow for the travel to come).
+fn meshes() -> Vec<MeshGeometry> {
+    let [bumpy, ico] = [bumpy_sphere(), TriangleMesh::icosphere(0.5, 3)];
+    let mut moving = MeshGeometry::new(&bumpy.vertices, &bumpy.triangles);
+    let to: Vec<DVec3> = (moving.end.iter().enumerate())
+        .map(|(k, v)| *v * (1.0 + 0.1 * (0.7 * k as f64).sin()))
+        .collect();
+    moving.begin_frame(&to);
+    moving.advance_to(1.0 / 3.0);
+    assert!(
+        moving.moving && moving.slack > 0.02,
+        "a frame with travel to come"
+    );
+    vec![
+        MeshGeometry::new(&bumpy.vertices, &bumpy.triangles),
+        MeshGeometry::new(&ico.vertices, &ico.triangles),
+        moving,
+    ]
 }
 
 /// Squared distance from `x` to every triangle, in storage order.

@@ -36,10 +36,15 @@ impl Frame {
 }
 
 impl Solver {
+    /// Time at the end of substep `k` of the frame (the frame's end after its last).
+    pub(super) fn substep_time(&self, k: u32) -> f64 {
+        let s = self.settings;
+        self.time + s.dt * f64::from(k + 1) / f64::from(s.substeps)
+    }
+
     /// Time at the end of substep `k`, and the pin and grab targets there, into `self.targets`.
     pub(super) fn substep_targets(&mut self, k: u32) -> f64 {
-        let s = self.settings;
-        let time = self.time + s.dt * f64::from(k + 1) / f64::from(s.substeps);
+        let time = self.substep_time(k);
         self.targets.clear();
         for pin in &self.pins {
             self.targets
@@ -58,7 +63,7 @@ impl Solver {
             }
         }
         if let Some(g) = &self.grab {
-            let f = (k + 1) as f64 / s.substeps as f64;
+            let f = (k + 1) as f64 / self.settings.substeps as f64;
             self.targets.push((g.particle, g.from.lerp(g.target, f)));
         }
         time
@@ -85,6 +90,7 @@ impl Solver {
             times.push(self.substep_targets(k));
             t.clone_from(&self.targets);
         }
+        let frame_end = self.substep_time(s.substeps - 1);
         let forces = &self.forces;
         let work = |k: u32, d: &mut Domain, aos: &AosChunk<'_>| {
             let start = if k == 0 {
@@ -121,6 +127,7 @@ impl Solver {
                             time: times[k as usize],
                             h,
                             substep: k,
+                            frame_end,
                         };
                         hook.begin_substep(&ctx, p);
                     }
@@ -207,6 +214,7 @@ impl Solver {
                 time,
                 h,
                 substep: k,
+                frame_end: self.substep_time(s.substeps - 1),
             };
             // External and (mass-spring) internal accelerations at the start of the substep.
             if !inline_accel {
