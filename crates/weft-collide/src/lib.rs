@@ -17,6 +17,7 @@ mod grid;
 mod mesh;
 mod obj;
 mod reach;
+mod run_lists;
 pub mod scenarios;
 mod self_collision;
 mod shape;

@@ -25,6 +25,7 @@ use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::friction::Friction;
 use crate::reach::{Bounds, Reach, Surface};
+use crate::run_lists::RunLists;
 use crate::self_collision::{Clamp, SelfCollision, SelfCollisionParams, SelfCollisionTimes};
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::contact_grid::ContactGrid;
@@ -69,8 +70,11 @@ pub struct CollisionWorld {
     max_thickness: f64,
     fresh: bool,
     stats: ContactStats,
-    /// Per chunk of [`CHUNK`] particles, the candidate lists of each triangle-mesh collider.
+    /// Per chunk of [`CHUNK`] particles, the candidate lists of each triangle-mesh collider
+    /// (the general loop's).
     mesh_lists: Vec<Vec<ChunkLists>>,
+    /// The same per run of particles of the fused frame (one per solver domain).
+    run_lists: RunLists,
     /// Per collider, the thickness its contact grid was last sought for, and for a still
     /// triangle mesh its grid (built at the first substep for the largest thickness) with the
     /// particles' state on the grid path (`None`: not a still mesh, or too large for a grid).
@@ -103,6 +107,7 @@ impl CollisionWorld {
             fresh: true,
             stats: ContactStats::default(),
             mesh_lists: Vec::new(),
+            run_lists: RunLists::default(),
             mesh_grids: Vec::new(),
             parry_meshes: false,
         };
@@ -118,6 +123,7 @@ impl CollisionWorld {
         }
         self.max_thickness = self.thickness.iter().copied().fold(0.0, f64::max);
         self.mesh_lists.clear();
+        self.run_lists.clear();
         self.mesh_grids.clear();
         if let Some(sc) = &mut self.self_collision {
             sc.invalidate();
@@ -184,6 +190,7 @@ impl CollisionWorld {
         self.bounds.push(None);
         self.reach.push(Reach::Box(None));
         self.mesh_lists.clear();
+        self.run_lists.clear();
         Ok(self.colliders.len() - 1)
     }
 
@@ -193,24 +200,25 @@ impl CollisionWorld {
     pub fn set_parry_meshes(&mut self, on: bool) {
         self.parry_meshes = on;
         self.mesh_lists.clear();
+        self.run_lists.clear();
         self.mesh_grids.clear();
     }
 
     /// Candidate lists built so far for triangle-mesh contacts (all mesh colliders).
     pub fn mesh_list_builds(&self) -> u64 {
-        self.mesh_lists
-            .iter()
+        let chunks: u64 = (self.mesh_lists.iter())
             .flat_map(|chunk| chunk.iter().map(|l| l.builds))
-            .sum()
+            .sum();
+        chunks + self.run_lists.sum(|l| l.builds)
     }
 
     /// Triangles now listed for triangle-mesh contacts, over all particles and mesh
     /// colliders.
     pub fn mesh_list_entries(&self) -> usize {
-        self.mesh_lists
-            .iter()
+        let chunks: usize = (self.mesh_lists.iter())
             .flat_map(|chunk| chunk.iter().map(ChunkLists::entries))
-            .sum()
+            .sum();
+        chunks + self.run_lists.sum(|l| l.entries() as u64) as usize
     }
 
     /// Whether collider `c` goes through the world's own mesh contacts.
@@ -427,6 +435,15 @@ type MeshGrid = (f64, Option<(Arc<ContactGrid>, GridParticles)>);
 /// A still mesh's contact grid and its particles' state, as the grid path takes them.
 type GridRef<'a> = (&'a ContactGrid, &'a GridParticles);
 
+/// A triangle mesh of ours as a pass sees it, with its grid if it has one (else it keeps
+/// candidate lists).
+type MeshOf<'a> = (MeshFrame<'a>, Option<GridRef<'a>>);
+
+/// How many of the meshes in `frames` keep candidate lists (have no grid).
+fn listed(frames: &[Option<MeshOf<'_>>]) -> usize {
+    frames.iter().flatten().filter(|(_, g)| g.is_none()).count()
+}
+
 /// The particles' positions to move, with their previous positions and inverse masses to read.
 pub(crate) fn moving_views(p: &mut Particles) -> (&mut [DVec3], &[DVec3], &[f64]) {
     let Particles {
@@ -621,13 +638,13 @@ impl SubstepHook for CollisionWorld {
     fn particle_contacts(&self) -> Option<&dyn ParticleContacts> {
         // Kinematic bodies run a pass of their own (`BodyCollider::contact`): a world with one
         // keeps the general loop.
-        // Triangle meshes join when they have a contact grid (whose particle state is kept
-        // per particle); the per-particle lists of the others are kept per chunk.
+        // Triangle meshes of ours join: on a contact grid the particle state is kept per
+        // particle, and the others' lists per run (`RunLists`). Those through parry keep the
+        // general loop.
         let per_particle = self.self_collision.is_none()
             && self.bodies.is_empty()
             && !self.colliders.is_empty()
-            && (self.colliders.iter().enumerate())
-                .all(|(k, c)| c.mesh().is_none() || self.grid(k).is_some());
+            && (self.colliders.iter()).all(|c| c.mesh().is_none() || self.own_mesh(c));
         per_particle.then_some(self as &dyn ParticleContacts)
     }
 
@@ -694,7 +711,10 @@ impl ParticleContacts for CollisionWorld {
     #[inline]
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        self.resolve_particle(&frames, 0..frames.len(), fresh, i, x, prev)
+        let owned = self.run_lists.lock(i, 1, listed(&frames));
+        let mut lists = owned.get();
+        let all = 0..frames.len();
+        self.resolve_particle(&frames, all, fresh, (&mut lists, i, 0), i, x, prev)
     }
 
     /// [`Self::resolve`] on every free particle of the run, collider by collider (each
@@ -705,14 +725,20 @@ impl ParticleContacts for CollisionWorld {
     /// other collider particle by particle.
     fn resolve_run(&self, mut run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        let r = &self.thickness[run.start..run.start + run.w.len()];
+        let start = run.start;
+        let r = &self.thickness[start..start + run.w.len()];
+        // The run's lists, for the meshes off a grid (held for the whole pass).
+        let owned =
+            (listed(&frames) > 0).then(|| self.run_lists.lock(start, r.len(), listed(&frames)));
+        let mut guard = owned.as_ref().map(|o| o.get());
+        let lists: &mut [ChunkLists] = guard.as_deref_mut().map_or(&mut [], |l| &mut l[..]);
         let n = self.colliders.len();
         let mut total = Contacts::default();
         // Collider j's block form, if it has one.
         let blocked = |j: usize| match still_surface(&self.colliders[j], &self.reach[j]) {
             Some(s) => Some(Blocked::Surface(s)),
             None => match &frames[j] {
-                Some((frame, grid)) if frame.settles() => Some(Blocked::Mesh(frame, *grid)),
+                Some((frame, Some(grid))) if frame.settles() => Some(Blocked::Mesh(frame, *grid)),
                 _ => None,
             },
         };
@@ -723,8 +749,10 @@ impl ParticleContacts for CollisionWorld {
             let next = (k..n).find_map(|j| blocked(j).map(|b| (j, b)));
             let stop = next.as_ref().map_or(n, |(j, _)| *j);
             if stop > k {
+                let slot = listed(&frames[..k]);
                 let pass = run.each_free(|i, p, before| {
-                    self.resolve_particle(&frames, k..stop, sweep, i, p, before)
+                    let lists = (&mut *lists, start, slot);
+                    self.resolve_particle(&frames, k..stop, sweep, lists, i, p, before)
                 });
                 total = total.merge(pass);
                 sweep = false;
@@ -765,9 +793,12 @@ enum Blocked<'f, 'a> {
 
 impl CollisionWorld {
     /// Per collider, the frame and grid of a still mesh on its grid path.
-    fn grid_frames(&self, fresh: bool) -> Vec<Option<(MeshFrame<'_>, GridRef<'_>)>> {
+    fn grid_frames(&self, fresh: bool) -> Vec<Option<MeshOf<'_>>> {
         (self.colliders.iter().enumerate())
-            .map(|(k, c)| Some((mesh_frame(c, fresh)?, self.grid(k)?)))
+            .map(|(k, c)| {
+                let frame = mesh_frame(c, fresh).filter(|_| self.own_mesh(c))?;
+                Some((frame, self.grid(k)))
+            })
             .collect()
     }
 
@@ -776,7 +807,7 @@ impl CollisionWorld {
     /// loads and a comparison, read straight from the run's arrays (no closure per particle).
     fn sweep_run(
         &self,
-        frames: &[Option<(MeshFrame<'_>, GridRef<'_>)>],
+        frames: &[Option<MeshOf<'_>>],
         run: &mut ParticleRun<'_>,
         r: &[f64],
     ) -> usize {
@@ -801,13 +832,17 @@ impl CollisionWorld {
     }
 
     /// [`ParticleContacts::resolve`] with the frames of [`Self::grid_frames`], against colliders
-    /// `range` alone, after the substep's sweep when `sweep`.
+    /// `range` alone, after the substep's sweep when `sweep`; `lists` are the candidate lists
+    /// of the run from particle `lists.1` for the meshes off a grid, the first of `range`'s
+    /// at `lists.2`.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn resolve_particle(
         &self,
-        frames: &[Option<(MeshFrame<'_>, GridRef<'_>)>],
+        frames: &[Option<MeshOf<'_>>],
         range: Range<usize>,
         sweep: bool,
+        (lists, start, mut slot): (&mut [ChunkLists], usize, usize),
         i: usize,
         x: &mut DVec3,
         prev: DVec3,
@@ -825,7 +860,13 @@ impl CollisionWorld {
             .zip(&frames[range])
         {
             if let Some((frame, grid)) = frame {
-                let o = frame.resolve_in_grid(*grid, i, prev, x, r);
+                let o = match grid {
+                    Some(grid) => frame.resolve_in_grid(*grid, i, prev, x, r),
+                    None => {
+                        slot += 1;
+                        frame.resolve(&mut lists[slot - 1], i - start, prev, x, r)
+                    }
+                };
                 out = out.merge(o.into());
             } else if reach.may_touch(*x, r) {
                 let (n, depth) = resolve_one(c, parry, prev, x, r);

@@ -1,0 +1,78 @@
+//! The candidate lists of triangle meshes that keep per-particle lists (deforming meshes, and
+//! still meshes too large for a contact grid), kept per run of particles when the solver's
+//! fused frame resolves contacts inside its domains: each domain hands the world the same run
+//! (first particle, length) at every pass, and locks the lists of that run alone.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use crate::trimesh::candidates::ChunkLists;
+
+/// One run's lists: one [`ChunkLists`] per mesh with lists, indexed from the run's start.
+type Lists = Arc<Mutex<Vec<ChunkLists>>>;
+
+/// The lists of every run seen, by (first particle, length).
+#[derive(Debug, Default)]
+pub(crate) struct RunLists(Mutex<Vec<((usize, usize), Lists)>>);
+
+/// A poisoned lock (a panic elsewhere while it was held) still holds valid lists: a list is
+/// rebuilt whenever it does not cover its particle, so a half-updated one is only slower.
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl RunLists {
+    /// The lists of the run of `len` particles from `start`, for `meshes` meshes (new ones,
+    /// all to be built, the first time the run is seen), locked; compacted if any was
+    /// rebuilt.
+    pub fn lock(&self, start: usize, len: usize, meshes: usize) -> OwnedLists {
+        let lists = {
+            let mut runs = lock(&self.0);
+            match runs.iter().find(|(key, _)| *key == (start, len)) {
+                Some((_, l)) if lock(l).len() == meshes => l.clone(),
+                _ => {
+                    runs.retain(|(key, _)| *key != (start, len));
+                    let l = Arc::new(Mutex::new(vec![ChunkLists::new(len); meshes]));
+                    runs.push(((start, len), l.clone()));
+                    l
+                }
+            }
+        };
+        OwnedLists(lists)
+    }
+
+    /// Forgets every run's lists.
+    pub fn clear(&mut self) {
+        lock(&self.0).clear();
+    }
+
+    /// `f` summed over every run's lists.
+    pub fn sum(&self, f: impl Fn(&ChunkLists) -> u64) -> u64 {
+        lock(&self.0)
+            .iter()
+            .map(|(_, l)| lock(l).iter().map(&f).sum::<u64>())
+            .sum()
+    }
+}
+
+/// A run's lists, to lock for the run's pass.
+pub(crate) struct OwnedLists(Lists);
+
+impl OwnedLists {
+    /// The lists, locked (one domain's pass at a time holds them), compacted if any was
+    /// rebuilt.
+    pub fn get(&self) -> MutexGuard<'_, Vec<ChunkLists>> {
+        let mut g = lock(&self.0);
+        g.iter_mut().for_each(ChunkLists::compact);
+        g
+    }
+}
+
+impl Clone for RunLists {
+    fn clone(&self) -> Self {
+        let runs = lock(&self.0)
+            .iter()
+            .map(|(key, l)| (*key, Arc::new(Mutex::new(lock(l).clone()))))
+            .collect();
+        Self(Mutex::new(runs))
+    }
+}
