@@ -22,8 +22,7 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 
 impl RunLists {
     /// The lists of the run of `len` particles from `start`, for `meshes` meshes (new ones,
-    /// all to be built, the first time the run is seen), locked; compacted if any was
-    /// rebuilt.
+    /// all to be built, the first time the run is seen).
     pub fn lock(&self, start: usize, len: usize, meshes: usize) -> OwnedLists {
         let lists = {
             let mut runs = lock(&self.0);
@@ -58,11 +57,11 @@ impl RunLists {
 pub(crate) struct OwnedLists(Lists);
 
 impl OwnedLists {
-    /// The lists, locked (one domain's pass at a time holds them), compacted if any was
-    /// rebuilt.
+    /// The lists, locked (one domain's pass at a time holds them), compacted once half
+    /// stale.
     pub fn get(&self) -> MutexGuard<'_, Vec<ChunkLists>> {
         let mut g = lock(&self.0);
-        g.iter_mut().for_each(ChunkLists::compact);
+        g.iter_mut().for_each(ChunkLists::tidy);
         g
     }
 }

@@ -366,7 +366,7 @@ impl CollisionWorld {
             .zip(self.mesh_lists.par_iter_mut())
             .enumerate()
             .map(|(k, (xs, lists))| {
-                lists.iter_mut().for_each(ChunkLists::compact);
+                lists.iter_mut().for_each(ChunkLists::tidy);
                 let (mut contacts, mut deepest, mut swept) = (0, 0.0f64, 0);
                 for (j, x) in xs.iter_mut().enumerate() {
                     let i = k * CHUNK + j;

@@ -93,8 +93,15 @@ impl ChunkLists {
         self.live
     }
 
+    /// [`Self::compact`] once half the arena (or more) is stale.
+    pub fn tidy(&mut self) {
+        if self.tris.len() > 2 * self.live + 64 {
+            self.compact();
+        }
+    }
+
     /// Drops stale entries and puts the lists back in particle order (the contact loop then
-    /// reads the arena front to back), whenever a list was rebuilt.
+    /// reads the arena front to back).
     pub fn compact(&mut self) {
         if self.tris.len() == self.live {
             return;
