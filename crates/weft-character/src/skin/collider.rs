@@ -1,7 +1,7 @@
 //! A skinned mesh as a deforming triangle-mesh collider: weft-collide asks for the vertices at
-//! the end of every substep and gets [`SkinnedMesh::skin`] at that time (linear blend
-//! skinning), placed in the world, then refits its BVH and sweeps contacts against the moving
-//! triangles.
+//! the end of every frame and gets [`SkinnedMesh::skin`] at that time (linear blend
+//! skinning), placed in the world, moves the mesh there linearly over the frame's substeps,
+//! refits its BVH once a frame and sweeps contacts against the moving triangles.
 
 use glam::{DMat4, DVec3};
 use weft_collide::{ColliderDesc, MeshAnimation, ShapeDesc, TriangleMesh};
@@ -85,7 +85,7 @@ impl SkinCollider {
     }
 
     /// The collider's description: the triangles at the pose of t = 0 (the rest shape the
-    /// collision world keeps; the skinning, not these positions, gives every substep's
+    /// collision world keeps; the skinning, not these positions, gives every frame's
     /// vertices), no friction and no placement of its own (set them on the result).
     pub fn desc(&self) -> Result<ColliderDesc, SkinError> {
         let mesh = TriangleMesh::new(self.vertices(0.0), self.mesh.triangles.clone())

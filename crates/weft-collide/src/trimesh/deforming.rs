@@ -1,5 +1,6 @@
 //! What drives a deforming mesh collider: the vertex positions at any time, evaluated by the
-//! collision world at the end of every substep (a skinned body, keyframes, a procedure).
+//! collision world at the end of every frame (a skinned body, keyframes, a procedure); the
+//! vertices move linearly between those over the frame's substeps.
 
 use glam::DVec3;
 
@@ -7,9 +8,10 @@ use crate::error::ShapeError;
 
 /// A source of a deforming mesh's vertices: positions at time `t`, in the collider's frame.
 ///
-/// Called once per substep, from the collision world, with the rest vertices (those of the
-/// collider's `TriangleMesh`) and an output of the same length. Non-finite output keeps the
-/// previous positions for that substep.
+/// Called once per frame, at the frame's end time, from the collision world, with the rest
+/// vertices (those of the collider's `TriangleMesh`) and an output of the same length; the
+/// mesh moves linearly there over the frame's substeps. Non-finite output keeps the previous
+/// positions for that frame.
 pub trait MeshAnimation: Send + Sync {
     /// Writes the vertex positions at time `t` (s) into `out` (one per rest vertex).
     fn vertices_at(&self, t: f64, rest: &[DVec3], out: &mut [DVec3]);
