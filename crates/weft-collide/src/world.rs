@@ -703,18 +703,19 @@ impl SubstepHook for CollisionWorld {
     }
 }
 
-/// One particle's part of [`SubstepHook::project`] with closed-form colliders only: on the
-/// substep's first pass the sweep, then the push-out from each collider in reach, in order —
-/// the same calls as `sweep` and `resolve_colliders` make for that particle. The fused pass
-/// reaches it through the trait's default `resolve_run`, one trait-object call per domain.
+/// One particle's part of [`SubstepHook::project`] with closed-form colliders and our triangle
+/// meshes (no bodies, no self-collision): on the substep's first pass the sweep, then the
+/// push-out from each collider in reach, in order — the same calls as `sweep` and
+/// `resolve_colliders` make for that particle. The fused pass calls `resolve_run`, one
+/// trait-object call per domain.
 impl ParticleContacts for CollisionWorld {
     #[inline]
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        let owned = self.run_lists.lock(i, 1, listed(&frames));
-        let mut lists = owned.get();
-        let all = 0..frames.len();
-        self.resolve_particle(&frames, all, fresh, (&mut lists, i, 0), i, x, prev)
+        self.with_run_lists(&frames, i..i + 1, |lists| {
+            let all = 0..frames.len();
+            self.resolve_particle(&frames, all, fresh, (lists, i, 0), i, x, prev)
+        })
     }
 
     /// [`Self::resolve`] on every free particle of the run, collider by collider (each
@@ -722,16 +723,49 @@ impl ParticleContacts for CollisionWorld {
     /// that particle alone, so the bits are the same): the substep's sweep first, then each
     /// still half-space or ball a block of particles at a time ([`resolve_still`]), each mesh
     /// still over the substep on its grid a block at a time too ([`resolve_grid_run`]), any
-    /// other collider particle by particle.
-    fn resolve_run(&self, mut run: ParticleRun<'_>, fresh: bool) -> Contacts {
+    /// other collider particle by particle (a mesh off a grid through the run's candidate
+    /// lists, locked for the pass).
+    fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
         let start = run.start;
+        let particles = start..start + run.w.len();
+        self.with_run_lists(&frames, particles, |lists| {
+            self.resolve_run_with(&frames, lists, run, fresh)
+        })
+    }
+}
+
+impl CollisionWorld {
+    /// Calls `f` with the candidate lists of the run of particles `particles` for the meshes
+    /// of `frames` off a grid (none if there is none), held for the whole call.
+    fn with_run_lists<R>(
+        &self,
+        frames: &[Option<MeshOf<'_>>],
+        particles: Range<usize>,
+        f: impl FnOnce(&mut [ChunkLists]) -> R,
+    ) -> R {
+        let meshes = listed(frames);
+        if meshes == 0 {
+            return f(&mut []);
+        }
+        let owned = self
+            .run_lists
+            .lock(particles.start, particles.len(), meshes);
+        let mut lists = owned.get();
+        f(&mut lists)
+    }
+
+    /// [`ParticleContacts::resolve_run`] with the frames of [`Self::grid_frames`] and the run's
+    /// candidate lists.
+    fn resolve_run_with(
+        &self,
+        frames: &[Option<MeshOf<'_>>],
+        lists: &mut [ChunkLists],
+        mut run: ParticleRun<'_>,
+        fresh: bool,
+    ) -> Contacts {
+        let start = run.start;
         let r = &self.thickness[start..start + run.w.len()];
-        // The run's lists, for the meshes off a grid (held for the whole pass).
-        let owned =
-            (listed(&frames) > 0).then(|| self.run_lists.lock(start, r.len(), listed(&frames)));
-        let mut guard = owned.as_ref().map(|o| o.get());
-        let lists: &mut [ChunkLists] = guard.as_deref_mut().map_or(&mut [], |l| &mut l[..]);
         let n = self.colliders.len();
         let mut total = Contacts::default();
         // Collider j's block form, if it has one.
@@ -752,12 +786,12 @@ impl ParticleContacts for CollisionWorld {
                 let slot = listed(&frames[..k]);
                 let pass = run.each_free(|i, p, before| {
                     let lists = (&mut *lists, start, slot);
-                    self.resolve_particle(&frames, k..stop, sweep, lists, i, p, before)
+                    self.resolve_particle(frames, k..stop, sweep, lists, i, p, before)
                 });
                 total = total.merge(pass);
                 sweep = false;
             } else if sweep {
-                total.swept += self.sweep_run(&frames, &mut run, r);
+                total.swept += self.sweep_run(frames, &mut run, r);
                 sweep = false;
             }
             match next {
@@ -792,7 +826,7 @@ enum Blocked<'f, 'a> {
 }
 
 impl CollisionWorld {
-    /// Per collider, the frame and grid of a still mesh on its grid path.
+    /// Per collider, the frame of a triangle mesh of ours and its grid if it has one.
     fn grid_frames(&self, fresh: bool) -> Vec<Option<MeshOf<'_>>> {
         (self.colliders.iter().enumerate())
             .map(|(k, c)| {
