@@ -12,8 +12,9 @@
 //!   rest over the ball and on the ground, not still sliding off it as at 30 frames: the bare
 //!   solve, the mesh and ground, and the analytic sphere and ground.
 //! - `deforming_mesh/8100`: a 90² cloth on `breathing_drop`'s deforming ball of 5,120
-//!   triangles (vertices set, faces and BVH refitted and contacts swept every substep),
-//!   against its own constraint solve.
+//!   triangles (the animation evaluated and the BVH refitted once a frame, the vertices moved,
+//!   the faces recomputed and contacts swept every substep), against its own constraint
+//!   solve.
 //!
 //! Every timed frame is warm: it follows the same copy's previous frame, as in a running app
 //! (see `common::warm_frames`).
