@@ -230,14 +230,13 @@ impl MeshGeometry {
         end.extend_from_slice(to);
         let (from, end) = (&self.frame.0, &self.frame.1);
         let triangles = &self.triangles;
-        self.planes = triangles
-            .par_iter()
+        // In place: no allocation (nor its page faults) once a frame.
+        (self.planes.par_iter_mut().zip(triangles))
             .with_min_len(1024)
-            .map(|t| {
+            .for_each(|(p, t)| {
                 let [a, b, c] = t.map(|i| end[i as usize]);
-                Planes::new([a, b, c], face_normal(a, b, c))
-            })
-            .collect();
+                *p = Planes::new([a, b, c], face_normal(a, b, c));
+            });
         self.bvh.refit(|i| {
             let t = triangles[i];
             let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
@@ -283,12 +282,9 @@ impl MeshGeometry {
             return;
         }
         let now = &self.end;
-        self.faces = self
-            .triangles
-            .par_iter()
+        (self.faces.par_iter_mut().zip(&self.triangles))
             .with_min_len(1024)
-            .map(|t| Face::at(t.map(|i| now[i as usize])))
-            .collect();
+            .for_each(|(f, t)| *f = Face::at(t.map(|i| now[i as usize])));
     }
 
     /// Moves the surface to `next` at once (a frame of one substep).
