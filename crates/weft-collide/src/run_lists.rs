@@ -22,14 +22,16 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 
 impl RunLists {
     /// The lists of the run of `len` particles from `start`, for `meshes` meshes (new ones,
-    /// all to be built, the first time the run is seen).
+    /// all to be built, the first time the run is seen). The runs of one solver's domains do
+    /// not overlap: a new run drops those it overlaps, left from domains since rebuilt.
     pub fn lock(&self, start: usize, len: usize, meshes: usize) -> OwnedLists {
         let lists = {
             let mut runs = lock(&self.0);
             match runs.iter().find(|(key, _)| *key == (start, len)) {
                 Some((_, l)) if lock(l).len() == meshes => l.clone(),
                 _ => {
-                    runs.retain(|(key, _)| *key != (start, len));
+                    let end = start + len;
+                    runs.retain(|((s, l), _)| s + l <= start || end <= *s);
                     let l = Arc::new(Mutex::new(vec![ChunkLists::new(len); meshes]));
                     runs.push(((start, len), l.clone()));
                     l
@@ -42,6 +44,12 @@ impl RunLists {
     /// Forgets every run's lists.
     pub fn clear(&mut self) {
         lock(&self.0).clear();
+    }
+
+    /// Runs whose lists are kept.
+    #[cfg(test)]
+    fn runs(&self) -> Vec<(usize, usize)> {
+        lock(&self.0).iter().map(|(key, _)| *key).collect()
     }
 
     /// `f` summed over every run's lists.
@@ -73,5 +81,30 @@ impl Clone for RunLists {
             .map(|(key, l)| (*key, Arc::new(Mutex::new(lock(l).clone()))))
             .collect();
         Self(Mutex::new(runs))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RunLists;
+
+    /// A run is found again with its lists; a run of new domains drops the old ones it
+    /// overlaps and keeps the others.
+    #[test]
+    fn runs_keep_their_lists_until_new_domains_overlap_them() {
+        let runs = RunLists::default();
+        for (start, len) in [(0, 100), (100, 100), (200, 50)] {
+            let owned = runs.lock(start, len, 2);
+            owned.get()[1].builds = start as u64 + 1;
+        }
+        assert_eq!(runs.sum(|l| l.builds), 1 + 101 + 201);
+        assert_eq!(runs.lock(100, 100, 2).get()[1].builds, 101, "found again");
+        // A domain from 50 to 150 replaces the first two.
+        runs.lock(50, 100, 2);
+        assert_eq!(runs.runs(), vec![(200, 50), (50, 100)]);
+        assert_eq!(runs.sum(|l| l.builds), 201);
+        // Another mesh count: new lists for the run.
+        assert_eq!(runs.lock(200, 50, 3).get().len(), 3);
+        assert_eq!(runs.sum(|l| l.builds), 0);
     }
 }
