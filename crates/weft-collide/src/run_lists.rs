@@ -41,6 +41,18 @@ impl RunLists {
         OwnedLists(lists)
     }
 
+    /// The lists of a run holding particle `i` (for `meshes` meshes) and that run's first
+    /// particle: a domain's run if one is kept, else a run of `i` alone.
+    pub fn lock_holding(&self, i: usize, meshes: usize) -> (OwnedLists, usize) {
+        let found = lock(&self.0).iter().find_map(|((s, l), lists)| {
+            ((*s..s + l).contains(&i) && lock(lists).len() == meshes).then(|| (lists.clone(), *s))
+        });
+        match found {
+            Some((lists, start)) => (OwnedLists(lists), start),
+            None => (self.lock(i, 1, meshes), i),
+        }
+    }
+
     /// Forgets every run's lists.
     pub fn clear(&mut self) {
         lock(&self.0).clear();
@@ -103,6 +115,10 @@ mod tests {
         runs.lock(50, 100, 2);
         assert_eq!(runs.runs(), vec![(200, 50), (50, 100)]);
         assert_eq!(runs.sum(|l| l.builds), 201);
+        // One particle's call finds the run holding it; a particle in none gets its own.
+        assert_eq!(runs.lock_holding(120, 2).1, 50);
+        assert_eq!(runs.lock_holding(300, 2).1, 300);
+        assert_eq!(runs.runs(), vec![(200, 50), (50, 100), (300, 1)]);
         // Another mesh count: new lists for the run.
         assert_eq!(runs.lock(200, 50, 3).get().len(), 3);
         assert_eq!(runs.sum(|l| l.builds), 0);

@@ -712,10 +712,16 @@ impl ParticleContacts for CollisionWorld {
     #[inline]
     fn resolve(&self, i: usize, x: &mut DVec3, prev: DVec3, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
-        self.with_run_lists(&frames, i..i + 1, |lists| {
-            let all = 0..frames.len();
-            self.resolve_particle(&frames, all, fresh, (lists, i, 0), i, x, prev)
-        })
+        let all = 0..frames.len();
+        match listed(&frames) {
+            0 => self.resolve_particle(&frames, all, fresh, (&mut [], i, 0), i, x, prev),
+            // The lists of the domain's run holding i, if the fused frame keeps one.
+            meshes => {
+                let (owned, start) = self.run_lists.lock_holding(i, meshes);
+                let mut lists = owned.get();
+                self.resolve_particle(&frames, all, fresh, (&mut lists, start, 0), i, x, prev)
+            }
+        }
     }
 
     /// [`Self::resolve`] on every free particle of the run, collider by collider (each
@@ -736,8 +742,8 @@ impl ParticleContacts for CollisionWorld {
 }
 
 impl CollisionWorld {
-    /// Calls `f` with the candidate lists of the run of particles `particles` for the meshes
-    /// of `frames` off a grid (none if there is none), held for the whole call.
+    /// Calls `f` with the candidate lists of the run of particles `particles` (a domain's) for
+    /// the meshes of `frames` off a grid (none if there is none), held for the whole call.
     fn with_run_lists<R>(
         &self,
         frames: &[Option<MeshOf<'_>>],
