@@ -10,9 +10,12 @@ use crate::trimesh::candidates::ChunkLists;
 /// One run's lists: one [`ChunkLists`] per mesh with lists, indexed from the run's start.
 type Lists = Arc<Mutex<Vec<ChunkLists>>>;
 
-/// The lists of every run seen, by (first particle, length).
+/// A run: its first particle, its length, and the meshes it keeps lists for.
+type Run = (usize, usize, usize);
+
+/// The lists of every run seen.
 #[derive(Debug, Default)]
-pub(crate) struct RunLists(Mutex<Vec<((usize, usize), Lists)>>);
+pub(crate) struct RunLists(Mutex<Vec<(Run, Lists)>>);
 
 /// A poisoned lock (a panic elsewhere while it was held) still holds valid lists: a list is
 /// rebuilt whenever it does not cover its particle, so a half-updated one is only slower.
@@ -25,27 +28,23 @@ impl RunLists {
     /// all to be built, the first time the run is seen). The runs of one solver's domains do
     /// not overlap: a new run drops those it overlaps, left from domains since rebuilt.
     pub fn lock(&self, start: usize, len: usize, meshes: usize) -> OwnedLists {
-        let lists = {
-            let mut runs = lock(&self.0);
-            match runs.iter().find(|(key, _)| *key == (start, len)) {
-                Some((_, l)) if lock(l).len() == meshes => l.clone(),
-                _ => {
-                    let end = start + len;
-                    runs.retain(|((s, l), _)| s + l <= start || end <= *s);
-                    let l = Arc::new(Mutex::new(vec![ChunkLists::new(len); meshes]));
-                    runs.push(((start, len), l.clone()));
-                    l
-                }
-            }
-        };
-        OwnedLists(lists)
+        let key = (start, len, meshes);
+        let mut runs = lock(&self.0);
+        if let Some((_, l)) = runs.iter().find(|(k, _)| *k == key) {
+            return OwnedLists(l.clone());
+        }
+        let end = start + len;
+        runs.retain(|((s, l, _), _)| s + l <= start || end <= *s);
+        let l = Arc::new(Mutex::new(vec![ChunkLists::new(len); meshes]));
+        runs.push((key, l.clone()));
+        OwnedLists(l)
     }
 
     /// The lists of a run holding particle `i` (for `meshes` meshes) and that run's first
     /// particle: a domain's run if one is kept, else a run of `i` alone.
     pub fn lock_holding(&self, i: usize, meshes: usize) -> (OwnedLists, usize) {
-        let found = lock(&self.0).iter().find_map(|((s, l), lists)| {
-            ((*s..s + l).contains(&i) && lock(lists).len() == meshes).then(|| (lists.clone(), *s))
+        let found = lock(&self.0).iter().find_map(|((s, l, m), lists)| {
+            ((*s..s + l).contains(&i) && *m == meshes).then(|| (lists.clone(), *s))
         });
         match found {
             Some((lists, start)) => (OwnedLists(lists), start),
@@ -61,7 +60,10 @@ impl RunLists {
     /// Runs whose lists are kept.
     #[cfg(test)]
     fn runs(&self) -> Vec<(usize, usize)> {
-        lock(&self.0).iter().map(|(key, _)| *key).collect()
+        lock(&self.0)
+            .iter()
+            .map(|((s, l, _), _)| (*s, *l))
+            .collect()
     }
 
     /// `f` summed over every run's lists.
