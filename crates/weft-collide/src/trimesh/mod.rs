@@ -258,6 +258,11 @@ impl MeshGeometry {
         let d2 = (now.iter().zip(end))
             .map(|(a, b)| (*b - *a).length_squared())
             .fold(0.0, f64::max);
+        Self::rounded_up(d2)
+    }
+
+    /// The distance whose square is `d2`, rounded up.
+    fn rounded_up(d2: f64) -> f64 {
         d2.sqrt() * (1.0 + 1e-12)
     }
 
@@ -267,16 +272,18 @@ impl MeshGeometry {
     pub fn advance_to(&mut self, w: f64) {
         let (from, end) = (&self.frame.0, &self.frame.1);
         std::mem::swap(&mut self.start, &mut self.end);
-        let mut moved = 0.0f64;
+        // One pass: the vertices, how far they moved, how far they have still to go.
+        let (mut moved, mut to_go) = (0.0f64, 0.0f64);
         for (((now, before), a), b) in self.end.iter_mut().zip(&self.start).zip(from).zip(end) {
             *now = if w >= 1.0 { *b } else { *a + (*b - *a) * w };
             moved = moved.max((*now - *before).length_squared());
+            to_go = to_go.max((*b - *now).length_squared());
         }
         let moved = moved.sqrt();
         self.moving = moved > 0.0;
         self.travel_before = self.travel;
         self.travel += moved;
-        self.slack = Self::remaining(&self.end, end);
+        self.slack = Self::rounded_up(to_go);
         self.set_margin(self.extent);
         if !self.moving {
             return;
