@@ -3,6 +3,8 @@
 
 use glam::DVec3;
 
+use super::wide_bvh::WideBvh;
+
 /// Triangles per leaf at most.
 const LEAF: usize = 4;
 
@@ -25,6 +27,8 @@ pub(crate) struct Node {
 pub(crate) struct Bvh {
     /// Nodes in depth-first creation order.
     pub nodes: Vec<Node>,
+    /// Its four-wide copy, which the nearest-first searches walk.
+    wide: WideBvh,
 }
 
 /// Squared distance from `x` to the box [lo, hi] (0 inside).
@@ -87,7 +91,11 @@ impl Bvh {
             work.push((child + 1, mid, e));
             work.push((child, s, mid));
         }
-        let mut bvh = Self { nodes };
+        let mut bvh = Self {
+            nodes,
+            wide: WideBvh::default(),
+        };
+        bvh.wide = WideBvh::of(&bvh);
         let stored: Vec<(DVec3, DVec3)> = order.iter().map(|&i| boxes[i as usize]).collect();
         bvh.refit(|i| stored[i]);
         (bvh, order)
@@ -115,6 +123,9 @@ impl Bvh {
             self.nodes[n].lo = lo;
             self.nodes[n].hi = hi;
         }
+        let mut wide = std::mem::take(&mut self.wide);
+        wide.refit(self);
+        self.wide = wide;
     }
 
     /// The root's box.
@@ -151,37 +162,8 @@ impl Bvh {
     /// ancestor's box, lies within the current limit of `x` (squared; `limit` at first, then
     /// what the last `leaf` call returned: it may shrink as the search finds nearer
     /// primitives), nearer children first; in an order that is a function of the input.
-    pub fn branch_and_bound(&self, x: DVec3, limit: f64, mut leaf: impl FnMut(usize) -> f64) {
-        let mut limit = limit;
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = self.nodes[stack[top] as usize];
-            if box_distance_squared(x, node.lo, node.hi) > limit {
-                continue;
-            }
-            if node.count > 0 {
-                for i in node.first..node.first + node.count {
-                    limit = leaf(i as usize);
-                }
-            } else {
-                let (a, b) = (node.first, node.first + 1);
-                let da = {
-                    let n = self.nodes[a as usize];
-                    box_distance_squared(x, n.lo, n.hi)
-                };
-                let db = {
-                    let n = self.nodes[b as usize];
-                    box_distance_squared(x, n.lo, n.hi)
-                };
-                // The nearer child on top, popped first.
-                let (first, second) = if db < da { (b, a) } else { (a, b) };
-                stack[top] = second;
-                stack[top + 1] = first;
-                top += 2;
-            }
-        }
+    pub fn branch_and_bound(&self, x: DVec3, limit: f64, leaf: impl FnMut(usize) -> f64) {
+        self.wide.branch_and_bound(x, limit, leaf);
     }
 
     /// Branch and bound: the primitive minimising `distance_squared(i, bound)` (a value no

@@ -17,6 +17,7 @@ pub(crate) mod normals;
 mod queries_vs_brute_force;
 #[cfg(test)]
 mod vs_parry;
+pub(crate) mod wide_bvh;
 
 use glam::DVec3;
 use rayon::prelude::*;
