@@ -84,7 +84,7 @@ impl Friction {
 /// `x` moved by `depth` along its unit `normal`, then its slip since `prev` across the normal
 /// corrected as [`Friction::correction`] does (Macklin et al. 2014, eq. 24), operation for
 /// operation. Returns the new positions (a lane whose `push` is false keeps its own) and each
-/// lane's correction, squared.
+/// pushed lane's correction, squared (a lane not pushed reads as sticking).
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
 pub(crate) fn push_lanes<const L: usize>(
@@ -113,15 +113,23 @@ pub(crate) fn push_lanes<const L: usize>(
             t[a][l] = rel[a][l] - normal[a][l] * along[l];
         }
     }
-    let mut scale = [0.0; L];
+    let mut scale = [1.0; L];
     let mut no_slip = [false; L];
+    let mut t2 = [0.0; L];
+    let mut stick = [true; L];
     for l in 0..L {
-        let slip2 = t[0][l] * t[0][l] + t[1][l] * t[1][l] + t[2][l] * t[2][l];
+        t2[l] = t[0][l] * t[0][l] + t[1][l] * t[1][l] + t[2][l] * t[2][l];
         let grip = friction.static_coefficient * depth[l];
-        let sliding = (friction.dynamic_coefficient * depth[l] / slip2.sqrt()).min(1.0);
-        // Sticking: t itself (t · 1 = t exactly).
-        scale[l] = if slip2 < grip * grip { 1.0 } else { sliding };
-        no_slip[l] = slip2 <= 0.0;
+        stick[l] = t2[l] < grip * grip;
+        no_slip[l] = t2[l] <= 0.0;
+    }
+    // Sticking: t itself (t · 1 = t exactly). The square root and the division only where a
+    // pushed lane slides (a block at rest sticks throughout).
+    if (0..L).any(|l| push[l] & !stick[l]) {
+        for l in 0..L {
+            let sliding = (friction.dynamic_coefficient * depth[l] / t2[l].sqrt()).min(1.0);
+            scale[l] = if stick[l] { 1.0 } else { sliding };
+        }
     }
     let mut out = *x;
     let mut slip2 = [0.0; L];
