@@ -858,15 +858,35 @@ impl CollisionWorld {
         let (x0, x1, x2) = (&mut x0[..n], &mut x1[..n], &mut x2[..n]);
         let (p0, p1, p2) = (&prev[0][..n], &prev[1][..n], &prev[2][..n]);
         let mut swept = 0;
-        for j in 0..n {
-            let mut x = DVec3::new(x0[j], x1[j], x2[j]);
-            let from = DVec3::new(p0[j], p1[j], p2[j]);
-            if w[j] == 0.0 || short_path(x, from, r[j]) {
+        // Eight particles' paths measured together first (one vector pass over the run's
+        // arrays, as `short_path`); only a block with a long path is walked one by one.
+        const BLOCK: usize = 8;
+        let mut j = 0;
+        while j < n {
+            if j % BLOCK == 0 && j + BLOCK <= n {
+                let long = (j..j + BLOCK).fold(false, |any, k| {
+                    let d = [x0[k] - p0[k], x1[k] - p1[k], x2[k] - p2[k]];
+                    let slow = 0.5 * r[k].max(1e-6);
+                    let free = w[k] != 0.0;
+                    // Not short (`short_path`), NaN included.
+                    let short = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= slow * slow;
+                    any | (free & !short)
+                });
+                if !long {
+                    j += BLOCK;
+                    continue;
+                }
+            }
+            let k = j;
+            j += 1;
+            let mut x = DVec3::new(x0[k], x1[k], x2[k]);
+            let from = DVec3::new(p0[k], p1[k], p2[k]);
+            if w[k] == 0.0 || short_path(x, from, r[k]) {
                 continue;
             }
             let (colliders, bounds, parry) = (&self.colliders, &self.bounds, self.parry_meshes);
-            swept += sweep_path(colliders, bounds, mesh, parry, from, &mut x, r[j]);
-            (x0[j], x1[j], x2[j]) = (x.x, x.y, x.z);
+            swept += sweep_path(colliders, bounds, mesh, parry, from, &mut x, r[k]);
+            (x0[k], x1[k], x2[k]) = (x.x, x.y, x.z);
         }
         swept
     }
