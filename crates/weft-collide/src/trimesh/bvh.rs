@@ -128,6 +128,44 @@ impl Bvh {
         self.wide = wide;
     }
 
+    /// Sets how far the primitives' vertices move over the current frame, from the box of
+    /// each primitive's motions `leaf_motion(i)` (i in storage order), for
+    /// [`Self::visit_riding`].
+    pub fn set_motions(&mut self, leaf_motion: impl Fn(usize) -> (DVec3, DVec3)) {
+        let mut boxes = vec![(DVec3::ZERO, DVec3::ZERO); self.nodes.len()];
+        for n in (0..self.nodes.len()).rev() {
+            let node = self.nodes[n];
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            if node.count > 0 {
+                for i in node.first..node.first + node.count {
+                    let (l, h) = leaf_motion(i as usize);
+                    lo = lo.min(l);
+                    hi = hi.max(h);
+                }
+            } else {
+                for c in [node.first, node.first + 1] {
+                    let (l, h) = boxes[c as usize];
+                    lo = lo.min(l);
+                    hi = hi.max(h);
+                }
+            }
+            boxes[n] = (lo, hi);
+        }
+        self.wide.set_motions(&boxes);
+    }
+
+    /// [`WideBvh::visit_riding`]: every primitive a riding list about `x` may need, out to
+    /// `outer` plus `k` times how far its vertices' motions lie from `motion`.
+    pub fn visit_riding(
+        &self,
+        x: DVec3,
+        outer: f64,
+        motion: (DVec3, f64),
+        leaf: impl FnMut(usize),
+    ) {
+        self.wide.visit_riding(x, outer, motion, leaf);
+    }
+
     /// The root's box.
     pub fn bounds(&self) -> (DVec3, DVec3) {
         self.nodes

@@ -10,8 +10,11 @@
 //! or skin list; Verlet 1967). The check is a few flops per particle; a particle that fails it
 //! gets a new list from the BVH with R = r (1 + skin) + |from − x| + the surface's motion this
 //! substep. An empty list records how far the nearest triangle is (or the mesh's box), so far
-//! particles are checked as rarely. The lists live in arenas of a fixed chunk of particles,
-//! each updated by one task: results do not depend on the thread count.
+//! particles are checked as rarely. On a deforming mesh whose fastest vertex would use up a
+//! list's skin before the frame ends (a jumping body), a list is built instead with a riding
+//! certificate (`riding`), which bounds the triangles' motion relative to the particle's own
+//! and lasts to the frame's end. The lists live in arenas of a fixed chunk of particles, each
+//! updated by one task: results do not depend on the thread count.
 
 use glam::DVec3;
 
@@ -23,6 +26,7 @@ mod tests;
 use super::bvh::box_distance_squared;
 use super::ccd::{Crossing, moving_crossing, segment_crossing};
 use super::closest::closest_on_triangle;
+use super::riding::Riding;
 use crate::analytic::WorldPose;
 use crate::friction::Friction;
 use weft_solver::Contacts;
@@ -30,6 +34,10 @@ use weft_solver::Contacts;
 /// Skin of a list, as a fraction of the particle's thickness r: lists are built with radius
 /// r (1 + SKIN) beyond the particle's own substep path.
 pub(crate) const SKIN: f64 = 0.5;
+
+/// Width of a riding list's guard and reach (`riding`) beyond the list's radius, as a
+/// fraction of the particle's thickness r.
+pub(crate) const GUARD: f64 = 1.0;
 
 /// Pushes per particle and projection (a push out of one face may land in another, in a
 /// concave corner).
@@ -59,6 +67,13 @@ pub(crate) struct ChunkLists {
     hint: Vec<u32>,
     /// Each particle's list: `tris[start .. start + len]`.
     range: Vec<(u32, u32)>,
+    /// On a deforming mesh, the length of each list's guard (the unlisted triangles its
+    /// riding certificate bounds), stored after it: `tris[start + len ..][.. guard]`.
+    guard: Vec<u32>,
+    /// On a deforming mesh, each list's riding certificate.
+    riding: Vec<Riding>,
+    /// A build's guard, before it joins the arena.
+    scratch: Vec<u32>,
     /// The lists, end to end; rebuilt lists are appended and the arena compacted when half
     /// of it is stale.
     tris: Vec<u32>,
@@ -81,6 +96,9 @@ impl ChunkLists {
             last: vec![DVec3::ZERO; n],
             hint: vec![u32::MAX; n],
             range: vec![(0, 0); n],
+            guard: vec![0; n],
+            riding: vec![Riding::NONE; n],
+            scratch: Vec::new(),
             tris: Vec::new(),
             live: 0,
             spare: Vec::new(),
@@ -88,7 +106,7 @@ impl ChunkLists {
         }
     }
 
-    /// Triangles listed, over all particles of the chunk.
+    /// Triangles listed (guards included), over all particles of the chunk.
     pub fn entries(&self) -> usize {
         self.live
     }
@@ -108,9 +126,9 @@ impl ChunkLists {
         }
         let mut fresh = std::mem::take(&mut self.spare);
         fresh.clear();
-        for r in &mut self.range {
+        for (r, &guard) in self.range.iter_mut().zip(&self.guard) {
             let s = fresh.len() as u32;
-            fresh.extend_from_slice(&self.tris[r.0 as usize..(r.0 + r.1) as usize]);
+            fresh.extend_from_slice(&self.tris[r.0 as usize..(r.0 + r.1 + guard) as usize]);
             *r = (s, r.1);
         }
         self.spare = std::mem::replace(&mut self.tris, fresh);
@@ -208,8 +226,15 @@ impl MeshFrame<'_> {
     }
 
     /// Whether particle `j`'s list holds every triangle within `r` of `x` and of the path
-    /// `from → x` (local).
+    /// `from → x` (local): by its bound on the whole mesh's travel, or by its riding
+    /// certificate.
     fn valid(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
+        self.valid_by_travel(lists, j, x, from, r)
+            || lists.riding[j].holds(self.geometry, x, from, self.fresh, r)
+    }
+
+    /// [`Self::valid`] by the bound on the whole mesh's travel since the build alone.
+    fn valid_by_travel(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
         let g = self.geometry;
         let anchor = lists.anchor[j];
         // max(|x − anchor|, |from − anchor|) ≤ slack, compared squared.
@@ -230,7 +255,12 @@ impl MeshFrame<'_> {
         lists.builds += 1;
         let radius = r * (1.0 + SKIN) + (from - x).length() + (g.travel - g.travel_before);
         let old = lists.range[j];
-        lists.live -= old.1 as usize;
+        lists.live -= (old.1 + lists.guard[j]) as usize;
+        lists.guard[j] = 0;
+        lists.riding[j] = Riding::NONE;
+        if self.build_riding(lists, j, (x, from), radius, r) {
+            return;
+        }
         let (lo, hi) = g.bounds();
         let outside_box = box_distance_squared(x, lo, hi).sqrt();
         // Inside a closed mesh's box an empty list needs the nearest triangle of all (the
@@ -255,6 +285,73 @@ impl MeshFrame<'_> {
         };
         lists.radius[j] = clearance;
         lists.inside[j] = inside;
+    }
+
+    /// On a deforming mesh, builds particle `j`'s list at `x` (on a path from `from`) with
+    /// `radius` as a riding list (`riding`), riding with the particle's own motion over the
+    /// substep, scaled to the frame; false (and nothing built) on the substep's later
+    /// projections (no motion to ride with), or where no triangle is within the radius (an
+    /// empty list keeps the clearance of the nearest triangle of all instead).
+    fn build_riding(
+        &self,
+        lists: &mut ChunkLists,
+        j: usize,
+        (x, from): (DVec3, DVec3),
+        radius: f64,
+        r: f64,
+    ) -> bool {
+        let g = self.geometry;
+        let (w_before, w) = g.frame_span;
+        if g.frame_id == 0 || !self.fresh || w <= w_before {
+            return false;
+        }
+        // Only where a plain list would not last the frame out: its skin used up by the
+        // particle and the surface each moving as far as the fastest vertex did this substep.
+        let substep = g.travel - g.travel_before;
+        if r * SKIN * (w - w_before) >= 2.0 * substep * (1.0 - w) {
+            return false;
+        }
+        let motion = (x - from) / (w - w_before);
+        if !motion.is_finite() {
+            return false;
+        }
+        let outer = radius + GUARD * r;
+        let k = 1.0 - g.frame_span.1;
+        let start = lists.tris.len();
+        let mut guard = std::mem::take(&mut lists.scratch);
+        guard.clear();
+        let (nearest, spread) =
+            g.within_riding(x, (radius, outer), (motion, k), &mut lists.tris, &mut guard);
+        let len = lists.tris.len() - start;
+        let (lo, hi) = g.bounds();
+        let outside_box = box_distance_squared(x, lo, hi).sqrt();
+        // An empty list inside a closed mesh's box needs the nearest triangle of all for its
+        // side: the plain search finds it.
+        let side = match nearest {
+            Some(p) if len > 0 => Some((radius, p.distance < 0.0)),
+            _ if g.closed() && outside_box == 0.0 => None,
+            _ => Some((radius.max(outside_box), false)),
+        };
+        let built = match side {
+            Some((clearance, inside)) => {
+                lists.tris.extend_from_slice(&guard);
+                lists.guard[j] = guard.len() as u32;
+                lists.live += len + guard.len();
+                lists.range[j] = (start as u32, len as u32);
+                lists.anchor[j] = x;
+                lists.travel[j] = g.travel_before;
+                lists.radius[j] = clearance;
+                lists.inside[j] = inside;
+                lists.riding[j] = Riding::new(g, x, motion, spread, (radius, outer));
+                true
+            }
+            None => {
+                lists.tris.truncate(start);
+                false
+            }
+        };
+        lists.scratch = guard;
+        built
     }
 
     /// The earliest crossing of the path `from → x` with a listed triangle: (crossing,
@@ -369,6 +466,7 @@ impl MeshFrame<'_> {
                     match g.nearest(xl, f64::INFINITY) {
                         Some(p) if p.distance < r => {
                             lists.radius[j] = f64::NAN;
+                            lists.riding[j] = Riding::NONE;
                             p
                         }
                         _ => break,

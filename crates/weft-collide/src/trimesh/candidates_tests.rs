@@ -117,3 +117,202 @@ fn rounds_stop_early_only_clear_of_every_triangle() {
         "{pushed} pushed, {early} stopped early"
     );
 }
+
+/// Particles riding on a ball that moves fast (4 cm a frame, far more than the lists' skin
+/// every substep) and ripples, over 12 frames of 10 substeps: wherever a list stands without
+/// a rebuild, it holds every triangle within the thickness of the particle and of its path's
+/// start (brute force, at the substep's end and start); and riding certificates (`riding`)
+/// carry most of the lists through.
+#[test]
+fn riding_lists_hold_every_triangle_in_reach() {
+    let m = TriangleMesh::icosphere(0.5, 3);
+    let mut g = MeshGeometry::new(&m.vertices, &m.triangles);
+    let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+    let rest = m.vertices.clone();
+    let shape = |frame: usize| -> Vec<DVec3> {
+        let t = frame as f64 / 60.0;
+        let shift = DVec3::new(2.4 * t, 0.6 * (7.0 * t).sin(), 0.0);
+        (rest.iter())
+            .map(|v| *v * (1.0 + 0.03 * (9.0 * t + 6.0 * v.y).sin()) + shift)
+            .collect()
+    };
+    let mut rng = Rng(21);
+    let r = 0.01;
+    let n = 300;
+    // On the surface, 0.2 r to 3 r off it.
+    let mut x: Vec<DVec3> = (0..n)
+        .map(|_| {
+            let dir = rng.cube(1.0).normalize_or(DVec3::Y);
+            let p = g.nearest(dir, f64::INFINITY).expect("nearest");
+            p.closest.point + p.normal * r * (0.2 + 2.8 * rng.next())
+        })
+        .collect();
+    let mut lists = ChunkLists::new(n);
+    let substeps = 10;
+    let (mut checked, mut riding, mut builds) = (0, 0, 0);
+    for frame in 1..=12 {
+        let before = g.end.clone();
+        g.begin_frame(&shape(frame));
+        let motion: Vec<DVec3> = (g.frame.1.iter().zip(&before))
+            .map(|(b, a)| *b - *a)
+            .collect();
+        for k in 1..=substeps {
+            let w = k as f64 / substeps as f64;
+            g.advance_to(w);
+            let frame_of = MeshFrame::still(&g, &pose, Friction::NONE);
+            for (j, xj) in x.iter_mut().enumerate() {
+                let from = *xj;
+                // Carried by the nearest vertex's motion (most), with a jitter of up to 2 mm.
+                let near_v = (0..rest.len())
+                    .min_by(|&a, &b| {
+                        (g.start[a] - from)
+                            .length_squared()
+                            .total_cmp(&(g.start[b] - from).length_squared())
+                    })
+                    .unwrap_or(0);
+                *xj += motion[near_v] / substeps as f64 + rng.cube(0.002);
+                let built = lists.builds;
+                let global = frame_of.valid_by_travel(&lists, j, *xj, from, r);
+                frame_of.ensure(&mut lists, j, *xj, from, r);
+                builds += lists.builds - built;
+                if lists.builds > built {
+                    continue;
+                }
+                riding += usize::from(!global);
+                let (s, len) = lists.range[j];
+                let list = &lists.tris[s as usize..(s + len) as usize];
+                for (t, f) in g.faces.iter().enumerate() {
+                    let [a, b, c] = f.corners;
+                    let d_end = (*xj - closest_on_triangle(*xj, a, b, c).point).length();
+                    let [a, b, c] = g.start_corners(t);
+                    let d_start = (from - closest_on_triangle(from, a, b, c).point).length();
+                    if d_end <= r || d_start <= r {
+                        assert!(
+                            list.contains(&(t as u32)),
+                            "frame {frame} substep {k}, particle {j}: triangle {t} at {d_end} \
+                             (end) / {d_start} (start) not listed"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+            // Particles that drift off are put back near the surface.
+            for xj in x.iter_mut() {
+                let p = g.nearest(*xj, f64::INFINITY).expect("nearest");
+                if p.distance.abs() > 4.0 * r {
+                    *xj = p.closest.point + p.normal * 2.0 * r;
+                }
+            }
+        }
+    }
+    assert!(checked > 10_000, "{checked} triangles in reach checked");
+    assert!(
+        riding > 10_000,
+        "{riding} lists stood on their riding certificate"
+    );
+    assert!(builds < (12 * 10 * n / 3) as u64, "{builds} builds");
+}
+
+/// Three square sheets of one mesh: a floor sliding 4 cm a frame with the particles riding
+/// above it, a ceiling 10 cm above sliding with it and closing in at 6 cm a frame (from
+/// beyond a list's reach to through the particles within one frame), and a still wall ahead
+/// that the particles reach: wherever a list stands without a rebuild, it holds every
+/// triangle within the thickness of the particle and its path's start, the ceiling's and the
+/// wall's included.
+#[test]
+fn riding_lists_see_a_part_closing_in() {
+    let (n_side, size) = (16, 0.4);
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for sheet in 0..3 {
+        let base = vertices.len() as u32;
+        for i in 0..=n_side {
+            for k in 0..=n_side {
+                let (u, v) = (i as f64 / n_side as f64, k as f64 / n_side as f64);
+                vertices.push(match sheet {
+                    0 => DVec3::new(size * (u - 0.5), 0.0, size * (v - 0.5)),
+                    1 => DVec3::new(size * (u - 0.5), 0.1, size * (v - 0.5)),
+                    _ => DVec3::new(0.3, 0.25 * (u - 0.5), size * (v - 0.5)),
+                });
+            }
+        }
+        let at = |i: u32, k: u32| base + i * (n_side as u32 + 1) + k;
+        for i in 0..n_side as u32 {
+            for k in 0..n_side as u32 {
+                triangles.push([at(i, k), at(i + 1, k), at(i + 1, k + 1)]);
+                triangles.push([at(i, k), at(i + 1, k + 1), at(i, k + 1)]);
+            }
+        }
+    }
+    let per_sheet = vertices.len() / 3;
+    let mut g = MeshGeometry::new(&vertices, &triangles);
+    let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+    let shape = |frame: usize| -> Vec<DVec3> {
+        let slide = DVec3::X * 0.04 * frame as f64;
+        let close = DVec3::Y * -0.06 * frame as f64;
+        (vertices.iter().enumerate())
+            .map(|(v, p)| match v / per_sheet {
+                0 => *p + slide,
+                1 => *p + slide + close,
+                _ => *p,
+            })
+            .collect()
+    };
+    let mut rng = Rng(5);
+    let r = 0.01;
+    let n = 200;
+    let mut x: Vec<DVec3> = (0..n)
+        .map(|_| {
+            let c = rng.cube(0.12);
+            DVec3::new(c.x, 0.004 + 0.016 * rng.next(), c.z)
+        })
+        .collect();
+    let mut lists = ChunkLists::new(n);
+    let substeps = 10;
+    let (mut near_ceiling, mut near_wall, mut riding) = (0, 0, 0);
+    for frame in 1..=6 {
+        g.begin_frame(&shape(frame));
+        for k in 1..=substeps {
+            g.advance_to(k as f64 / substeps as f64);
+            let frame_of = MeshFrame::still(&g, &pose, Friction::NONE);
+            for (j, xj) in x.iter_mut().enumerate() {
+                let from = *xj;
+                *xj += DVec3::X * 0.004 + rng.cube(0.0005);
+                let built = lists.builds;
+                let by_travel = frame_of.valid_by_travel(&lists, j, *xj, from, r);
+                frame_of.ensure(&mut lists, j, *xj, from, r);
+                if lists.builds > built {
+                    continue;
+                }
+                riding += usize::from(!by_travel);
+                let (s, len) = lists.range[j];
+                let list = &lists.tris[s as usize..(s + len) as usize];
+                for (t, f) in g.faces.iter().enumerate() {
+                    let [a, b, c] = f.corners;
+                    let d_end = (*xj - closest_on_triangle(*xj, a, b, c).point).length();
+                    let [a, b, c] = g.start_corners(t);
+                    let d_start = (from - closest_on_triangle(from, a, b, c).point).length();
+                    if d_end <= r || d_start <= r {
+                        assert!(
+                            list.contains(&(t as u32)),
+                            "frame {frame} substep {k}, particle {j}: triangle {t} at {d_end} \
+                             (end) / {d_start} (start) not listed"
+                        );
+                        let sheet = g.triangles[t][0] as usize / per_sheet;
+                        near_ceiling += usize::from(sheet == 1);
+                        near_wall += usize::from(sheet == 2);
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        near_ceiling > 500,
+        "{near_ceiling} times the ceiling in reach"
+    );
+    assert!(near_wall > 100, "{near_wall} times the wall in reach");
+    assert!(
+        riding > 1000,
+        "{riding} lists stood on their riding certificate"
+    );
+}

@@ -15,6 +15,7 @@ pub(crate) mod grid_run;
 pub(crate) mod normals;
 #[cfg(test)]
 mod queries_vs_brute_force;
+pub(crate) mod riding;
 #[cfg(test)]
 mod vs_parry;
 pub(crate) mod wide_bvh;
@@ -152,6 +153,10 @@ pub(crate) struct MeshGeometry {
     /// A bound on how far any vertex has still to move before the frame's end (m): the
     /// planes are the frame end's, so every bound on them is this much less.
     slack: f64,
+    /// The frame begun last, counted from 1 (0: none yet).
+    pub frame_id: u64,
+    /// Where in that frame the current substep starts and ends (fractions, 0 to 1).
+    pub frame_span: (f64, f64),
 }
 
 impl MeshGeometry {
@@ -186,6 +191,8 @@ impl MeshGeometry {
             moving: false,
             frame: (Vec::new(), Vec::new()),
             slack: 0.0,
+            frame_id: 0,
+            frame_span: (0.0, 0.0),
         };
         (geometry.faces, geometry.planes) = geometry.compute_faces();
         geometry.set_margin(extent);
@@ -249,9 +256,39 @@ impl MeshGeometry {
             }
             (lo, hi)
         });
+        self.bvh.set_motions(|i| {
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            for v in triangles[i] {
+                let d = end[v as usize] - from[v as usize];
+                lo = lo.min(d);
+                hi = hi.max(d);
+            }
+            (lo, hi)
+        });
         let extent = (from.iter().chain(end)).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         self.slack = Self::remaining(&self.end, end);
+        self.frame_id += 1;
+        self.frame_span = (0.0, 0.0);
         self.set_margin(extent);
+    }
+
+    /// How far vertex `v` moves over the current frame (zero before the first).
+    #[inline]
+    pub fn frame_motion(&self, v: u32) -> DVec3 {
+        let (from, end) = &self.frame;
+        match (from.get(v as usize), end.get(v as usize)) {
+            (Some(a), Some(b)) => *b - *a,
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// How far triangle `t`'s corners' motions over the frame lie from `motion`, at most.
+    #[inline]
+    pub fn motion_spread(&self, t: usize, motion: DVec3) -> f64 {
+        (self.triangles[t].iter())
+            .map(|&v| (self.frame_motion(v) - motion).length_squared())
+            .fold(0.0, f64::max)
+            .sqrt()
     }
 
     /// How far any of `now` has still to go to `end`, rounded up.
@@ -281,6 +318,7 @@ impl MeshGeometry {
             to_go = to_go.max((*b - *now).length_squared());
         }
         let moved = moved.sqrt();
+        self.frame_span = (self.frame_span.1, w);
         self.moving = moved > 0.0;
         self.travel_before = self.travel;
         self.travel += moved;
@@ -397,6 +435,51 @@ impl MeshGeometry {
             limit
         });
         best.map(|(d2, t, q)| self.signed(x, t, q, d2))
+    }
+
+    /// A riding list's search (`riding`): appends to `out` every triangle within `radius` of
+    /// `x` at the end of the substep and to `guard` every other triangle that may come
+    /// within `outer` of a point riding from `x` with `motion` before the frame's end (`k`:
+    /// the part of the frame left), each in a fixed order; returns the nearest listed
+    /// triangle and the guard's spread (how far its corners' motions lie from `motion`, at
+    /// most). Every triangle in neither lies farther than `outer` + k |dᵥ − motion| from `x`
+    /// now (dᵥ: the frame motion of any of its vertices).
+    pub fn within_riding(
+        &self,
+        x: DVec3,
+        (radius, outer): (f64, f64),
+        (motion, k): (DVec3, f64),
+        out: &mut Vec<u32>,
+        guard: &mut Vec<u32>,
+    ) -> (Option<MeshPoint>, f64) {
+        let r2 = radius * radius;
+        let faces = &self.faces;
+        let (x32, margin) = (x.as_vec3(), self.margin_at(x));
+        let mut best: Option<(f64, usize, Closest)> = None;
+        let mut spread = 0.0f64;
+        self.bvh.visit_riding(x, outer, (motion, k), |t| {
+            // A lower bound on the distance² now (and until the frame's end).
+            let lower = f64::from(self.planes[t].distance_squared_bound(x32, margin));
+            if lower <= r2 {
+                let [a, b, c] = faces[t].corners;
+                let q = closest_on_triangle(x, a, b, c);
+                let d2 = (x - q.point).length_squared();
+                if d2 <= r2 {
+                    out.push(t as u32);
+                    if best.is_none_or(|b| d2 < b.0) {
+                        best = Some((d2, t, q));
+                    }
+                    return;
+                }
+            }
+            let dev = self.motion_spread(t, motion);
+            if lower.sqrt() * (1.0 - 1e-12) - k * dev * (1.0 + 1e-12) > outer {
+                return;
+            }
+            guard.push(t as u32);
+            spread = spread.max(dev);
+        });
+        (best.map(|(d2, t, q)| self.signed(x, t, q, d2)), spread)
     }
 
     /// The mesh's box at the end of the substep (of the swept boxes while it moves).

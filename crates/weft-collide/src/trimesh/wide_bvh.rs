@@ -30,12 +30,23 @@ struct Wide {
     count: [u32; WIDTH],
 }
 
+/// How far a node's children's vertices move over a frame: per child, the centre of the box
+/// of their motions and a radius about it (f32, rounded up), so that every motion lies within
+/// the radius of the centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Motions {
+    centre: [[f32; WIDTH]; 3],
+    radius: [f32; WIDTH],
+}
+
 /// The four-wide hierarchy, root first, with the binary node behind each child (to refit).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct WideBvh {
     nodes: Vec<Wide>,
     /// Per node and child, the binary node whose box it copies (`u32::MAX`: none).
     source: Vec<[u32; WIDTH]>,
+    /// Per node, its children's motions over the current frame (empty: none known).
+    motions: Vec<Motions>,
 }
 
 /// The largest f32 no greater than `x`.
@@ -144,6 +155,33 @@ impl WideBvh {
         }
     }
 
+    /// Sets the children's motions over the frame from the binary nodes' boxes of motions
+    /// `boxes` (indexed as the binary tree's nodes).
+    pub fn set_motions(&mut self, boxes: &[(DVec3, DVec3)]) {
+        self.motions.clear();
+        for source in &self.source {
+            let mut m = Motions {
+                centre: [[0.0; WIDTH]; 3],
+                radius: [f32::INFINITY; WIDTH],
+            };
+            for (k, &s) in source.iter().enumerate() {
+                let Some(&(lo, hi)) = boxes.get(s as usize) else {
+                    continue;
+                };
+                let centre = 0.5 * (lo + hi);
+                let c32 = centre.as_vec3();
+                // Every motion within the half-diagonal of the centre, and the f32 centre
+                // within its rounding of the f64 one.
+                let radius = 0.5 * (hi - lo).length() + (centre - c32.as_dvec3()).length();
+                for a in 0..3 {
+                    m.centre[a][k] = c32[a];
+                }
+                m.radius[k] = up(radius * (1.0 + 1e-9));
+            }
+            self.motions.push(m);
+        }
+    }
+
     /// Branch and bound, as [`Bvh::branch_and_bound`]: calls `leaf(i)` for every primitive
     /// in a leaf whose box, and every ancestor's box, may lie within the current limit of `x`
     /// (squared; `limit` at first, then what the last `leaf` call returned), nearer children
@@ -219,6 +257,80 @@ impl WideBvh {
     }
 }
 
+impl WideBvh {
+    /// Calls `leaf(i)` for every primitive in a leaf that the search for a riding list may
+    /// need (`super::riding`): a child is passed over only when every primitive in it is
+    /// farther from `x` than `outer` plus `k` times how far any of its vertices' motions over
+    /// the frame lies from `motion`, by its box (f32 distances bounded as in
+    /// [`Self::branch_and_bound`], the motions' bound rounded up). Without motions (before
+    /// [`Self::set_motions`]), as [`Self::branch_and_bound`] with the limit `outer`².
+    pub fn visit_riding(
+        &self,
+        x: DVec3,
+        outer: f64,
+        (motion, k): (DVec3, f64),
+        mut leaf: impl FnMut(usize),
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        if self.motions.len() != self.nodes.len() {
+            self.branch_and_bound(x, outer * outer, |i| {
+                leaf(i);
+                outer * outer
+            });
+            return;
+        }
+        let x32 = x.as_vec3();
+        let e = (x - x32.as_dvec3()).length() * (1.0 + 1e-6);
+        // The reference motion in f32, and how far it was moved by rounding.
+        let m32 = motion.as_vec3();
+        let em = (motion - m32.as_dvec3()).length() * (1.0 + 1e-6);
+        let base = up((outer + e + k * em) * (1.0 + 1e-5) + 1e-30);
+        let k32 = up(k * (1.0 + 1e-6));
+        let (px, py, pz) = (Vec4::splat(x32.x), Vec4::splat(x32.y), Vec4::splat(x32.z));
+        let (mx, my, mz) = (Vec4::splat(m32.x), Vec4::splat(m32.y), Vec4::splat(m32.z));
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let at = stack[top] as usize;
+            let (node, motions) = (&self.nodes[at], &self.motions[at]);
+            let axis = |a: usize, p: Vec4| {
+                let lo = Vec4::from_array(node.lo[a]);
+                let hi = Vec4::from_array(node.hi[a]);
+                (lo - p).max(p - hi).max(Vec4::ZERO)
+            };
+            let (dx, dy, dz) = (axis(0, px), axis(1, py), axis(2, pz));
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let c = |a: usize, m: Vec4| Vec4::from_array(motions.centre[a]) - m;
+            let (cx, cy, cz) = (c(0, mx), c(1, my), c(2, mz));
+            // How far a child's motions lie from the reference, at most (rounded up a few
+            // ulps by the factor), and the reach that child must lie beyond.
+            let dev = ((cx * cx + cy * cy + cz * cz).sqrt() + Vec4::from_array(motions.radius))
+                * (1.0 + 1e-5);
+            let reach = Vec4::splat(base) + Vec4::splat(k32) * dev;
+            let cut = (reach * reach * (1.0 + 1e-5)).to_array();
+            let d2 = d2.to_array();
+            for c in (0..WIDTH).rev() {
+                let count = node.count[c];
+                if count == EMPTY || d2[c] > cut[c] {
+                    continue;
+                }
+                if count > 0 {
+                    let first = node.at[c];
+                    for i in first..first + count {
+                        leaf(i as usize);
+                    }
+                } else {
+                    stack[top] = node.at[c];
+                    top += 1;
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -278,6 +390,69 @@ mod tests {
             }
         }
         assert!(on_the_edge > 1000, "{on_the_edge} queries at the limit");
+    }
+
+    #[test]
+    fn riding_visits_every_box_that_may_come_within_reach() {
+        let mut s = 3;
+        let boxes = boxes(601, &mut s);
+        let (mut bvh, order) = Bvh::build(&boxes);
+        let stored: Vec<_> = order.iter().map(|&i| boxes[i as usize]).collect();
+        // Each primitive's box of motions: about a drift that varies across space, up to 5 cm
+        // wide, or (every other one) a single motion, so that the bound is tight.
+        let motions: Vec<(DVec3, DVec3)> = (stored.iter().enumerate())
+            .map(|(i, b)| {
+                let wobble = DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s)) * 0.01;
+                let c = 0.1 * (b.0 + b.1) + wobble;
+                let h = DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s)).abs() * 0.025;
+                if i % 2 == 0 { (c, c) } else { (c - h, c + h) }
+            })
+            .collect();
+        bvh.set_motions(|i| motions[i]);
+        // The farthest a primitive's motions lie from `m`: at a corner of its box.
+        let dev = |i: usize, m: DVec3| {
+            let (lo, hi) = motions[i];
+            (0..8)
+                .map(|c| {
+                    let p = DVec3::new(
+                        if c & 1 == 0 { lo.x } else { hi.x },
+                        if c & 2 == 0 { lo.y } else { hi.y },
+                        if c & 4 == 0 { lo.z } else { hi.z },
+                    );
+                    (p - m).length()
+                })
+                .fold(0.0, f64::max)
+        };
+        let (mut at_edge, mut pruned) = (0, 0);
+        for q in 0..1500 {
+            let x = DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s)) * 1.1;
+            let m = DVec3::new(rand(&mut s), rand(&mut s), rand(&mut s)) * 0.05;
+            // A third with no motion allowance, so that the reach alone is at the edge.
+            let k = if q % 3 == 0 { 0.0 } else { rand(&mut s).abs() };
+            // The reach exactly at one primitive's bound, so that rounding decides it.
+            let pick = q % stored.len();
+            let d = box_distance_squared(x, stored[pick].0, stored[pick].1).sqrt();
+            let outer = (d - k * dev(pick, m)).max(0.0);
+            let mut seen = vec![false; stored.len()];
+            bvh.visit_riding(x, outer, (m, k), |i| seen[i] = true);
+            for (i, b) in stored.iter().enumerate() {
+                let reach = outer + k * dev(i, m);
+                if box_distance_squared(x, b.0, b.1).sqrt() <= reach {
+                    assert!(
+                        seen[i],
+                        "query {q}: primitive {i} within {reach} not visited"
+                    );
+                    at_edge += usize::from(i == pick);
+                } else {
+                    pruned += usize::from(!seen[i]);
+                }
+            }
+        }
+        assert!(at_edge > 1000, "{at_edge} queries at the edge");
+        assert!(
+            pruned > 100_000,
+            "{pruned} primitives passed over: no pruning"
+        );
     }
 
     #[test]
