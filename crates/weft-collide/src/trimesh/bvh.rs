@@ -29,6 +29,8 @@ pub(crate) struct Bvh {
     pub nodes: Vec<Node>,
     /// Its four-wide copy, which the nearest-first searches walk.
     wide: WideBvh,
+    /// Per node, a box worked out bottom-up (kept between refits, not to allocate).
+    scratch: Vec<(DVec3, DVec3)>,
 }
 
 /// Squared distance from `x` to the box [lo, hi] (0 inside).
@@ -94,6 +96,7 @@ impl Bvh {
         let mut bvh = Self {
             nodes,
             wide: WideBvh::default(),
+            scratch: Vec::new(),
         };
         bvh.wide = WideBvh::of(&bvh);
         let stored: Vec<(DVec3, DVec3)> = order.iter().map(|&i| boxes[i as usize]).collect();
@@ -104,25 +107,13 @@ impl Bvh {
     /// Recomputes every box from the primitives' boxes `leaf_box(i)` (i in storage order),
     /// children before parents; the tree's shape is kept.
     pub fn refit(&mut self, leaf_box: impl Fn(usize) -> (DVec3, DVec3)) {
-        for n in (0..self.nodes.len()).rev() {
-            let node = self.nodes[n];
-            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-            if node.count > 0 {
-                for i in node.first..node.first + node.count {
-                    let (l, h) = leaf_box(i as usize);
-                    lo = lo.min(l);
-                    hi = hi.max(h);
-                }
-            } else {
-                for c in [node.first, node.first + 1] {
-                    let child = self.nodes[c as usize];
-                    lo = lo.min(child.lo);
-                    hi = hi.max(child.hi);
-                }
-            }
-            self.nodes[n].lo = lo;
-            self.nodes[n].hi = hi;
+        let mut boxes = std::mem::take(&mut self.scratch);
+        self.merge_up(leaf_box, &mut boxes);
+        for (node, &(lo, hi)) in self.nodes.iter_mut().zip(&boxes) {
+            node.lo = lo;
+            node.hi = hi;
         }
+        self.scratch = boxes;
         let mut wide = std::mem::take(&mut self.wide);
         wide.refit(self);
         self.wide = wide;
@@ -132,26 +123,32 @@ impl Bvh {
     /// each primitive's motions `leaf_motion(i)` (i in storage order), for
     /// [`Self::visit_riding`].
     pub fn set_motions(&mut self, leaf_motion: impl Fn(usize) -> (DVec3, DVec3)) {
-        let mut boxes = vec![(DVec3::ZERO, DVec3::ZERO); self.nodes.len()];
+        let mut boxes = std::mem::take(&mut self.scratch);
+        self.merge_up(leaf_motion, &mut boxes);
+        self.wide.set_motions(&boxes);
+        self.scratch = boxes;
+    }
+
+    /// Every node's box of its primitives' boxes `leaf(i)`, children before parents, into
+    /// `boxes` (indexed as the nodes).
+    fn merge_up(&self, leaf: impl Fn(usize) -> (DVec3, DVec3), boxes: &mut Vec<(DVec3, DVec3)>) {
+        boxes.clear();
+        boxes.resize(self.nodes.len(), (DVec3::ZERO, DVec3::ZERO));
         for n in (0..self.nodes.len()).rev() {
             let node = self.nodes[n];
             let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            let mut take = |(l, h): (DVec3, DVec3)| {
+                lo = lo.min(l);
+                hi = hi.max(h);
+            };
             if node.count > 0 {
-                for i in node.first..node.first + node.count {
-                    let (l, h) = leaf_motion(i as usize);
-                    lo = lo.min(l);
-                    hi = hi.max(h);
-                }
+                (node.first..node.first + node.count).for_each(|i| take(leaf(i as usize)));
             } else {
-                for c in [node.first, node.first + 1] {
-                    let (l, h) = boxes[c as usize];
-                    lo = lo.min(l);
-                    hi = hi.max(h);
-                }
+                take(boxes[node.first as usize]);
+                take(boxes[node.first as usize + 1]);
             }
             boxes[n] = (lo, hi);
         }
-        self.wide.set_motions(&boxes);
     }
 
     /// [`WideBvh::visit_riding`]: every primitive a riding list about `x` may need, out to

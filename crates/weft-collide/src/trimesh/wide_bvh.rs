@@ -49,30 +49,25 @@ pub(crate) struct WideBvh {
     motions: Vec<Motions>,
 }
 
-/// The largest f32 no greater than `x`.
+/// The largest f32 no greater than `x` (selects, not branches: a refit converts every box
+/// once a frame).
 fn down(x: f64) -> f32 {
     let f = x as f32;
-    if f64::from(f) <= x {
-        f
+    let bits = f.to_bits();
+    // The next f32 toward −∞ (f32::MAX from +∞).
+    let lower = if f == 0.0 {
+        0x8000_0001
+    } else if bits >> 31 == 0 {
+        bits - 1
     } else {
-        next_toward_neg(f)
-    }
+        bits + 1
+    };
+    f32::from_bits(if f64::from(f) > x { lower } else { bits })
 }
 
 /// The smallest f32 no less than `x`.
 fn up(x: f64) -> f32 {
     -down(-x)
-}
-
-/// The next f32 below a finite `f`.
-fn next_toward_neg(f: f32) -> f32 {
-    if f == 0.0 {
-        -f32::from_bits(1)
-    } else if f > 0.0 {
-        f32::from_bits(f.to_bits() - 1)
-    } else {
-        f32::from_bits(f.to_bits() + 1)
-    }
 }
 
 impl WideBvh {
@@ -346,6 +341,31 @@ mod tests {
                 (c - h, c + h)
             })
             .collect()
+    }
+
+    #[test]
+    fn rounding_outwards_is_the_nearest_f32_on_that_side() {
+        let mut s = 17;
+        let mut values = vec![
+            0.0, -0.0, 1e-300, -1e-300, 1e-40, -1e-40, 3.0, -3.0, 1e39, -1e39,
+        ];
+        values.extend((0..10_000).map(|k| rand(&mut s) * 10f64.powi(k % 9 - 4)));
+        for x in values {
+            let (d, u) = (down(x), up(x));
+            assert!(f64::from(d) <= x && f64::from(u) >= x, "{x}: {d} {u}");
+            // Nothing representable strictly between.
+            let above = f32::from_bits(if d >= 0.0 {
+                d.to_bits() + 1
+            } else {
+                d.to_bits() - 1
+            });
+            if d != 0.0 && d.is_finite() {
+                assert!(f64::from(above) > x, "{x}: {d} is not the largest below");
+            }
+            if f64::from(x as f32) == x {
+                assert_eq!((d, u), (x as f32, x as f32), "{x} is an f32");
+            }
+        }
     }
 
     #[test]
