@@ -297,12 +297,44 @@ impl CollisionWorld {
         let own: Vec<bool> = self.colliders.iter().map(|c| self.own_mesh(c)).collect();
         let parry = self.parry_meshes;
         let (colliders, bounds, thickness) = (&self.colliders, &self.bounds, &self.thickness);
-        self.stats.swept += over_free_particles(
-            p,
-            0,
-            |i, x, prev| sweep_one(colliders, bounds, |k| own[k], parry, prev, x, thickness[i]),
-            |a, b| a + b,
-        );
+        let (positions, prev, inv) = moving_views(p);
+        // As `sweep_run`: eight particles' paths measured together, and only a block holding
+        // a long path walked one by one.
+        self.stats.swept += (positions.par_chunks_mut(CHUNK).enumerate())
+            .map(|(k, xs)| {
+                let base = k * CHUNK;
+                let mut swept = 0;
+                let mut j = 0;
+                while j < xs.len() {
+                    if j % BLOCK == 0 && j + BLOCK <= xs.len() {
+                        let long = (j..j + BLOCK).fold(false, |any, m| {
+                            let i = base + m;
+                            let free = inv[i] != 0.0;
+                            any | (free & !short_path(xs[m], prev[i], thickness[i]))
+                        });
+                        if !long {
+                            j += BLOCK;
+                            continue;
+                        }
+                    }
+                    let i = base + j;
+                    if inv[i] != 0.0 {
+                        let own = |k: usize| own[k];
+                        swept += sweep_one(
+                            colliders,
+                            bounds,
+                            own,
+                            parry,
+                            prev[i],
+                            &mut xs[j],
+                            thickness[i],
+                        );
+                    }
+                    j += 1;
+                }
+                swept
+            })
+            .sum::<usize>();
     }
 
     /// Builds the contact grid of every still triangle mesh of ours that has none for the
@@ -455,32 +487,8 @@ pub(crate) fn moving_views(p: &mut Particles) -> (&mut [DVec3], &[DVec3], &[f64]
     (positions, prev_positions, inv_masses)
 }
 
-/// Calls `f(i, position, previous position)` for every particle with a nonzero inverse mass,
-/// in parallel over fixed chunks of [`CHUNK`] particles, and folds the results with
-/// `combine`, which must not depend on order (sums of counts, maxima) so that the answer is
-/// the same on any thread count.
-fn over_free_particles<T: Copy + Send + Sync>(
-    p: &mut Particles,
-    zero: T,
-    f: impl Fn(usize, &mut DVec3, DVec3) -> T + Sync,
-    combine: impl Fn(T, T) -> T + Sync + Send,
-) -> T {
-    let (positions, prev, inv) = moving_views(p);
-    positions
-        .par_chunks_mut(CHUNK)
-        .enumerate()
-        .map(|(k, xs)| {
-            let mut acc = zero;
-            for (j, x) in xs.iter_mut().enumerate() {
-                let i = k * CHUNK + j;
-                if inv[i] != 0.0 {
-                    acc = combine(acc, f(i, x, prev[i]));
-                }
-            }
-            acc
-        })
-        .reduce(|| zero, &combine)
-}
+/// Particles whose paths a sweep pass measures together before walking any one by one.
+const BLOCK: usize = 8;
 
 /// Sweeps one particle's substep path `from → x` against every collider; returns how many
 /// stopped it. A path shorter than half the thickness (most) leaves here, inlined, before
@@ -860,7 +868,6 @@ impl CollisionWorld {
         let mut swept = 0;
         // Eight particles' paths measured together first (one vector pass over the run's
         // arrays, as `short_path`); only a block with a long path is walked one by one.
-        const BLOCK: usize = 8;
         let mut j = 0;
         while j < n {
             if j % BLOCK == 0 && j + BLOCK <= n {
