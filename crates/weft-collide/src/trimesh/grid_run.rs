@@ -216,10 +216,10 @@ impl<const L: usize> Block<L> {
             return;
         };
         let at: [&FaceCert; L] = std::array::from_fn(|l| &certs[t[l].min(last)]);
+        // Each field's lanes built as one value, then stored whole (scalar stores read back
+        // as a vector stall the load).
         for k in 0..FIELDS {
-            for l in 0..L {
-                self.f[k][l] = at[l].0[k];
-            }
+            self.f[k] = std::array::from_fn(|l| at[l].0[k]);
         }
     }
 }
