@@ -118,6 +118,43 @@ fn rounds_stop_early_only_clear_of_every_triangle() {
     );
 }
 
+/// Makes particle `j`'s list valid at `x` on a path from `from` (`MeshFrame::ensure`); where
+/// it stood without a rebuild, checks by brute force that it holds every triangle within `r`
+/// of `x` (at the substep's end) and of `from` (at its start), and returns those triangles
+/// and whether the bound on the mesh's travel alone held it; `None` after a rebuild.
+fn standing_list(
+    frame: &MeshFrame<'_>,
+    lists: &mut ChunkLists,
+    j: usize,
+    (x, from): (DVec3, DVec3),
+    r: f64,
+) -> Option<(Vec<usize>, bool)> {
+    let g = frame.geometry;
+    let built = lists.builds;
+    let by_travel = frame.valid_by_travel(lists, j, x, from, r);
+    frame.ensure(lists, j, x, from, r);
+    if lists.builds > built {
+        return None;
+    }
+    let (s, len) = lists.range[j];
+    let list = &lists.tris[s as usize..(s + len) as usize];
+    let mut in_reach = Vec::new();
+    for (t, f) in g.faces.iter().enumerate() {
+        let [a, b, c] = f.corners;
+        let d_end = (x - closest_on_triangle(x, a, b, c).point).length();
+        let [a, b, c] = g.start_corners(t);
+        let d_start = (from - closest_on_triangle(from, a, b, c).point).length();
+        if d_end <= r || d_start <= r {
+            assert!(
+                list.contains(&(t as u32)),
+                "particle {j}: triangle {t} at {d_end} (end) / {d_start} (start) not listed"
+            );
+            in_reach.push(t);
+        }
+    }
+    Some((in_reach, by_travel))
+}
+
 /// Particles riding on a ball that moves fast (4 cm a frame, far more than the lists' skin
 /// every substep) and ripples, over 12 frames of 10 substeps: wherever a list stands without
 /// a rebuild, it holds every triangle within the thickness of the particle and of its path's
@@ -171,30 +208,14 @@ fn riding_lists_hold_every_triangle_in_reach() {
                     })
                     .unwrap_or(0);
                 *xj += motion[near_v] / substeps as f64 + rng.cube(0.002);
-                let built = lists.builds;
-                let global = frame_of.valid_by_travel(&lists, j, *xj, from, r);
-                frame_of.ensure(&mut lists, j, *xj, from, r);
-                builds += lists.builds - built;
-                if lists.builds > built {
+                let Some((in_reach, by_travel)) =
+                    standing_list(&frame_of, &mut lists, j, (*xj, from), r)
+                else {
+                    builds += 1;
                     continue;
-                }
-                riding += usize::from(!global);
-                let (s, len) = lists.range[j];
-                let list = &lists.tris[s as usize..(s + len) as usize];
-                for (t, f) in g.faces.iter().enumerate() {
-                    let [a, b, c] = f.corners;
-                    let d_end = (*xj - closest_on_triangle(*xj, a, b, c).point).length();
-                    let [a, b, c] = g.start_corners(t);
-                    let d_start = (from - closest_on_triangle(from, a, b, c).point).length();
-                    if d_end <= r || d_start <= r {
-                        assert!(
-                            list.contains(&(t as u32)),
-                            "frame {frame} substep {k}, particle {j}: triangle {t} at {d_end} \
-                             (end) / {d_start} (start) not listed"
-                        );
-                        checked += 1;
-                    }
-                }
+                };
+                riding += usize::from(!by_travel);
+                checked += in_reach.len();
             }
             // Particles that drift off are put back near the surface.
             for xj in x.iter_mut() {
@@ -278,30 +299,16 @@ fn riding_lists_see_a_part_closing_in() {
             for (j, xj) in x.iter_mut().enumerate() {
                 let from = *xj;
                 *xj += DVec3::X * 0.004 + rng.cube(0.0005);
-                let built = lists.builds;
-                let by_travel = frame_of.valid_by_travel(&lists, j, *xj, from, r);
-                frame_of.ensure(&mut lists, j, *xj, from, r);
-                if lists.builds > built {
+                let Some((in_reach, by_travel)) =
+                    standing_list(&frame_of, &mut lists, j, (*xj, from), r)
+                else {
                     continue;
-                }
+                };
                 riding += usize::from(!by_travel);
-                let (s, len) = lists.range[j];
-                let list = &lists.tris[s as usize..(s + len) as usize];
-                for (t, f) in g.faces.iter().enumerate() {
-                    let [a, b, c] = f.corners;
-                    let d_end = (*xj - closest_on_triangle(*xj, a, b, c).point).length();
-                    let [a, b, c] = g.start_corners(t);
-                    let d_start = (from - closest_on_triangle(from, a, b, c).point).length();
-                    if d_end <= r || d_start <= r {
-                        assert!(
-                            list.contains(&(t as u32)),
-                            "frame {frame} substep {k}, particle {j}: triangle {t} at {d_end} \
-                             (end) / {d_start} (start) not listed"
-                        );
-                        let sheet = g.triangles[t][0] as usize / per_sheet;
-                        near_ceiling += usize::from(sheet == 1);
-                        near_wall += usize::from(sheet == 2);
-                    }
+                for t in in_reach {
+                    let sheet = g.triangles[t][0] as usize / per_sheet;
+                    near_ceiling += usize::from(sheet == 1);
+                    near_wall += usize::from(sheet == 2);
                 }
             }
         }
