@@ -267,7 +267,10 @@ def dressed(r):
     for f, label in [("glb cape: solve + skinned body + self-collision",
                       "solve + skinned-body contact + self-collision"),
                      ("glb cape: solve + skinned body", "solve + skinned-body contact"),
-                     ("glb cape: solve only", "solve only (no contact)")]:
+                     ("glb cape: solve only", "solve only (no contact)"),
+                     ("glb cape 8k: solve + skinned body",
+                      "8,097-particle cape (`cape_fine.toml`): solve + skinned-body contact"),
+                     ("glb cape 8k: solve only", "8,097-particle cape: solve only (no contact)")]:
         print(f"| {label} | {fmt(ms(r, f'dressed walker frame/{f}'))} |")
     print()
 
