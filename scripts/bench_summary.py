@@ -268,9 +268,11 @@ def dressed(r):
                       "solve + skinned-body contact + self-collision"),
                      ("glb cape: solve + skinned body", "solve + skinned-body contact"),
                      ("glb cape: solve only", "solve only (no contact)"),
-                     ("glb cape 8k: solve + skinned body",
-                      "8,097-particle cape (`cape_fine.toml`): solve + skinned-body contact"),
-                     ("glb cape 8k: solve only", "8,097-particle cape: solve only (no contact)")]:
+                     *[(f"glb cape 8k, frame {n}: {what}",
+                        f"8,097-particle cape (`cape_fine.toml`), frames {n + 2}–{n + 11}: {label}")
+                       for n in (30, 90, 150)
+                       for what, label in (("solve + skinned body", "solve + skinned-body contact"),
+                                           ("solve only", "solve only (no contact)"))]]:
         print(f"| {label} | {fmt(ms(r, f'dressed walker frame/{f}'))} |")
     print()
 
