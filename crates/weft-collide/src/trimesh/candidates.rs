@@ -256,21 +256,24 @@ impl MeshFrame<'_> {
         let radius = r * (1.0 + SKIN) + (from - x).length() + (g.travel - g.travel_before);
         let old = lists.range[j];
         lists.live -= (old.1 + lists.guard[j]) as usize;
-        lists.guard[j] = 0;
-        lists.riding[j] = Riding::NONE;
-        if self.build_riding(lists, j, (x, from), radius, r) {
-            return;
-        }
         let (lo, hi) = g.bounds();
         let outside_box = box_distance_squared(x, lo, hi).sqrt();
         // Inside a closed mesh's box an empty list needs the nearest triangle of all (the
         // inside flag and the clearance): the same search finds it.
         let deep = g.closed() && outside_box == 0.0;
         let start = lists.tris.len();
-        let nearest = g.within(x, radius, deep, &mut lists.tris);
-        let len = lists.tris.len() - start;
-        lists.live += len;
+        let (nearest, guard, riding) = match self.riding_search(lists, (x, from), radius, r, deep) {
+            Some(found) => found,
+            None => {
+                let nearest = g.within(x, radius, deep, &mut lists.tris);
+                (nearest, 0, Riding::NONE)
+            }
+        };
+        let len = lists.tris.len() - start - guard;
+        lists.live += len + guard;
         lists.range[j] = (start as u32, len as u32);
+        lists.guard[j] = guard as u32;
+        lists.riding[j] = riding;
         lists.anchor[j] = x;
         lists.travel[j] = g.travel_before;
         let (clearance, inside) = match nearest {
@@ -287,71 +290,56 @@ impl MeshFrame<'_> {
         lists.inside[j] = inside;
     }
 
-    /// On a deforming mesh, builds particle `j`'s list at `x` (on a path from `from`) with
-    /// `radius` as a riding list (`riding`), riding with the particle's own motion over the
-    /// substep, scaled to the frame; false (and nothing built) on the substep's later
-    /// projections (no motion to ride with), or where no triangle is within the radius (an
-    /// empty list keeps the clearance of the nearest triangle of all instead).
-    fn build_riding(
+    /// On a deforming mesh, the search for particle `j`'s list at `x` (on a path from `from`)
+    /// with `radius` as a riding list (`riding`), riding with the particle's own motion over
+    /// the substep, scaled to the frame: the list and then its guard appended to the arena,
+    /// and (the nearest listed triangle, the guard's length, the certificate). `None`, and
+    /// nothing appended, on the substep's later projections (no motion to ride with), where a
+    /// plain list would last the frame out, or where the list is empty and `deep` (inside a
+    /// closed mesh's box, where an empty list needs the nearest triangle of all for its side).
+    fn riding_search(
         &self,
         lists: &mut ChunkLists,
-        j: usize,
         (x, from): (DVec3, DVec3),
         radius: f64,
         r: f64,
-    ) -> bool {
+        deep: bool,
+    ) -> Option<(Option<MeshPoint>, usize, Riding)> {
         let g = self.geometry;
         let (w_before, w) = g.frame_span;
         if g.frame_id == 0 || !self.fresh || w <= w_before {
-            return false;
+            return None;
         }
         // Only where a plain list would not last the frame out: its skin used up by the
         // particle and the surface each moving as far as the fastest vertex did this substep.
         let substep = g.travel - g.travel_before;
         if r * SKIN * (w - w_before) >= 2.0 * substep * (1.0 - w) {
-            return false;
+            return None;
         }
         let motion = (x - from) / (w - w_before);
         if !motion.is_finite() {
-            return false;
+            return None;
         }
         let outer = radius + GUARD * r;
-        let k = 1.0 - g.frame_span.1;
         let start = lists.tris.len();
         let mut guard = std::mem::take(&mut lists.scratch);
         guard.clear();
-        let (nearest, spread) =
-            g.within_riding(x, (radius, outer), (motion, k), &mut lists.tris, &mut guard);
-        let len = lists.tris.len() - start;
-        let (lo, hi) = g.bounds();
-        let outside_box = box_distance_squared(x, lo, hi).sqrt();
-        // An empty list inside a closed mesh's box needs the nearest triangle of all for its
-        // side: the plain search finds it.
-        let side = match nearest {
-            Some(p) if len > 0 => Some((radius, p.distance < 0.0)),
-            _ if g.closed() && outside_box == 0.0 => None,
-            _ => Some((radius.max(outside_box), false)),
-        };
-        let built = match side {
-            Some((clearance, inside)) => {
-                lists.tris.extend_from_slice(&guard);
-                lists.guard[j] = guard.len() as u32;
-                lists.live += len + guard.len();
-                lists.range[j] = (start as u32, len as u32);
-                lists.anchor[j] = x;
-                lists.travel[j] = g.travel_before;
-                lists.radius[j] = clearance;
-                lists.inside[j] = inside;
-                lists.riding[j] = Riding::new(g, x, motion, spread, (radius, outer));
-                true
-            }
-            None => {
-                lists.tris.truncate(start);
-                false
-            }
+        let (nearest, spread) = g.within_riding(
+            x,
+            (radius, outer),
+            (motion, 1.0 - w),
+            &mut lists.tris,
+            &mut guard,
+        );
+        let found = if lists.tris.len() == start && deep {
+            None
+        } else {
+            lists.tris.extend_from_slice(&guard);
+            let riding = Riding::new(g, x, motion, spread, (radius, outer));
+            Some((nearest, guard.len(), riding))
         };
         lists.scratch = guard;
-        built
+        found
     }
 
     /// The earliest crossing of the path `from → x` with a listed triangle: (crossing,
