@@ -39,6 +39,27 @@ struct Motions {
     radius: [f32; WIDTH],
 }
 
+impl Wide {
+    /// The squared f32 distances from the point `p` (per axis, splat) to the four children's
+    /// boxes (zero inside).
+    #[inline(always)]
+    fn distances_squared(&self, p: [Vec4; 3]) -> Vec4 {
+        let d = |a: usize| {
+            let (lo, hi) = (Vec4::from_array(self.lo[a]), Vec4::from_array(self.hi[a]));
+            (lo - p[a]).max(p[a] - hi).max(Vec4::ZERO)
+        };
+        let (dx, dy, dz) = (d(0), d(1), d(2));
+        dx * dx + dy * dy + dz * dz
+    }
+}
+
+/// `v` in f32 (per axis, splat) and a bound on how far rounding moved it.
+fn splat32(v: DVec3) -> ([Vec4; 3], f64) {
+    let v32 = v.as_vec3();
+    let moved = (v - v32.as_dvec3()).length() * (1.0 + 1e-6);
+    ([v32.x, v32.y, v32.z].map(Vec4::splat), moved)
+}
+
 /// The four-wide hierarchy, root first, with the binary node behind each child (to refit).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct WideBvh {
@@ -71,15 +92,15 @@ fn up(x: f64) -> f32 {
 }
 
 impl WideBvh {
-    /// The four-wide copy of `bvh`: each node takes up to four of the binary tree's nodes
-    /// below it, opening the inner one with most primitives first.
+    /// The four-wide copy of `bvh`'s shape: each node takes up to four of the binary tree's
+    /// nodes below it, opening the inner one with most primitives first. Its boxes are set by
+    /// [`Self::refit`] (`Bvh::build` refits at once).
     pub fn of(bvh: &Bvh) -> Self {
         let mut wide = Self::default();
         if bvh.nodes.is_empty() {
             return wide;
         }
         wide.push(bvh, 0);
-        wide.refit(bvh);
         wide
     }
 
@@ -190,8 +211,7 @@ impl WideBvh {
         if self.nodes.is_empty() {
             return;
         }
-        let x32 = x.as_vec3();
-        let e = (x - x32.as_dvec3()).length() * (1.0 + 1e-6);
+        let (p, e) = splat32(x);
         let threshold = |limit: f64| -> f32 {
             if limit.is_nan() {
                 return f32::INFINITY;
@@ -201,7 +221,6 @@ impl WideBvh {
         };
         let mut limit = limit;
         let mut cut = threshold(limit);
-        let (px, py, pz) = (Vec4::splat(x32.x), Vec4::splat(x32.y), Vec4::splat(x32.z));
         // (squared distance, node or first primitive, primitives: 0 for a node)
         let mut stack = [(0f32, 0u32, 0u32); STACK];
         let mut top = 1;
@@ -222,13 +241,7 @@ impl WideBvh {
                 continue;
             }
             let node = &self.nodes[at as usize];
-            let axis = |a: usize, p: Vec4| {
-                let lo = Vec4::from_array(node.lo[a]);
-                let hi = Vec4::from_array(node.hi[a]);
-                (lo - p).max(p - hi).max(Vec4::ZERO)
-            };
-            let (dx, dy, dz) = (axis(0, px), axis(1, py), axis(2, pz));
-            let d = (dx * dx + dy * dy + dz * dz).to_array();
+            let d = node.distances_squared(p).to_array();
             // The children within the cut, farthest pushed first (popped last).
             let mut near = [(0f32, 0usize); WIDTH];
             let mut n = 0;
@@ -276,30 +289,20 @@ impl WideBvh {
             });
             return;
         }
-        let x32 = x.as_vec3();
-        let e = (x - x32.as_dvec3()).length() * (1.0 + 1e-6);
+        let (p, e) = splat32(x);
         // The reference motion in f32, and how far it was moved by rounding.
-        let m32 = motion.as_vec3();
-        let em = (motion - m32.as_dvec3()).length() * (1.0 + 1e-6);
+        let (m, em) = splat32(motion);
         let base = up((outer + e + k * em) * (1.0 + 1e-5) + 1e-30);
         let k32 = up(k * (1.0 + 1e-6));
-        let (px, py, pz) = (Vec4::splat(x32.x), Vec4::splat(x32.y), Vec4::splat(x32.z));
-        let (mx, my, mz) = (Vec4::splat(m32.x), Vec4::splat(m32.y), Vec4::splat(m32.z));
         let mut stack = [0u32; STACK];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let at = stack[top] as usize;
             let (node, motions) = (&self.nodes[at], &self.motions[at]);
-            let axis = |a: usize, p: Vec4| {
-                let lo = Vec4::from_array(node.lo[a]);
-                let hi = Vec4::from_array(node.hi[a]);
-                (lo - p).max(p - hi).max(Vec4::ZERO)
-            };
-            let (dx, dy, dz) = (axis(0, px), axis(1, py), axis(2, pz));
-            let d2 = dx * dx + dy * dy + dz * dz;
-            let c = |a: usize, m: Vec4| Vec4::from_array(motions.centre[a]) - m;
-            let (cx, cy, cz) = (c(0, mx), c(1, my), c(2, mz));
+            let d2 = node.distances_squared(p);
+            let c = |a: usize| Vec4::from_array(motions.centre[a]) - m[a];
+            let (cx, cy, cz) = (c(0), c(1), c(2));
             // How far a child's motions lie from the reference, at most (rounded up a few
             // ulps by the factor), and the reach that child must lie beyond.
             let dev = ((cx * cx + cy * cy + cz * cz).sqrt() + Vec4::from_array(motions.radius))
