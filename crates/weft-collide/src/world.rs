@@ -32,6 +32,7 @@ use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::deforming::MeshAnimation;
 use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::grid_run::resolve_grid_run;
+use crate::trimesh::list_run::resolve_list_run;
 
 /// What the last substep's contacts did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -412,9 +413,13 @@ impl CollisionWorld {
                                 Some(grid) => {
                                     frame.resolve_in_grid(*grid, i, prev[i], x, thickness[i])
                                 }
-                                None => {
-                                    frame.resolve(&mut lists[slot], j, prev[i], x, thickness[i])
-                                }
+                                None => frame.resolve_listed(
+                                    &mut lists[slot],
+                                    j,
+                                    prev[i],
+                                    x,
+                                    thickness[i],
+                                ),
                             };
                             slot += 1;
                             contacts += o.contacts;
@@ -787,6 +792,9 @@ impl CollisionWorld {
             Some(s) => Some(Blocked::Surface(s)),
             None => match &frames[j] {
                 Some((frame, Some(grid))) if frame.settles() => Some(Blocked::Mesh(frame, *grid)),
+                Some((frame, None)) if frame.lists_settle() => {
+                    Some(Blocked::Lists(frame, listed(&frames[..j])))
+                }
                 _ => None,
             },
         };
@@ -823,6 +831,9 @@ impl CollisionWorld {
                 Some((_, Blocked::Mesh(frame, grid))) => {
                     total = total.merge(resolve_grid_run(frame, grid, r, &mut run));
                 }
+                Some((_, Blocked::Lists(frame, slot))) => {
+                    total = total.merge(resolve_list_run(frame, &mut lists[slot], r, &mut run));
+                }
                 None => {}
             }
             k = stop + 1;
@@ -837,6 +848,9 @@ enum Blocked<'f, 'a> {
     Surface(Surface),
     /// A mesh still over the substep, on its grid.
     Mesh(&'f MeshFrame<'a>, GridRef<'a>),
+    /// A mesh with candidate lists whose pose is the identity throughout, and the slot of
+    /// its lists among the run's.
+    Lists(&'f MeshFrame<'a>, usize),
 }
 
 impl CollisionWorld {
@@ -931,7 +945,7 @@ impl CollisionWorld {
                     Some(grid) => frame.resolve_in_grid(*grid, i, prev, x, r),
                     None => {
                         slot += 1;
-                        frame.resolve(&mut lists[slot - 1], i - start, prev, x, r)
+                        frame.resolve_listed(&mut lists[slot - 1], i - start, prev, x, r)
                     }
                 };
                 out = out.merge(o.into());

@@ -53,20 +53,20 @@ const SCAN_BLOCK: usize = 32;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ChunkLists {
     /// Where each particle was when its list was built (collider frame).
-    anchor: Vec<DVec3>,
+    pub(super) anchor: Vec<DVec3>,
     /// The list holds every triangle within this distance of the anchor; NaN: no list.
-    radius: Vec<f64>,
+    pub(super) radius: Vec<f64>,
     /// The surface's travel bound before the substep of the build.
-    travel: Vec<f64>,
+    pub(super) travel: Vec<f64>,
     /// Whether the anchor was inside the closed mesh.
-    inside: Vec<bool>,
+    pub(super) inside: Vec<bool>,
     /// The particle's position after the last projection (collider frame, end pose).
-    last: Vec<DVec3>,
+    pub(super) last: Vec<DVec3>,
     /// The triangle each particle touched last (tested first: it tightens the search), or
     /// `u32::MAX`.
-    hint: Vec<u32>,
+    pub(super) hint: Vec<u32>,
     /// Each particle's list: `tris[start .. start + len]`.
-    range: Vec<(u32, u32)>,
+    pub(super) range: Vec<(u32, u32)>,
     /// On a deforming mesh, the length of each list's guard (the unlisted triangles its
     /// riding certificate bounds), stored after it: `tris[start + len ..][.. guard]`.
     guard: Vec<u32>,
@@ -76,7 +76,7 @@ pub(crate) struct ChunkLists {
     scratch: Vec<u32>,
     /// The lists, end to end; rebuilt lists are appended and the arena compacted when half
     /// of it is stale.
-    tris: Vec<u32>,
+    pub(super) tris: Vec<u32>,
     /// Entries in use.
     live: usize,
     /// The arena's spare buffer, for compaction.
@@ -228,7 +228,14 @@ impl MeshFrame<'_> {
     /// Whether particle `j`'s list holds every triangle within `r` of `x` and of the path
     /// `from → x` (local): by its bound on the whole mesh's travel, or by its riding
     /// certificate.
-    fn valid(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
+    pub(super) fn valid(
+        &self,
+        lists: &ChunkLists,
+        j: usize,
+        x: DVec3,
+        from: DVec3,
+        r: f64,
+    ) -> bool {
         self.valid_by_travel(lists, j, x, from, r)
             || lists.riding[j].holds(self.geometry, x, from, self.fresh, r)
     }
@@ -247,7 +254,7 @@ impl MeshFrame<'_> {
     }
 
     /// Makes particle `j`'s list valid for position `x` and path start `from` (local).
-    fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+    pub(super) fn ensure(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
         if self.valid(lists, j, x, from, r) {
             return;
         }

@@ -12,6 +12,7 @@ pub(crate) mod contact_grid;
 pub(crate) mod deforming;
 pub(crate) mod grid_contacts;
 pub(crate) mod grid_run;
+pub(crate) mod list_run;
 pub(crate) mod normals;
 #[cfg(test)]
 mod queries_vs_brute_force;
