@@ -14,10 +14,9 @@
 //!
 //! Every other particle goes through `resolve`, from where it was. What a lane does depends on
 //! that particle alone, the run's last particles (past the last full block) take the same
-//! test a lane at a time, and so does a particle resolved on its own in the solver's fused
-//! frame ([`MeshFrame::resolve_listed`]): the bits do not depend on where a particle falls.
-//! The general loop (`CollisionWorld::project`) keeps `resolve` alone: one particle at a time,
-//! the test cost more than it saved (riding lists on a skinned body, 10 % of the frame).
+//! test a lane at a time, and so does a particle resolved on its own, in the fused frame or
+//! the general loop ([`MeshFrame::resolve_listed`]): the bits do not depend on where a
+//! particle falls, nor on which loop runs it.
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
@@ -156,8 +155,8 @@ fn block<const L: usize>(
 impl MeshFrame<'_> {
     /// Particle `j` of `lists` (thickness `r`, previous position `prev`, current `x`) as a
     /// run of one: the lane test where [`Self::lists_settle`] holds, else (and where the test
-    /// leaves it open) `resolve`. In the fused frame every particle of a mesh with lists takes
-    /// this path or a block of the same test, so its bits do not depend on which.
+    /// leaves it open) `resolve`. Every particle of a mesh with lists takes this path or a
+    /// block of the same test, so its bits do not depend on which.
     pub(crate) fn resolve_listed(
         &self,
         lists: &mut ChunkLists,
