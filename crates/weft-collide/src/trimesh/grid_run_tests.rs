@@ -1,7 +1,7 @@
 //! A run of particles through the block path against the same particles one at a time.
 
 use glam::{DQuat, DVec3};
-use weft_solver::{Contacts, ParticleRun, SimdPath};
+use weft_solver::{Contacts, SimdPath};
 
 use super::resolve_grid_run;
 use crate::analytic::WorldPose;
@@ -12,30 +12,8 @@ use crate::trimesh::MeshGeometry;
 use crate::trimesh::candidates::MeshFrame;
 use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::grid_contacts::GridParticles;
+use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
-
-/// Positions, per axis.
-type Axes = [Vec<f64>; 3];
-
-/// Particles about mesh `g`: near its surface on either side, on it, deep inside (one in
-/// six), and far away (one in five), thickness `r`.
-fn particles(g: &MeshGeometry, rng: &mut Rng, n: usize, r: f64) -> Vec<DVec3> {
-    (0..n)
-        .map(|k| {
-            if k % 5 == 0 {
-                return rng.cube(1.5);
-            }
-            let dir = rng.cube(1.0).normalize_or(DVec3::Y);
-            let p = g.nearest(dir, f64::INFINITY).expect("nearest");
-            let h = if k % 6 == 0 { -3.0 } else { 2.5 * rng.next() };
-            p.closest.point + p.normal * r * h
-        })
-        .collect()
-}
-
-fn axes(p: &[DVec3]) -> Axes {
-    [0, 1, 2].map(|k| p.iter().map(|v| v[k]).collect())
-}
 
 /// Steps particles about `m` (at the origin, or `placed` elsewhere and turned) for several
 /// substeps (two passes each: the substep's first and
@@ -58,7 +36,7 @@ fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath, placed: bo
     let mut rng = Rng(seed);
     let n = 1003;
     let (one, many) = (GridParticles::new(n), GridParticles::new(n));
-    let start: Vec<DVec3> = particles(&g, &mut rng, n, r)
+    let start: Vec<DVec3> = about(&g, &mut rng, n, r)
         .into_iter()
         .map(|p| pose.transform_point(p))
         .collect();
@@ -91,32 +69,14 @@ fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath, placed: bo
                     expected = expected.merge(o.into());
                 }
             }
-            let mut total = Contacts::default();
             // Runs of 0..100, 100..613 and 613..1003: full blocks and remainders.
-            for (s, e) in [(0, 100), (100, 613), (613, n)] {
-                let [x0, x1, x2] = &mut b;
-                let mut run = ParticleRun {
-                    start: s,
-                    x: [&mut x0[s..e], &mut x1[s..e], &mut x2[s..e]],
-                    prev: [0, 1, 2].map(|k| &prev_axes[k][s..e]),
-                    w: &w[s..e],
-                    path,
-                };
-                let o = resolve_grid_run(&frame, (&grid, &many), &thickness[s..e], &mut run);
-                total = total.merge(o);
-            }
-            for j in 0..n {
-                for k in 0..3 {
-                    assert_eq!(
-                        a[j][k].to_bits(),
-                        b[k][j].to_bits(),
-                        "{path:?}, step {step}, fresh {fresh}, particle {j}, axis {k}"
-                    );
-                }
-            }
-            assert_eq!(total.contacts, expected.contacts, "{path:?}, step {step}");
-            assert_eq!(total.swept, expected.swept, "{path:?}, step {step}");
-            assert_eq!(total.depth.to_bits(), expected.depth.to_bits());
+            let runs = [(0, 100), (100, 613), (613, n)];
+            let total = over_runs(&mut b, (&prev_axes, &w), &runs, path, |k, mut run| {
+                let (s, e) = runs[k];
+                resolve_grid_run(&frame, (&grid, &many), &thickness[s..e], &mut run)
+            });
+            let what = format!("{path:?}, step {step}, fresh {fresh}");
+            assert_same_bits(&a, &b, (total, expected), &what);
             assert!(
                 one.snapshot() == many.snapshot(),
                 "{path:?}, step {step}: state"

@@ -2,7 +2,7 @@
 //! lane test against `MeshFrame::resolve` alone, on deforming and still meshes.
 
 use glam::{DQuat, DVec3};
-use weft_solver::{Contacts, ParticleRun, SimdPath};
+use weft_solver::{Contacts, SimdPath};
 
 use super::resolve_list_run;
 use crate::analytic::WorldPose;
@@ -11,6 +11,7 @@ use crate::friction::Friction;
 use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
+use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
 
 thread_local! {
@@ -18,34 +19,11 @@ thread_local! {
     pub(super) static SETTLED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
-/// Positions, per axis.
-type Axes = [Vec<f64>; 3];
-
 /// Thickness of every particle (m).
 const R: f64 = 0.02;
 
 /// Substeps per frame of the deforming meshes.
 const SUBSTEPS: usize = 4;
-
-/// Particles about mesh `g`: near its surface on either side, on it, deep inside (one in
-/// six), and far away (one in five).
-fn particles(g: &MeshGeometry, rng: &mut Rng, n: usize) -> Vec<DVec3> {
-    (0..n)
-        .map(|k| {
-            if k % 5 == 0 {
-                return rng.cube(1.5);
-            }
-            let dir = rng.cube(1.0).normalize_or(DVec3::Y);
-            let p = g.nearest(dir, f64::INFINITY).expect("nearest");
-            let h = if k % 6 == 0 { -3.0 } else { 2.5 * rng.next() };
-            p.closest.point + p.normal * R * h
-        })
-        .collect()
-}
-
-fn axes(p: &[DVec3]) -> Axes {
-    [0, 1, 2].map(|k| p.iter().map(|v| v[k]).collect())
-}
 
 /// The mesh's vertices at time `t`: still, or breathing (each vertex scaled about the origin
 /// by 1 + 3 % sin(2π(t + 2y)), a few mm a substep).
@@ -77,7 +55,7 @@ fn passes(
     let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
     let friction = Friction::new(0.8, 0.6);
     let mut rng = Rng(seed);
-    let mut a = particles(&g, &mut rng, n);
+    let mut a = about(&g, &mut rng, n, R);
     let mut contacts = 0;
     for frame_no in 0..3 {
         g.begin_frame(&shape(&m.vertices, 0.05 * (frame_no + 1) as f64, deforming));
@@ -123,30 +101,11 @@ fn run_matches_particles(m: &TriangleMesh, seed: u64, path: SimdPath, deforming:
                 expected = expected.merge(o.into());
             }
         }
-        let mut total = Contacts::default();
-        for (&(s, e), lists) in runs.iter().zip(&mut many) {
-            let [x0, x1, x2] = &mut b;
-            let mut run = ParticleRun {
-                start: s,
-                x: [&mut x0[s..e], &mut x1[s..e], &mut x2[s..e]],
-                prev: [0, 1, 2].map(|k| &prev_axes[k][s..e]),
-                w: &w[s..e],
-                path,
-            };
-            total = total.merge(resolve_list_run(frame, lists, &thickness[s..e], &mut run));
-        }
-        for j in 0..n {
-            for k in 0..3 {
-                assert_eq!(
-                    a[j][k].to_bits(),
-                    b[k][j].to_bits(),
-                    "{path:?}, particle {j}, axis {k}"
-                );
-            }
-        }
-        assert_eq!(total.contacts, expected.contacts, "{path:?}");
-        assert_eq!(total.swept, expected.swept, "{path:?}");
-        assert_eq!(total.depth.to_bits(), expected.depth.to_bits(), "{path:?}");
+        let total = over_runs(&mut b, (&prev_axes, &w), &runs, path, |k, mut run| {
+            let (s, e) = runs[k];
+            resolve_list_run(frame, &mut many[k], &thickness[s..e], &mut run)
+        });
+        assert_same_bits(a, &b, (total, expected), &format!("{path:?}"));
         total.contacts
     });
     assert!(contacts > 1000, "{path:?}: {contacts} contacts");

@@ -18,6 +18,8 @@ pub(crate) mod normals;
 mod queries_vs_brute_force;
 pub(crate) mod riding;
 #[cfg(test)]
+pub(crate) mod test_particles;
+#[cfg(test)]
 mod vs_parry;
 pub(crate) mod wide_bvh;
 
