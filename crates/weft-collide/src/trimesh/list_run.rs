@@ -465,9 +465,11 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// The least squared distance from each lane's position in `x` (thickness `r`) where `which`
-/// to the triangles of its list but `skip`: each one's bound (`Planes`), and where that does
-/// not clear r (it is loose by the surface's travel still to come in the frame), the distance
-/// itself, worked out for a block of such triangles at a time.
+/// to the triangles of its list but `skip`: on a still surface each one's bound (`Planes`)
+/// and, where that does not clear r, the distance itself; on a moving one the distance
+/// always (its planes are the frame end's, every bound less the surface's travel still to
+/// come, and most neighbours of a touched face fail them). Distances are worked out for a
+/// block of triangles at a time.
 #[inline(always)]
 fn others<const L: usize>(
     g: &MeshGeometry,
@@ -491,7 +493,11 @@ fn others<const L: usize>(
             if t == skip[l] {
                 continue;
             }
-            let bound = f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin));
+            let bound = if g.moving {
+                0.0
+            } else {
+                f64::from(g.planes[t as usize].distance_squared_bound(x32, g.margin))
+            };
             if bound >= r2 {
                 bounds = bounds.min(bound);
             } else if pending.add(l, t) {
