@@ -7,8 +7,8 @@
 //! - a particle whose list is empty: nothing within reach, nothing to do;
 //! - a particle whose path is short (no sweep is due) and whose list holds no triangle within
 //!   its thickness r but, perhaps, the one it touched last, touched from in front and inside
-//!   its face (each other triangle cleared by its plane bound or, where that is too loose, by
-//!   its distance, worked out a block of triangles at a time): it is pushed along that face's
+//!   its face (each other triangle cleared by its distance, worked out a block of triangles at
+//!   a time, or on a still mesh by its plane bound first): it is pushed along that face's
 //!   normal to r and slid back by friction against the surface's motion there, as `resolve`
 //!   would, and settles if every other listed triangle is still r away.
 //!
