@@ -741,9 +741,10 @@ impl ParticleContacts for CollisionWorld {
     /// particle meets the colliders in the same order, and what one particle meets depends on
     /// that particle alone, so the bits are the same): the substep's sweep first, then each
     /// still half-space or ball a block of particles at a time ([`resolve_still`]), each mesh
-    /// still over the substep on its grid a block at a time too ([`resolve_grid_run`]), any
-    /// other collider particle by particle (a mesh off a grid through the run's candidate
-    /// lists, locked for the pass).
+    /// still over the substep on its grid a block at a time too ([`resolve_grid_run`]), a mesh
+    /// off a grid whose pose is the identity through the run's candidate lists (locked for the
+    /// pass) a block at a time as well ([`resolve_list_run`]), any other collider particle by
+    /// particle.
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
         let start = run.start;

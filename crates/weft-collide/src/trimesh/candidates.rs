@@ -228,14 +228,7 @@ impl MeshFrame<'_> {
     /// Whether particle `j`'s list holds every triangle within `r` of `x` and of the path
     /// `from → x` (local): by its bound on the whole mesh's travel, or by its riding
     /// certificate.
-    pub(super) fn valid(
-        &self,
-        lists: &ChunkLists,
-        j: usize,
-        x: DVec3,
-        from: DVec3,
-        r: f64,
-    ) -> bool {
+    fn valid(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
         self.valid_by_travel(lists, j, x, from, r)
             || lists.riding[j].holds(self.geometry, x, from, self.fresh, r)
     }

@@ -217,10 +217,7 @@ fn lanes<const L: usize>(
             continue;
         }
         let at = |v: &[[f64; L]; 3]| DVec3::new(v[0][l], v[1][l], v[2][l]);
-        let (xl, fl) = (at(x), at(&from));
-        if !frame.valid(lists, s + l, xl, fl, rr[l]) {
-            frame.ensure(lists, s + l, xl, fl, rr[l]);
-        }
+        frame.ensure(lists, s + l, at(x), at(&from), rr[l]);
         let lane = Lane::of(frame, lists, s + l, (x, &from, rr[l]), l);
         done[l] = lane.empty & lane.outside;
         near[l] = !lane.empty & lane.outside & lane.short;
