@@ -191,6 +191,16 @@ impl From<Outcome> for Contacts {
     }
 }
 
+impl From<Contacts> for Outcome {
+    fn from(c: Contacts) -> Self {
+        Self {
+            contacts: c.contacts,
+            depth: c.depth,
+            swept: c.swept,
+        }
+    }
+}
+
 impl MeshFrame<'_> {
     pub(super) fn to_local(&self, pose: &WorldPose, x: DVec3) -> DVec3 {
         if self.identity {
@@ -210,7 +220,7 @@ impl MeshFrame<'_> {
 
     /// How far the material point with barycentric weights `bary` on triangle `t` moved over
     /// the substep, in world space; exactly zero for a still surface.
-    fn surface_displacement(&self, t: usize, bary: [f64; 3]) -> DVec3 {
+    pub(super) fn surface_displacement(&self, t: usize, bary: [f64; 3]) -> DVec3 {
         let g = self.geometry;
         if self.still && !g.moving {
             return DVec3::ZERO;
@@ -234,7 +244,15 @@ impl MeshFrame<'_> {
     }
 
     /// [`Self::valid`] by the bound on the whole mesh's travel since the build alone.
-    fn valid_by_travel(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
+    #[inline]
+    pub(super) fn valid_by_travel(
+        &self,
+        lists: &ChunkLists,
+        j: usize,
+        x: DVec3,
+        from: DVec3,
+        r: f64,
+    ) -> bool {
         let g = self.geometry;
         let anchor = lists.anchor[j];
         // max(|x − anchor|, |from − anchor|) ≤ slack, compared squared.
@@ -342,6 +360,22 @@ impl MeshFrame<'_> {
         found
     }
 
+    /// Whether the path `from → x` is shorter than r/2 relative to the surface (its motion
+    /// this substep taken off, on the substep's first projection): it cannot cross the surface
+    /// from r away, where the last projection left the particle (as the closed-form shapes'
+    /// sweep).
+    #[inline]
+    pub(super) fn short_path(&self, from: DVec3, x: DVec3, r: f64) -> bool {
+        let g = self.geometry;
+        let surface = if self.fresh && g.moving {
+            g.travel - g.travel_before
+        } else {
+            0.0
+        };
+        let short = 0.5 * r - surface;
+        short >= 0.0 && (x - from).length_squared() <= short * short
+    }
+
     /// The earliest crossing of the path `from → x` with a listed triangle: (crossing,
     /// triangle).
     fn first_crossing(
@@ -354,15 +388,7 @@ impl MeshFrame<'_> {
         let g = self.geometry;
         let closed = g.closed();
         let moving = self.fresh && g.moving;
-        // A path shorter than r/2 (relative to the surface) cannot cross it from r away,
-        // where the last projection left the particle (as the closed-form shapes' sweep).
-        let surface = if moving {
-            g.travel - g.travel_before
-        } else {
-            0.0
-        };
-        let short = 0.5 * r - surface;
-        if short >= 0.0 && (x - from).length_squared() <= short * short {
+        if self.short_path(from, x, r) {
             return None;
         }
         let mut best: Option<(Crossing, usize)> = None;

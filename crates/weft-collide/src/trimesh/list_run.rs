@@ -172,26 +172,21 @@ impl MeshFrame<'_> {
         let before = [[prev.x], [prev.y], [prev.z]];
         let total = lanes::<1>(self, lists, j, (&mut at, &before), (&[r], [true]));
         *x = DVec3::new(at[0][0], at[1][0], at[2][0]);
-        Outcome {
-            contacts: total.contacts,
-            depth: total.depth,
-            swept: total.swept,
-        }
+        total.into()
     }
 }
 
-/// The lane test of particles `j0 .. j0 + L` of `lists` (see the module's notes) at `x`
+/// The lane test of particles `s .. s + L` of `lists` (see the module's notes) at `x`
 /// (moved in place), their substep starts `prev`, thicknesses `r`, taking part where `live`,
 /// then `MeshFrame::resolve` for each lane it left open, in order.
 #[inline(always)]
 fn lanes<const L: usize>(
     frame: &MeshFrame<'_>,
     lists: &mut ChunkLists,
-    j0: usize,
+    s: usize,
     (x, prev): (&mut [[f64; L]; 3], &[[f64; L]; 3]),
     (rr, live): (&[f64; L], [bool; L]),
 ) -> Contacts {
-    let s = j0;
     let mut from = *prev;
     // Done: the list holds and is empty. Near: the list holds and is not, the path is short
     // and the particle was outside: the hint's test follows. Open: `resolve`.
@@ -273,27 +268,15 @@ impl Lane {
         (x, from, r): (&[[f64; L]; 3], &[[f64; L]; 3], f64),
         l: usize,
     ) -> Self {
-        let g = frame.geometry;
-        let a = lists.anchor[j];
-        let a = a.to_array();
-        let q = sub(lane(x, l), a);
-        let e = sub(lane(from, l), a);
-        let slack = lists.radius[j] - (g.travel - lists.travel[j]) - r;
-        let reach2 =
-            (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).max(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-        // The surface's motion this substep, which a sweep allows for.
-        let surface = if frame.fresh && g.moving {
-            g.travel - g.travel_before
-        } else {
-            0.0
-        };
-        let p = sub(lane(x, l), lane(from, l));
-        let short = 0.5 * r - surface;
+        let (x, from) = (
+            DVec3::from_array(lane(x, l)),
+            DVec3::from_array(lane(from, l)),
+        );
         Self {
-            valid: (slack >= 0.0) & (reach2 <= slack * slack),
+            valid: frame.valid_by_travel(lists, j, x, from, r),
             empty: lists.range[j].1 == 0,
             outside: !lists.inside[j],
-            short: (short >= 0.0) & (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] <= short * short),
+            short: frame.short_path(from, x, r),
         }
     }
 }
@@ -382,18 +365,16 @@ fn settle<const L: usize>(
     if !push.contains(&true) {
         return Contacts::default();
     }
-    // The surface's displacement at the touched point (none where it is still), as
-    // `surface_displacement`: the friction's reference is the start position carried along.
+    // The friction's reference: the start position carried along with the surface's
+    // displacement at the touched point (none where it is still).
     let mut carried = *prev;
     if g.moving {
         for l in 0..L {
             if !push[l] {
                 continue;
             }
-            let t = g.triangles[tri[l] as usize];
             let bary = [1.0 - beta[l] - gamma[l], beta[l], gamma[l]];
-            let at = |v: &[DVec3]| (0..3).fold(DVec3::ZERO, |s, k| s + v[t[k] as usize] * bary[k]);
-            let moved = at(&g.end) - at(&g.start);
+            let moved = frame.surface_displacement(tri[l] as usize, bary);
             for k in 0..3 {
                 carried[k][l] += moved[k];
             }
