@@ -158,20 +158,12 @@ impl MeshFrame<'_> {
                 Settled::Done => {
                     *x = DVec3::new(moved[0][0], moved[1][0], moved[2][0]);
                     self.settled_in_grid(state, i, local, b.new_ball[0]);
-                    return Outcome {
-                        contacts: tally.contacts,
-                        depth: tally.depth,
-                        swept: 0,
-                    };
+                    return tally.into();
                 }
                 Settled::Rounds => {
                     *x = DVec3::new(moved[0][0], moved[1][0], moved[2][0]);
                     let o = self.rounds_after_settle((grid, state), i, prev, (x, local), from, r);
-                    return Outcome {
-                        contacts: tally.contacts + o.contacts,
-                        depth: tally.depth.max(o.depth),
-                        swept: o.swept,
-                    };
+                    return tally.merge(o.into()).into();
                 }
             }
         }
