@@ -5,12 +5,14 @@
 use std::sync::atomic::{AtomicU8, AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use glam::DVec3;
+use pulp::Scalar;
 
 use super::MeshPoint;
 use super::candidates::{MeshFrame, Outcome, ROUNDS};
 use super::closest::{Feature, closest_on_triangle};
 use super::contact_grid::{ContactGrid, Side};
-use super::grid_run::{Block, Placement, Settled, settle};
+use super::grid_lanes::Ops;
+use super::grid_run::{Placement, Settled, first_test};
 use super::normals::NONE;
 
 /// Triangles a particle's contact walks across from the one it touched last, at most.
@@ -143,25 +145,29 @@ impl MeshFrame<'_> {
         // The first test, as a block of one (`grid_run`): the same bits as in a run.
         if self.settles() {
             let place = Placement::of(self);
-            let mut b = Block::<1>::new();
-            let (wx, wp) = (x.to_array().map(|v| [v]), prev.to_array().map(|v| [v]));
-            let [t] = b.load(self, state, &place, (&wx, &wp), (&[r], [true]), i);
-            b.gather_all(grid.certs(), [t]);
-            let before = b.x;
-            let mut settled = [Settled::Open];
-            let tally = settle(&mut b, self.friction, &mut settled);
-            let moved = place.world(&wx, &before, &b.x, &b.pushed);
-            let local = DVec3::new(b.x[0][0], b.x[1][0], b.x[2][0]);
-            let from = DVec3::new(b.from[0][0], b.from[1][0], b.from[2][0]);
-            match settled[0] {
+            let (wx, wp) = (x.to_array(), prev.to_array());
+            let tested = first_test::<Scalar, 1>(
+                Ops(Scalar),
+                self,
+                (grid.certs(), state),
+                &place,
+                (&wx, &wp),
+                r,
+                [true],
+                i,
+            );
+            let tally = tested.verdict.contacts;
+            match tested.verdict.settled[0] {
                 Settled::Open => {}
                 Settled::Done => {
-                    *x = DVec3::new(moved[0][0], moved[1][0], moved[2][0]);
-                    self.settled_in_grid(state, i, local, b.new_ball[0]);
+                    *x = tested.world_at(0);
+                    self.settled_in_grid(state, i, tested.local_at(0), tested.verdict.new_ball[0]);
                     return tally.into();
                 }
                 Settled::Rounds => {
-                    *x = DVec3::new(moved[0][0], moved[1][0], moved[2][0]);
+                    *x = tested.world_at(0);
+                    let local = tested.local_at(0);
+                    let from = tested.path_start(0);
                     let o = self.rounds_after_settle((grid, state), i, prev, (x, local), from, r);
                     return tally.merge(o.into()).into();
                 }

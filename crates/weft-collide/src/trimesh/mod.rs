@@ -11,6 +11,7 @@ pub(crate) mod closest;
 pub(crate) mod contact_grid;
 pub(crate) mod deforming;
 pub(crate) mod grid_contacts;
+pub(crate) mod grid_lanes;
 pub(crate) mod grid_run;
 pub(crate) mod list_run;
 pub(crate) mod normals;
