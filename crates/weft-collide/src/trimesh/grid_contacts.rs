@@ -153,7 +153,7 @@ impl MeshFrame<'_> {
                 &place,
                 (&wx, &wp),
                 r,
-                [true],
+                true,
                 i,
             );
             let tally = tested.verdict.contacts;

@@ -102,12 +102,6 @@ impl<S: Simd> Ops<S> {
         let ones = self.sel(m, self.c(1.0), self.c(0.0));
         store::<S, L>(ones).map(|v| v != 0.0)
     }
-    /// A mask from lanes.
-    #[inline(always)]
-    pub fn mask<const L: usize>(self, b: [bool; L]) -> S::m64s {
-        let v = load::<S, L>(b.map(|b| if b { 1.0 } else { 0.0 }));
-        self.gt(v, self.c(0.0))
-    }
     /// a − b per axis.
     #[inline(always)]
     pub fn dif(self, a: &V3<S>, b: &V3<S>) -> V3<S> {
@@ -194,7 +188,8 @@ pub(crate) fn gather<S: Simd, const L: usize>(
 }
 
 /// The first test of every live lane against its triangle `f`, with the mesh still over the
-/// substep; moves the lanes it pushes. A lane is settled where its path lies in its clear
+/// substep; moves the lanes it pushes, and returns what it did with them and the mask of
+/// those it pushed. A lane is settled where its path lies in its clear
 /// ball (no point of the ball is within r of the mesh, so neither a contact nor a crossing),
 /// or where its path is shorter than r/2 (so no sweep is due) and either
 ///
@@ -212,7 +207,7 @@ pub(crate) fn settle<S: Simd, const L: usize>(
     in_ball: S::m64s,
     f: &[S::f64s; FIELDS],
     friction: Friction,
-) -> Verdict<L> {
+) -> (Verdict<L>, S::m64s) {
     let p = o.dif(&b.x, &b.from);
     let half = o.mul(o.c(0.5), b.r);
     let short = o.le(o.dot(&p, &p), o.mul(half, half));
@@ -267,12 +262,13 @@ pub(crate) fn settle<S: Simd, const L: usize>(
     let done_lanes = o.bits::<L>(done);
     let mut settled_out = done_lanes.map(|d| if d { Settled::Done } else { Settled::Open });
     if !o.any(push) {
-        return Verdict {
+        let verdict = Verdict {
             settled: settled_out,
             pushed: [false; L],
             new_ball,
             contacts: Contacts::default(),
         };
+        return (verdict, push);
     }
     // Pushed out along the normal, then friction on the slip since the substep's start.
     let (moved, slip2) = push_vectors(o, friction, &b.x, &b.prev, &normal, depth, push);
@@ -293,12 +289,13 @@ pub(crate) fn settle<S: Simd, const L: usize>(
             tally.depth = tally.depth.max(depth[l]);
         }
     }
-    Verdict {
+    let verdict = Verdict {
         settled: settled_out,
         pushed,
         new_ball,
         contacts: tally,
-    }
+    };
+    (verdict, push)
 }
 
 /// The push-out and friction of the lanes `push` against a still surface, as

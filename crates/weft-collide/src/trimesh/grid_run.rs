@@ -158,7 +158,7 @@ pub(crate) fn first_test<S: Simd, const L: usize>(
     place: &Placement,
     (wx, wp): (&V3<S>, &V3<S>),
     r: S::f64s,
-    live: [bool; L],
+    live: S::m64s,
     i0: usize,
 ) -> Tested<L> {
     debug_assert_eq!(L, S::F64_LANES);
@@ -177,24 +177,33 @@ pub(crate) fn first_test<S: Simd, const L: usize>(
         from,
         prev,
         r,
-        live: o.mask(live),
+        live,
         anchor: std::array::from_fn(|k| load::<S, L>(balls.map(|(c, _)| c[k]))),
         ball: load::<S, L>(balls.map(|(_, radius)| radius)),
     };
     let in_ball = b.in_ball(o);
-    let verdict = if o.any(o.and(b.live, o.not(in_ball))) {
+    let (verdict, moved) = if o.any(o.and(live, o.not(in_ball))) {
         let f = gather::<S, L>(certs, t);
-        settle::<S, L>(o, &mut b, in_ball, &f, frame.friction)
+        let (verdict, push) = settle::<S, L>(o, &mut b, in_ball, &f, frame.friction);
+        let moved = if o.any(push) {
+            world(o, place, wx, &x, &b.x, push)
+        } else {
+            *wx
+        };
+        (verdict, moved)
     } else {
         // Nothing within r of any path: no triangle to read.
-        Verdict {
-            settled: live.map(|l| if l { Settled::Done } else { Settled::Open }),
+        let settled = o
+            .bits::<L>(live)
+            .map(|l| if l { Settled::Done } else { Settled::Open });
+        let verdict = Verdict {
+            settled,
             pushed: [false; L],
             new_ball: [f64::NAN; L],
             contacts: Contacts::default(),
-        }
+        };
+        (verdict, *wx)
     };
-    let moved = world(o, place, wx, &x, &b.x, o.mask(verdict.pushed));
     Tested {
         world: moved.map(store::<S, L>),
         local: b.x.map(store::<S, L>),
@@ -320,7 +329,8 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_, L>) 
     for s in (0..full).step_by(L) {
         let wx: V3<S> = std::array::from_fn(|k| load::<S, L>(lanes_at(x[k], s)));
         let wp: V3<S> = std::array::from_fn(|k| load::<S, L>(lanes_at(prev[k], s)));
-        let live: [bool; L] = lanes_at::<L>(w, s).map(|w| w != 0.0);
+        let wb = load::<S, L>(lanes_at(w, s));
+        let live = o.not(o.0.equal_f64s(wb, o.c(0.0)));
         let rb = load::<S, L>(lanes_at(r, s));
         let tested = first_test::<S, L>(
             o,
@@ -348,7 +358,7 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_, L>) 
                     frame.settled_in_grid(state, i, tested.local_at(l), ball);
                     continue;
                 }
-                Settled::Open if !live[l] => continue,
+                Settled::Open if w[s + l] == 0.0 => continue,
                 settled => {
                     let mut p = tested.world_at(l);
                     let start_pos = DVec3::new(prev[0][s + l], prev[1][s + l], prev[2][s + l]);
