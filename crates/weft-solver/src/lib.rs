@@ -17,6 +17,7 @@ mod error;
 mod forces;
 mod grid;
 mod hook;
+pub mod lane_ops;
 mod material;
 mod method;
 mod methods;

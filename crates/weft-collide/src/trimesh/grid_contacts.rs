@@ -6,12 +6,12 @@ use std::sync::atomic::{AtomicU8, AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use glam::DVec3;
 use pulp::Scalar;
+use weft_solver::lane_ops::Ops;
 
 use super::MeshPoint;
 use super::candidates::{MeshFrame, Outcome, ROUNDS};
 use super::closest::{Feature, closest_on_triangle};
 use super::contact_grid::{ContactGrid, Side};
-use super::grid_lanes::Ops;
 use super::grid_run::{Placement, Settled, first_test};
 use super::normals::NONE;
 

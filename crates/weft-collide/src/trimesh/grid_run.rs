@@ -17,7 +17,9 @@ use weft_solver::{Contacts, ParticleRun, SimdPath};
 use super::candidates::MeshFrame;
 use super::contact_grid::ContactGrid;
 use super::grid_contacts::GridParticles;
-use super::grid_lanes::{Lanes, Ops, V3, Verdict, gather, load, local, settle, store, world};
+use weft_solver::lane_ops::{Ops, V3, load, store};
+
+use super::grid_lanes::{Lanes, Verdict, gather, local, settle, world};
 
 /// What the first test reads of one triangle, in f64, two cache lines: a corner, the unit
 /// normal, the in-plane dual basis of the edges (barycentric coordinates β = u · (x − a),
@@ -330,7 +332,7 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_, L>) 
         let wx: V3<S> = std::array::from_fn(|k| load::<S, L>(lanes_at(x[k], s)));
         let wp: V3<S> = std::array::from_fn(|k| load::<S, L>(lanes_at(prev[k], s)));
         let wb = load::<S, L>(lanes_at(w, s));
-        let live = o.not(o.0.equal_f64s(wb, o.c(0.0)));
+        let live = o.not(o.eq(wb, o.c(0.0)));
         let rb = load::<S, L>(lanes_at(r, s));
         let tested = first_test::<S, L>(
             o,

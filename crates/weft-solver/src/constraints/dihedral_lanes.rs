@@ -24,6 +24,7 @@ use pulp::Simd;
 
 use super::lanes::Coefs;
 use super::quad_sweep::Quads;
+use crate::lane_ops::{Ops, V3, load, store};
 
 /// tan(3π/8).
 const TAN_3PI_8: f64 = 2.414_213_562_373_095;
@@ -47,91 +48,8 @@ const Q: [f64; 5] = [
     1.945_506_571_482_614e2,
 ];
 
-/// The lanes of `a` as one vector of `S` (`L` = `S`'s f64 lanes).
-#[inline(always)]
-pub(crate) fn load<S: Simd, const L: usize>(a: [f64; L]) -> S::f64s {
-    bytemuck::cast(a)
-}
-
-/// The lanes of `v` as an array.
-#[inline(always)]
-pub(crate) fn store<S: Simd, const L: usize>(v: S::f64s) -> [f64; L] {
-    bytemuck::cast(v)
-}
-
 /// A 3-vector of lanes.
-type V<S> = [<S as Simd>::f64s; 3];
-
-/// The vector operations of the kernel on `S`, as functions rather than closures: a closure
-/// is a function of its own without the target features, into which the intrinsics do not
-/// inline (measured: `_mm256_mul_pd` as a call, the kernel twice as slow as scalar code).
-#[derive(Clone, Copy)]
-struct Ops<S>(S);
-
-/// `Ops` methods that forward two vectors to a `Simd` method of the same meaning.
-macro_rules! binary {
-    ($($name:ident => $method:ident -> $out:ident;)*) => {
-        $(
-            #[inline(always)]
-            fn $name(self, a: S::f64s, b: S::f64s) -> S::$out {
-                self.0.$method(a, b)
-            }
-        )*
-    };
-}
-
-impl<S: Simd> Ops<S> {
-    binary! {
-        add => add_f64s -> f64s;
-        sub => sub_f64s -> f64s;
-        mul => mul_f64s -> f64s;
-        div => div_f64s -> f64s;
-        gt => greater_than_f64s -> m64s;
-        ge => greater_than_or_equal_f64s -> m64s;
-        le => less_than_or_equal_f64s -> m64s;
-        lt => less_than_f64s -> m64s;
-    }
-    #[inline(always)]
-    fn c(self, v: f64) -> S::f64s {
-        self.0.splat_f64s(v)
-    }
-    #[inline(always)]
-    fn neg(self, a: S::f64s) -> S::f64s {
-        self.0.neg_f64s(a)
-    }
-    #[inline(always)]
-    fn sel(self, m: S::m64s, t: S::f64s, f: S::f64s) -> S::f64s {
-        self.0.select_f64s(m, t, f)
-    }
-    #[inline(always)]
-    fn and(self, a: S::m64s, b: S::m64s) -> S::m64s {
-        self.0.and_m64s(a, b)
-    }
-    /// a − b per axis.
-    #[inline(always)]
-    fn dif(self, a: &V<S>, b: &V<S>) -> V<S> {
-        [
-            self.sub(a[0], b[0]),
-            self.sub(a[1], b[1]),
-            self.sub(a[2], b[2]),
-        ]
-    }
-    /// u × v.
-    #[inline(always)]
-    fn cross(self, u: &V<S>, v: &V<S>) -> V<S> {
-        [
-            self.sub(self.mul(u[1], v[2]), self.mul(u[2], v[1])),
-            self.sub(self.mul(u[2], v[0]), self.mul(u[0], v[2])),
-            self.sub(self.mul(u[0], v[1]), self.mul(u[1], v[0])),
-        ]
-    }
-    /// u · v.
-    #[inline(always)]
-    fn dot(self, u: &V<S>, v: &V<S>) -> S::f64s {
-        let xy = self.add(self.mul(u[0], v[0]), self.mul(u[1], v[1]));
-        self.add(xy, self.mul(u[2], v[2]))
-    }
-}
+type V<S> = V3<S>;
 
 /// atan2(y, x) in every lane, without branches: Cephes' argument reduction of |y|/|x| to
 /// |t| ≤ 0.66 (t = |y|/|x|, (|y| − |x|)/(|y| + |x|) around π/4 or −|x|/|y| near π/2, chosen
