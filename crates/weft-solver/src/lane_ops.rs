@@ -3,10 +3,55 @@
 //! running the same IEEE operations in the same order (no fused multiply-adds), so a kernel
 //! gives the same bits at every width.
 
-use pulp::Simd;
+use pulp::{Scalar128b, Simd, WithSimd};
+
+use crate::domains::SimdPath;
 
 /// A 3-vector of lanes, one vector per axis.
 pub type V3<S> = [<S as Simd>::f64s; 3];
+
+/// A kernel written over `L` f64 lanes of any [`Simd`] (`L` = `S`'s f64 lanes).
+pub trait LaneKernel {
+    /// What the kernel returns.
+    type Output;
+
+    /// Runs the kernel on the vectors of `s`.
+    fn run<S: Simd, const L: usize>(self, s: S) -> Self::Output;
+}
+
+/// Runs `kernel` on kernel path `path`: eight lanes on the AVX-512 path (`pulp`'s `V4`), four
+/// on AVX2 (`V3`; also the AVX-512 path's fallback on a CPU without it), each entered through
+/// `vectorize` so that the kernel compiles with those features; elsewhere two lanes of
+/// portable code. Every width gives the same bits.
+#[inline(always)]
+pub fn on_path<K: LaneKernel>(path: SimdPath, kernel: K) -> K::Output {
+    match path {
+        #[cfg(target_arch = "x86_64")]
+        SimdPath::Avx512 => match (pulp::x86::V4::try_new(), pulp::x86::V3::try_new()) {
+            (Some(v4), _) => Simd::vectorize(v4, Lanes::<K, 8>(kernel)),
+            (None, Some(v3)) => Simd::vectorize(v3, Lanes::<K, 4>(kernel)),
+            (None, None) => kernel.run::<_, 2>(Scalar128b),
+        },
+        #[cfg(target_arch = "x86_64")]
+        SimdPath::Avx2 => match pulp::x86::V3::try_new() {
+            Some(v3) => Simd::vectorize(v3, Lanes::<K, 4>(kernel)),
+            None => kernel.run::<_, 2>(Scalar128b),
+        },
+        _ => kernel.run::<_, 2>(Scalar128b),
+    }
+}
+
+/// A [`LaneKernel`] at `L` lanes, as `pulp`'s `vectorize` takes it.
+struct Lanes<K, const L: usize>(K);
+
+impl<K: LaneKernel, const L: usize> WithSimd for Lanes<K, L> {
+    type Output = K::Output;
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, s: S) -> K::Output {
+        self.0.run::<S, L>(s)
+    }
+}
 
 /// The lanes of `a` as one vector of `S` (`L` = `S`'s f64 lanes).
 #[inline(always)]

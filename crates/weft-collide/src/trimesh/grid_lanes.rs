@@ -40,8 +40,6 @@ pub(crate) struct Lanes<S: Simd> {
 pub(crate) struct Verdict<const L: usize> {
     /// What it did per lane.
     pub settled: [Settled; L],
-    /// Lanes it moved.
-    pub pushed: [bool; L],
     /// A new clear ball about the lane's position, where the triangle's test cleared it
     /// outside its ball: the radius, or NaN.
     pub new_ball: [f64; L],
@@ -151,7 +149,6 @@ pub(crate) fn settle<S: Simd, const L: usize>(
     if !o.any(push) {
         let verdict = Verdict {
             settled: settled_out,
-            pushed: [false; L],
             new_ball,
             contacts: Contacts::default(),
         };
@@ -178,7 +175,6 @@ pub(crate) fn settle<S: Simd, const L: usize>(
     }
     let verdict = Verdict {
         settled: settled_out,
-        pushed,
         new_ball,
         contacts: tally,
     };
@@ -238,8 +234,8 @@ fn push_vectors<S: Simd>(
     (out, slip2)
 }
 
-/// A block's lanes in the mesh's frame from world positions `wx`, `wp` at the substep's
-/// start, as [`Placement::local`] per lane.
+/// World positions `w` in the mesh's frame: Bᵀ (w − t), or `w` itself where the mesh's pose
+/// is the world's frame.
 #[inline(always)]
 pub(crate) fn local<S: Simd>(o: Ops<S>, place: &Placement, w: &V3<S>) -> V3<S> {
     if place.identity {
@@ -261,7 +257,8 @@ pub(crate) fn local<S: Simd>(o: Ops<S>, place: &Placement, w: &V3<S>) -> V3<S> {
 }
 
 /// World positions `w` of lanes moved from `old` to `new` in the mesh's frame (lanes not
-/// `moved` keep theirs), as [`Placement::world`] per lane.
+/// `moved` keep theirs): w + B (new − old), or `new` where the mesh's pose is the world's
+/// frame.
 #[inline(always)]
 pub(crate) fn world<S: Simd>(
     o: Ops<S>,

@@ -11,14 +11,13 @@
 #![allow(clippy::needless_range_loop)]
 
 use glam::DVec3;
-use pulp::{Scalar128b, Simd, WithSimd};
-use weft_solver::{Contacts, ParticleRun, SimdPath};
+use pulp::Simd;
+use weft_solver::lane_ops::{LaneKernel, Ops, V3, load, on_path, store};
+use weft_solver::{Contacts, ParticleRun};
 
 use super::candidates::MeshFrame;
 use super::contact_grid::ContactGrid;
 use super::grid_contacts::GridParticles;
-use weft_solver::lane_ops::{Ops, V3, load, store};
-
 use super::grid_lanes::{Lanes, Verdict, gather, local, settle, world};
 
 /// What the first test reads of one triangle, in f64, two cache lines: a corner, the unit
@@ -200,7 +199,6 @@ pub(crate) fn first_test<S: Simd, const L: usize>(
             .map(|l| if l { Settled::Done } else { Settled::Open });
         let verdict = Verdict {
             settled,
-            pushed: [false; L],
             new_ball: [f64::NAN; L],
             contacts: Contacts::default(),
         };
@@ -224,78 +222,31 @@ pub(crate) fn resolve_grid_run(
     r: &[f64],
     run: &mut ParticleRun<'_>,
 ) -> Contacts {
-    match run.path {
-        #[cfg(target_arch = "x86_64")]
-        SimdPath::Avx512 => match (pulp::x86::V4::try_new(), pulp::x86::V3::try_new()) {
-            (Some(v4), _) => Simd::vectorize(
-                v4,
-                Blocks::<8> {
-                    frame,
-                    grid,
-                    r,
-                    run,
-                },
-            ),
-            (None, Some(v3)) => Simd::vectorize(
-                v3,
-                Blocks::<4> {
-                    frame,
-                    grid,
-                    r,
-                    run,
-                },
-            ),
-            (None, None) => Blocks::<2> {
-                frame,
-                grid,
-                r,
-                run,
-            }
-            .with_simd(Scalar128b),
-        },
-        #[cfg(target_arch = "x86_64")]
-        SimdPath::Avx2 => match pulp::x86::V3::try_new() {
-            Some(v3) => Simd::vectorize(
-                v3,
-                Blocks::<4> {
-                    frame,
-                    grid,
-                    r,
-                    run,
-                },
-            ),
-            None => Blocks::<2> {
-                frame,
-                grid,
-                r,
-                run,
-            }
-            .with_simd(Scalar128b),
-        },
-        _ => Blocks::<2> {
+    on_path(
+        run.path,
+        Blocks {
             frame,
             grid,
             r,
             run,
-        }
-        .with_simd(Scalar128b),
-    }
+        },
+    )
 }
 
-/// [`resolve_grid_run`]'s arguments, run on the vectors of whatever [`Simd`] they are handed,
-/// `L` f64 lanes wide.
-struct Blocks<'f, 'a, 'r, 'c, const L: usize> {
+/// [`resolve_grid_run`]'s arguments, a [`LaneKernel`] run on the vectors of whatever [`Simd`]
+/// [`on_path`] hands it.
+struct Blocks<'f, 'a, 'r, 'c> {
     frame: &'f MeshFrame<'a>,
     grid: (&'f ContactGrid, &'f GridParticles),
     r: &'f [f64],
     run: &'r mut ParticleRun<'c>,
 }
 
-impl<const L: usize> WithSimd for Blocks<'_, '_, '_, '_, L> {
+impl LaneKernel for Blocks<'_, '_, '_, '_> {
     type Output = Contacts;
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, s: S) -> Contacts {
+    fn run<S: Simd, const L: usize>(self, s: S) -> Contacts {
         run_blocks::<S, L>(Ops(s), self)
     }
 }
@@ -310,7 +261,7 @@ fn lanes_at<const L: usize>(v: &[f64], s: usize) -> [f64; L] {
 }
 
 #[inline(always)]
-fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_, L>) -> Contacts {
+fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> Contacts {
     let Blocks {
         frame,
         grid: (grid, state),
@@ -347,10 +298,8 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_, L>) 
         total = total.merge(tested.verdict.contacts);
         // The block's own pushes (the other lanes' positions as they were), then the lanes it
         // left to the walk and the cell, one by one (in the world's frame).
-        if tested.verdict.pushed.contains(&true) {
-            for k in 0..3 {
-                x[k][s..s + L].copy_from_slice(&tested.world[k]);
-            }
+        for k in 0..3 {
+            x[k][s..s + L].copy_from_slice(&tested.world[k]);
         }
         for l in 0..L {
             let i = start + s + l;

@@ -10,12 +10,13 @@
 use std::ops::Range;
 
 use glam::DVec3;
-use pulp::{Scalar, Scalar128b, Simd, WithSimd};
+use pulp::{Scalar, Simd};
 use rayon::prelude::*;
 
 use super::lanes::{Coef, Coefs};
 use super::{Block, Dihedral, Isometric, Rule, Shape, dihedral_lanes, isometric_lanes};
 use crate::domains::SimdPath;
+use crate::lane_ops::{LaneKernel, on_path};
 use crate::params::FamilyParams;
 
 /// Positions of the four particles of `L` constraints, `[particle][axis][lane]`, in the
@@ -293,40 +294,26 @@ fn project_run<Q: QuadLanes>(
         };
     }
     if !Q::WIDE {
-        return Run::<Q, 1>(seg).with_simd(Scalar);
+        return Run(seg).run::<_, 1>(Scalar);
     }
-    match sweep.path {
-        #[cfg(target_arch = "x86_64")]
-        SimdPath::Avx512 => match (pulp::x86::V4::try_new(), pulp::x86::V3::try_new()) {
-            (Some(v4), _) => Simd::vectorize(v4, Run::<Q, 8>(seg)),
-            (None, Some(v3)) => Simd::vectorize(v3, Run::<Q, 4>(seg)),
-            (None, None) => Run::<Q, 2>(seg).with_simd(Scalar128b),
-        },
-        #[cfg(target_arch = "x86_64")]
-        SimdPath::Avx2 => match pulp::x86::V3::try_new() {
-            Some(v3) => Simd::vectorize(v3, Run::<Q, 4>(seg)),
-            None => Run::<Q, 2>(seg).with_simd(Scalar128b),
-        },
-        _ => Run::<Q, 2>(seg).with_simd(Scalar128b),
-    }
+    on_path(sweep.path, Run(seg))
 }
 
-/// One run of the sweep on the vectors of whatever [`Simd`] it is handed, `L` f64 lanes wide:
-/// eight on the AVX-512 path (`pulp`'s `V4`), four on AVX2 (`V3`), both entered through
-/// `vectorize` so that the kernel compiles with those features; elsewhere two lanes of
-/// portable code. Every width gives the same bits.
+/// One run of the sweep on the vectors of whatever [`Simd`] it is handed, `L` f64 lanes wide
+/// ([`on_path`]: eight on the AVX-512 path, four on AVX2, two portable lanes elsewhere). Every
+/// width gives the same bits.
 ///
 /// Written with explicit vectors: left to LLVM's SLP vectoriser, the same kernel over lane
 /// arrays compiled to scalar divisions and branches once inlined into the sweep (T-shirt,
 /// solve only, 2 threads: 22.8 ms against 12.9 ms with `V3`; `V4` against `V3` alternated:
 /// 12.1, 12.1, 12.5 against 13.1, 13.3, 14.3 ms).
-struct Run<'s, 'a, Q: QuadLanes, const L: usize>(&'s mut Segment<'a, Q>);
+struct Run<'s, 'a, Q: QuadLanes>(&'s mut Segment<'a, Q>);
 
-impl<Q: QuadLanes, const L: usize> WithSimd for Run<'_, '_, Q, L> {
+impl<Q: QuadLanes> LaneKernel for Run<'_, '_, Q> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: Simd>(self, s: S) {
+    fn run<S: Simd, const L: usize>(self, s: S) {
         if self.0.sweep.damped {
             run_with::<S, Q, L, true>(s, self.0);
         } else {
