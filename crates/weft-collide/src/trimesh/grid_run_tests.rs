@@ -10,6 +10,7 @@ use crate::friction::Friction;
 use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
 use crate::trimesh::candidates::MeshFrame;
+use crate::trimesh::ccd::segment_crossing;
 use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
@@ -104,5 +105,91 @@ fn a_run_moves_each_particle_as_the_one_particle_path_does_bit_for_bit() {
             run_matches_particles(&TriangleMesh::icosphere(0.5, 4), 32, path, placed);
             run_matches_particles(&bumpy_sheet(), 33, path, placed);
         }
+    }
+}
+
+/// Particles 1.5 r under an open cap, left there for a substep (so that each keeps the
+/// triangle it came nearest to), then moved 3r along the normal, through the cap, in one
+/// substep: a path r/2 or longer must be left to the sweep, not settled by the first test in
+/// front of the face, so each stays on the side it came from, on the block path of every
+/// kernel path and on the one-particle path.
+#[test]
+fn a_long_path_through_an_open_cap_is_swept_not_settled_in_front() {
+    // An open cap of a sphere: convex, so its faces' clearances reach past r and the first
+    // test would settle a particle in front of one.
+    let ball = TriangleMesh::icosphere(0.5, 3);
+    let cap: Vec<[u32; 3]> = ball
+        .triangles
+        .iter()
+        .copied()
+        .filter(|t| t.iter().all(|&i| ball.vertices[i as usize].y > 0.0))
+        .collect();
+    let m = TriangleMesh::new(ball.vertices.clone(), cap).expect("valid cap");
+    let g = MeshGeometry::new(&m.vertices, &m.triangles);
+    let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+    let r = 0.01;
+    let grid = ContactGrid::new(&g, r).expect("small grid");
+    let mut rng = Rng(34);
+    let n = 203;
+    let on: Vec<(DVec3, DVec3)> = (0..n)
+        .map(|_| {
+            let above = DVec3::new(0.6 * rng.next() - 0.3, 1.0, 0.6 * rng.next() - 0.3);
+            let p = g.nearest(above, f64::INFINITY).expect("nearest");
+            (p.closest.point, p.normal)
+        })
+        .collect();
+    let behind: Vec<DVec3> = on.iter().map(|&(p, nrm)| p - nrm * 1.5 * r).collect();
+    // 3r along the normal from `x`: through the cap.
+    let through = |x: &[DVec3]| -> Vec<DVec3> {
+        x.iter()
+            .zip(&on)
+            .map(|(x, &(_, nrm))| *x + nrm * 3.0 * r)
+            .collect()
+    };
+    let w = vec![1.0; n];
+    let thickness = vec![r; n];
+    // No particle's path over the second substep crosses the cap (brute force over every
+    // triangle).
+    let kept = |from: &[DVec3], to: &[DVec3], what: &str| {
+        for (j, (from, to)) in from.iter().zip(to).enumerate() {
+            let crossed = m.triangles.iter().any(|t| {
+                let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+                let normal = (b - a).cross(c - a).normalize();
+                segment_crossing(*from, *to, [a, b, c], normal, false).is_some()
+            });
+            assert!(
+                !crossed,
+                "{what}, particle {j}: crossed from {from} to {to}"
+            );
+        }
+    };
+    let frame = MeshFrame::still(&g, &pose, Friction::new(0.8, 0.6));
+    // One particle at a time: a substep at rest, then one through the cap.
+    let state = GridParticles::new(n);
+    let step = |from: &[DVec3], to: Vec<DVec3>| -> Vec<DVec3> {
+        let mut x = to;
+        for j in 0..n {
+            frame.resolve_in_grid((&grid, &state), j, from[j], &mut x[j], r);
+        }
+        x
+    };
+    let rest = step(&behind, behind.clone());
+    let end = step(&rest, through(&rest));
+    kept(&rest, &end, "one particle");
+    // A block at a time, on every kernel path.
+    for path in SimdPath::ALL {
+        let state = GridParticles::new(n);
+        let step = |from: &[DVec3], to: Vec<DVec3>| -> Vec<DVec3> {
+            let mut x = axes(&to);
+            over_runs(&mut x, (&axes(from), &w), &[(0, n)], path, |_, mut run| {
+                resolve_grid_run(&frame, (&grid, &state), &thickness, &mut run)
+            });
+            (0..n)
+                .map(|j| DVec3::new(x[0][j], x[1][j], x[2][j]))
+                .collect()
+        };
+        let rest = step(&behind, behind.clone());
+        let end = step(&rest, through(&rest));
+        kept(&rest, &end, &format!("{path:?}"));
     }
 }
