@@ -49,6 +49,10 @@ const NEAR: usize = 16;
 /// Triangles whose bounds a scan computes together.
 const SCAN_BLOCK: usize = 32;
 
+/// The least cosine between a particle's direction from its closest point on an open surface
+/// and that feature's pseudo-normal (or its opposite) that tells which side it is on.
+const SIDED: f64 = 0.5;
+
 /// The candidate lists of one mesh collider for one chunk of particles.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ChunkLists {
@@ -438,6 +442,8 @@ impl MeshFrame<'_> {
         self.ensure(lists, j, xl, from, r);
         // The list is valid where the particle is (ensure needs calling only after a move).
         let mut listed = true;
+        // The side of an open surface the particle is held to (see `contact`).
+        let mut keep = None;
         let (s, len) = lists.range[j];
         if len == 0 && !lists.inside[j] {
             // No triangle within r of the particle or its path: nothing to do.
@@ -451,6 +457,7 @@ impl MeshFrame<'_> {
             let [a, b, cc] = f.corners;
             let hit = a * c.bary[0] + b * c.bary[1] + cc * c.bary[2];
             self.move_to(&mut xl, x, hit + f.normal * (c.side * r));
+            keep = Some(c.side);
             listed = false;
             out.swept += 1;
         }
@@ -474,7 +481,7 @@ impl MeshFrame<'_> {
             );
             let scanned_at = xl;
             let hit = match scan.best {
-                Some(best) => self.contact(best, xl, from),
+                Some(best) => self.contact(best, xl, from, &mut keep),
                 None if lists.inside[j] => {
                     // Deep inside a closed mesh: out through the nearest surface.
                     match g.nearest(xl, f64::INFINITY) {
@@ -612,19 +619,46 @@ impl MeshFrame<'_> {
         }
     }
 
-    /// The contact at the scan's nearest triangle (`d2`, `t`, `q`): signed on a closed mesh;
-    /// on an open surface, a particle on it goes back to the side its path came from.
+    /// The contact at the scan's nearest triangle (`d2`, `t`, `q`): signed on a closed mesh.
+    /// On an open surface a particle on it goes back to the side its path came from, and
+    /// the particle is held to one side, `keep` (+1 in front of the faces' normals, −1
+    /// behind): the one its path came from where the sweep stopped it, else the one it was
+    /// clearly on at its first contact of the projection (set here). Found clearly on the
+    /// other side (a push out of one face beside a sharp fold can carry it through the face
+    /// across the fold), it is pushed back through the surface, as from inside a closed mesh.
     pub(super) fn contact(
         &self,
         (d2, t, q): (f64, usize, Closest),
         xl: DVec3,
         from: DVec3,
+        keep: &mut Option<f64>,
     ) -> MeshPoint {
         let g = self.geometry;
-        let mut p = g.signed(xl, t, q, d2);
-        if !g.closed() && d2 <= 1e-24 {
+        let (mut p, pn) = g.signed_with_normal(xl, t, q, d2);
+        if g.closed() {
+            return p;
+        }
+        if d2 <= 1e-24 {
             let n = g.faces[t].normal;
             p.normal = if n.dot(from - q.point) < 0.0 { -n } else { n };
+        }
+        // Clearly on a side: within 60° of the feature's pseudo-normal or its opposite (not
+        // level with a boundary edge, where either side is as near).
+        let along = p.normal.dot(pn.normalize_or_zero());
+        let on = if along >= SIDED {
+            1.0
+        } else if along <= -SIDED {
+            -1.0
+        } else {
+            return p;
+        };
+        match *keep {
+            None => *keep = Some(on),
+            Some(side) if side != on => {
+                p.distance = -p.distance;
+                p.normal = -p.normal;
+            }
+            Some(_) => {}
         }
         p
     }

@@ -207,7 +207,16 @@ impl MeshFrame<'_> {
         r: f64,
     ) -> Outcome {
         state.set_side(i, Some(false));
-        self.rounds_in_grid((grid, state), i, prev, x, xl, from, r, Outcome::default())
+        self.rounds_in_grid(
+            (grid, state),
+            i,
+            prev,
+            x,
+            xl,
+            (from, None),
+            r,
+            Outcome::default(),
+        )
     }
 
     /// [`Self::resolve_in_grid`] past the first test: the sweep of a long path, the walk from
@@ -226,13 +235,31 @@ impl MeshFrame<'_> {
         // Continuous: a path shorter than r/2 cannot cross the surface from r away, where the
         // last projection left the particle; a longer one is swept through the BVH.
         let short = 0.5 * r;
+        let mut keep = None;
         if (xl - from).length_squared() > short * short
-            && let Some((t, n)) = g.sweep(from, xl)
+            && let Some((t, n, side)) = g.sweep_sided(from, xl)
         {
             let to = from + (xl - from) * t + n * r;
             self.move_to(&mut xl, x, to);
             state.set_side(i, Some(false));
             out.swept += 1;
+            if !g.closed() {
+                // Held to the side it came from (see `contact`). The walk settles a particle
+                // in front of the faces only, so from behind it goes to the rounds.
+                keep = Some(side);
+                if side < 0.0 {
+                    return self.rounds_in_grid(
+                        (grid, state),
+                        i,
+                        prev,
+                        x,
+                        xl,
+                        (from, keep),
+                        r,
+                        out,
+                    );
+                }
+            }
         }
         // The triangle touched last, or one a few edges across from it towards the particle,
         // settles the contact alone where its face is nearest and no triangle in front of its
@@ -315,7 +342,7 @@ impl MeshFrame<'_> {
                                     prev,
                                     x,
                                     xl,
-                                    from,
+                                    (from, keep),
                                     r,
                                     out,
                                 );
@@ -334,7 +361,7 @@ impl MeshFrame<'_> {
                 u => t = u as usize,
             }
         }
-        self.rounds_in_grid((grid, state), i, prev, x, xl, from, r, out)
+        self.rounds_in_grid((grid, state), i, prev, x, xl, (from, keep), r, out)
     }
 
     /// Records particle `i` at `xl` (thickness `r`) clear in `cell`, which lists no triangle
@@ -354,7 +381,8 @@ impl MeshFrame<'_> {
     }
 
     /// The contact rounds of [`Self::resolve_in_grid`] through the particle's cell, from
-    /// local position `xl` on the path from `from`, adding to `out`.
+    /// local position `xl` on the path from `from`, held to side `keep` of an open surface if
+    /// known (see `MeshFrame::contact`), adding to `out`.
     #[allow(clippy::too_many_arguments)]
     fn rounds_in_grid(
         &self,
@@ -363,7 +391,7 @@ impl MeshFrame<'_> {
         prev: DVec3,
         x: &mut DVec3,
         mut xl: DVec3,
-        from: DVec3,
+        (from, mut keep): (DVec3, Option<f64>),
         r: f64,
         mut out: Outcome,
     ) -> Outcome {
@@ -379,7 +407,7 @@ impl MeshFrame<'_> {
             let scan = self.scan(list, state.hint(i), xl, r);
             let scanned_at = xl;
             let hit = match scan.best {
-                Some(best) => self.contact(best, xl, from),
+                Some(best) => self.contact(best, xl, from, &mut keep),
                 None => {
                     let inside = g.closed()
                         && match side {

@@ -16,6 +16,8 @@ pub(crate) mod grid_run;
 pub(crate) mod list_run;
 pub(crate) mod normals;
 #[cfg(test)]
+mod open_side_tests;
+#[cfg(test)]
 mod queries_vs_brute_force;
 pub(crate) mod riding;
 #[cfg(test)]
@@ -365,6 +367,17 @@ impl MeshGeometry {
     /// for a closed mesh the sign of (x − q) · pseudo-normal (Bærentzen & Aanæs 2005,
     /// Theorem 1), else positive.
     pub fn signed(&self, x: DVec3, t: usize, c: Closest, d2: f64) -> MeshPoint {
+        self.signed_with_normal(x, t, c, d2).0
+    }
+
+    /// [`Self::signed`], and the pseudo-normal (not normalised) of the closest feature.
+    pub fn signed_with_normal(
+        &self,
+        x: DVec3,
+        t: usize,
+        c: Closest,
+        d2: f64,
+    ) -> (MeshPoint, DVec3) {
         let delta = x - c.point;
         let len = d2.sqrt();
         let pn = self.pseudo_normal(t, c.feature);
@@ -374,12 +387,13 @@ impl MeshGeometry {
         } else {
             pn.normalize_or(self.faces[t].normal)
         };
-        MeshPoint {
+        let p = MeshPoint {
             triangle: t,
             closest: c,
             distance: if inside { -len } else { len },
             normal,
-        }
+        };
+        (p, pn)
     }
 
     /// The closest point of the whole mesh to `x` within `max_dist` (BVH branch and bound).
@@ -494,9 +508,15 @@ impl MeshGeometry {
     /// The first crossing of the segment `from → to` with the current surface (the entry into
     /// a closed mesh, any crossing of an open one): (fraction, unit normal facing `from`).
     pub fn sweep(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3)> {
+        self.sweep_sided(from, to).map(|(t, n, _)| (t, n))
+    }
+
+    /// [`Self::sweep`], and the side `from` lies on: +1 in front of the crossed face's
+    /// normal, −1 behind it.
+    pub fn sweep_sided(&self, from: DVec3, to: DVec3) -> Option<(f64, DVec3, f64)> {
         let (lo, hi) = (from.min(to), from.max(to));
         let closed = self.closed();
-        let mut best: Option<(f64, DVec3)> = None;
+        let mut best: Option<(f64, DVec3, f64)> = None;
         self.bvh.visit(
             |l, h| l.cmple(hi).all() && h.cmpge(lo).all(),
             |t| {
@@ -504,7 +524,7 @@ impl MeshGeometry {
                 if let Some(c) = ccd::segment_crossing(from, to, f.corners, f.normal, closed)
                     && best.is_none_or(|b| c.t < b.0)
                 {
-                    best = Some((c.t, f.normal * c.side));
+                    best = Some((c.t, f.normal * c.side, c.side));
                 }
             },
         );
