@@ -7,10 +7,11 @@
 //! - a particle whose list is empty: nothing within reach, nothing to do;
 //! - a particle whose path is short (no sweep is due) and whose list holds no triangle within
 //!   its thickness r but, perhaps, the one it touched last, touched from in front and inside
-//!   its face (each other triangle cleared by its distance, worked out a block of triangles at
-//!   a time, or on a still mesh by its plane bound first): it is pushed along that face's
-//!   normal to r and slid back by friction against the surface's motion there, as `resolve`
-//!   would, and settles if every other listed triangle is still r away.
+//!   its face, or holds others within r but none nearer than that face (each other triangle's
+//!   distance worked out a block of triangles at a time, or on a still mesh bounded by its
+//!   plane first): it is pushed along that face's normal to r and slid back by friction
+//!   against the surface's motion there, as `resolve` would, and settles if every other
+//!   listed triangle is then r away.
 //!
 //! Every other particle goes through `resolve`, from where it was. What a lane does depends on
 //! that particle alone, the run's last particles (past the last full block) take the same
@@ -285,12 +286,14 @@ impl Lane {
 /// lane settles, substep starts `prev`, thicknesses `r`) against the triangle each touched
 /// last: marks each lane it settles `done` and each it cannot `open`; returns the contacts
 /// made. A lane settles where every other listed triangle is at least r away ([`others`])
-/// and either its last triangle is too, or the lane's projection lies inside that face, in
-/// front of it at h < r: then it is pushed to h = r along the normal and slid back by Coulomb
-/// friction against the surface's displacement at the touched point over the substep
-/// (Macklin et al. 2014, eq. 24; `Friction::correction`), and it settles if the others are
-/// still r away: by their distance less the push and the slip, or else from where it is now
-/// (as `MeshFrame::look_again`).
+/// and its last triangle is too. Where the lane's projection lies inside that face, in front
+/// of it at h < r, and the face is nearest of all (every other listed triangle at least h
+/// away, as `resolve`'s scan would find it), it is pushed to h = r along the normal and slid
+/// back by Coulomb friction against the surface's displacement at the touched point over the
+/// substep (Macklin et al. 2014, eq. 24; `Friction::correction`), and it settles if the
+/// others are then r away: by their distance less the push and the slip, or else from where
+/// it is now (as `MeshFrame::look_again`; beside a convex edge the face across it is within r
+/// before the push and r away after).
 #[inline(always)]
 fn settle<const L: usize>(
     frame: &MeshFrame<'_>,
@@ -354,7 +357,10 @@ fn settle<const L: usize>(
         let others_clear = second[l] >= r[l] * r[l];
         depth[l] = r[l] - h[l];
         let tiny = depth[l] <= 1e-6 * r[l].max(1e-3);
-        push[l] = near[l] & others_clear & face[l] & !tiny;
+        // The last triangle is nearest of all (`resolve` tests it first and keeps it on a
+        // tie): pushed out of it first, the others are checked from there.
+        let nearest = h[l] * h[l] <= second[l];
+        push[l] = near[l] & (others_clear | nearest) & face[l] & !tiny;
         // Nothing within r, or within rounding of r already (`push` leaves it).
         let clear = near[l] & others_clear & (!face[l] | tiny);
         done[l] |= clear;
