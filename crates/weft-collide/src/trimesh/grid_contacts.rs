@@ -244,21 +244,8 @@ impl MeshFrame<'_> {
             state.set_side(i, Some(false));
             out.swept += 1;
             if !g.closed() {
-                // Held to the side it came from (see `contact`). The walk settles a particle
-                // in front of the faces only, so from behind it goes to the rounds.
+                // Held to the side it came from (see `contact`).
                 keep = Some(side);
-                if side < 0.0 {
-                    return self.rounds_in_grid(
-                        (grid, state),
-                        i,
-                        prev,
-                        x,
-                        xl,
-                        (from, keep),
-                        r,
-                        out,
-                    );
-                }
             }
         }
         // The triangle touched last, or one a few edges across from it towards the particle,
@@ -273,7 +260,14 @@ impl MeshFrame<'_> {
         }
         let hint = state.hint(i) as usize;
         let mut t = hint;
-        for _ in 0..WALK {
+        // The walk settles a particle in front of the faces only: one held behind an open
+        // surface goes to the rounds.
+        let walk = if keep.is_some_and(|side| side < 0.0) {
+            0
+        } else {
+            WALK
+        };
+        for _ in 0..walk {
             let Some(f) = g.faces.get(t) else { break };
             let [a, b, c] = f.corners;
             // Clear of everything without the closest point: r or more in front of the plane

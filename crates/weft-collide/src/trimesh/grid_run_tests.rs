@@ -13,7 +13,7 @@ use crate::trimesh::candidates::MeshFrame;
 use crate::trimesh::ccd::segment_crossing;
 use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::grid_contacts::GridParticles;
-use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
+use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs, under};
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
 
 /// Steps particles about `m` (at the origin, or `placed` elsewhere and turned) for several
@@ -131,13 +131,7 @@ fn a_long_path_through_an_open_cap_is_swept_not_settled_in_front() {
     let grid = ContactGrid::new(&g, r).expect("small grid");
     let mut rng = Rng(34);
     let n = 203;
-    let on: Vec<(DVec3, DVec3)> = (0..n)
-        .map(|_| {
-            let above = DVec3::new(0.6 * rng.next() - 0.3, 1.0, 0.6 * rng.next() - 0.3);
-            let p = g.nearest(above, f64::INFINITY).expect("nearest");
-            (p.closest.point, p.normal)
-        })
-        .collect();
+    let on = under(&g, &mut rng, n, (0.3, 1.0));
     let behind: Vec<DVec3> = on.iter().map(|&(p, nrm)| p - nrm * 1.5 * r).collect();
     // 3r along the normal from `x`: through the cap.
     let through = |x: &[DVec3]| -> Vec<DVec3> {

@@ -12,6 +12,7 @@ use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::ccd::segment_crossing;
 use crate::trimesh::contact_grid::ContactGrid;
 use crate::trimesh::grid_contacts::GridParticles;
+use crate::trimesh::test_particles::under;
 use crate::trimesh::vs_parry::bumpy_sheet;
 
 /// Thickness of every particle (m).
@@ -35,13 +36,7 @@ fn crossed(m: &TriangleMesh, path: Path, seed: u64, depth: f64, side: f64) -> us
     let g = MeshGeometry::new(&m.vertices, &m.triangles);
     let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
     let mut rng = Rng(seed);
-    let on: Vec<(DVec3, DVec3)> = (0..N)
-        .map(|_| {
-            let above = DVec3::new(0.7 * rng.next() - 0.35, 0.5, 0.7 * rng.next() - 0.35);
-            let p = g.nearest(above, f64::INFINITY).expect("nearest");
-            (p.closest.point, p.normal)
-        })
-        .collect();
+    let on = under(&g, &mut rng, N, (0.35, 0.5));
     let start: Vec<DVec3> = on.iter().map(|&(p, n)| p + n * 1.5 * R * side).collect();
     let frame = MeshFrame::still(&g, &pose, Friction::new(0.8, 0.6));
     let grid = ContactGrid::new(&g, R).expect("small grid");

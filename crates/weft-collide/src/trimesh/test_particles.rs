@@ -9,6 +9,27 @@ use crate::analytic_vs_parry::Rng;
 /// Positions, per axis.
 pub(crate) type Axes = [Vec<f64>; 3];
 
+/// The nearest points of mesh `g` to `n` points spread over the square of half-width `half`
+/// at height `y` above the origin, with the direction to each from its nearest point.
+pub(crate) fn under(
+    g: &MeshGeometry,
+    rng: &mut Rng,
+    n: usize,
+    (half, y): (f64, f64),
+) -> Vec<(DVec3, DVec3)> {
+    (0..n)
+        .map(|_| {
+            let above = DVec3::new(
+                2.0 * half * rng.next() - half,
+                y,
+                2.0 * half * rng.next() - half,
+            );
+            let p = g.nearest(above, f64::INFINITY).expect("nearest");
+            (p.closest.point, p.normal)
+        })
+        .collect()
+}
+
 /// Particles about mesh `g`: near its surface on either side, on it, deep inside (one in
 /// six), and far away (one in five), thickness `r`.
 pub(crate) fn about(g: &MeshGeometry, rng: &mut Rng, n: usize, r: f64) -> Vec<DVec3> {
