@@ -7,11 +7,12 @@
 //! - a particle whose list is empty: nothing within reach, nothing to do;
 //! - a particle whose path is short (no sweep is due) and whose list holds no triangle within
 //!   its thickness r but, perhaps, the one it touched last, touched from in front and inside
-//!   its face, or holds others within r but none nearer than that face (each other triangle's
-//!   distance worked out a block of triangles at a time, or on a still mesh bounded by its
-//!   plane first): it is pushed along that face's normal to r and slid back by friction
-//!   against the surface's motion there, as `resolve` would, and settles if every other
-//!   listed triangle is then r away.
+//!   its face, or holds others within r but none nearer than that face (shown without a
+//!   distance where every other listed triangle lies below the face's plane, as on a convex
+//!   patch; else each one's distance worked out a block of triangles at a time, or on a still
+//!   mesh bounded by its plane first): it is pushed along that face's normal to r and slid
+//!   back by friction against the surface's motion there, as `resolve` would, and settles if
+//!   every other listed triangle is then r away.
 //!
 //! Every other particle goes through `resolve`, from where it was. What a lane does depends on
 //! that particle alone, the run's last particles (past the last full block) take the same
@@ -36,6 +37,11 @@ const LANES: usize = 8;
 
 /// Projections nearer than this (barycentric) to an edge of the face are left to `resolve`.
 const INSIDE: f64 = 1e-9;
+
+/// How far (a fraction of r) another listed triangle may rise above the plane below which
+/// the flat test counts it r away: the rounding of its corners' heights (a contact that
+/// shallow is none, as the lane test's own push leaves one of up to 10⁻⁶ r).
+const FLAT: f64 = 1e-9;
 
 impl MeshFrame<'_> {
     /// Whether the block test of [`resolve_list_run`] applies: the mesh's pose is the identity
@@ -285,8 +291,8 @@ impl Lane {
 /// The test of the `near` lanes of the block at `s` (positions `x`, moved in place where a
 /// lane settles, substep starts `prev`, thicknesses `r`) against the triangle each touched
 /// last: marks each lane it settles `done` and each it cannot `open`; returns the contacts
-/// made. A lane settles where every other listed triangle is at least r away ([`others`])
-/// and its last triangle is too. Where the lane's projection lies inside that face, in front
+/// made. A lane settles where every other listed triangle is at least r away ([`below`] where
+/// they all lie below the face's plane, else [`others`]) and its last triangle is too. Where the lane's projection lies inside that face, in front
 /// of it at h < r, and the face is nearest of all (every other listed triangle at least h
 /// away, as `resolve`'s scan would find it), it is pushed to h = r along the normal and slid
 /// back by Coulomb friction against the surface's displacement at the touched point over the
@@ -351,12 +357,32 @@ fn settle<const L: usize>(
             skip[l] = tri[l];
         }
     }
-    let second = others(g, lists, s, (x, r), near, &skip);
-    let (mut depth, mut push) = ([0.0; L], [false; L]);
+    // Where the face test stands and every other listed triangle lies below the face's plane
+    // (every corner no higher than where the particle will sit less r), each is r away and
+    // the face nearest: their distances are not needed.
+    let (mut depth, mut tiny, mut lift) = ([0.0; L], [false; L], [0.0; L]);
+    let mut faced = [false; L];
+    for l in 0..L {
+        depth[l] = r[l] - h[l];
+        tiny[l] = depth[l] <= 1e-6 * r[l].max(1e-3);
+        // Pushed, the particle sits at r; else where it is.
+        let sits = if tiny[l] { h[l] } else { r[l] };
+        lift[l] = sits - r[l] + FLAT * r[l];
+        faced[l] = near[l] & face[l];
+    }
+    let flat = below(g, lists, s, (&f, &lift), &faced, &skip);
+    let mut rest = [false; L];
+    for l in 0..L {
+        rest[l] = near[l] & !flat[l];
+        #[cfg(test)]
+        tests::FLAT.with(|c| c.set(c.get() + usize::from(flat[l])));
+    }
+    // The others' least distance (none, infinite, for the flat lanes).
+    let second = others(g, lists, s, (x, r), &rest, &skip);
+    let mut push = [false; L];
     for l in 0..L {
         let others_clear = second[l] >= r[l] * r[l];
-        depth[l] = r[l] - h[l];
-        let tiny = depth[l] <= 1e-6 * r[l].max(1e-3);
+        let tiny = tiny[l];
         // The last triangle is nearest of all (`resolve` tests it first and keeps it on a
         // tie): pushed out of it first, the others are checked from there.
         let nearest = h[l] * h[l] <= second[l];
@@ -421,6 +447,41 @@ fn settle<const L: usize>(
         tally.depth = tally.depth.max(depth[l]);
     }
     tally
+}
+
+/// Whether every triangle of each `which` lane's list but `skip` lies on or below the plane
+/// `lift` above the lane's face (`f`: corners a, b, c and unit normal n, per field), every
+/// corner c with n · (c − a) ≤ lift. Then every point y of them is at least
+/// n · (x − a) − lift from a particle at x, since |x − y| ≥ n · (x − y): at least r once the
+/// particle sits r + lift above the plane (on a convex patch every other triangle lies below
+/// the face's plane, lift 0).
+#[inline(always)]
+fn below<const L: usize>(
+    g: &MeshGeometry,
+    lists: &ChunkLists,
+    s: usize,
+    (f, lift): (&[[f64; L]; 12], &[f64; L]),
+    which: &[bool; L],
+    skip: &[u32; L],
+) -> [bool; L] {
+    let mut out = [false; L];
+    for l in 0..L {
+        if !which[l] {
+            continue;
+        }
+        let a = [f[0][l], f[1][l], f[2][l]];
+        let n = [f[9][l], f[10][l], f[11][l]];
+        let (start, len) = lists.range[s + l];
+        out[l] = lists.tris[start as usize..(start + len) as usize]
+            .iter()
+            .filter(|&&t| t != skip[l])
+            .all(|&t| {
+                let c = &g.faces[t as usize].corners;
+                let high = |k: usize| dot(n, sub(c[k].to_array(), a));
+                high(0).max(high(1)).max(high(2)) <= lift[l]
+            });
+    }
+    out
 }
 
 /// Lane `l` of `v`.
