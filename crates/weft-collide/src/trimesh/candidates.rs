@@ -62,6 +62,9 @@ pub(crate) struct ChunkLists {
     pub(super) radius: Vec<f64>,
     /// The surface's travel bound before the substep of the build.
     pub(super) travel: Vec<f64>,
+    /// How far the nearest triangle lay from the anchor at the build, at most (infinite:
+    /// not known).
+    nearest: Vec<f64>,
     /// Whether the anchor was inside the closed mesh.
     pub(super) inside: Vec<bool>,
     /// The particle's position after the last projection (collider frame, end pose).
@@ -96,6 +99,7 @@ impl ChunkLists {
             anchor: vec![DVec3::ZERO; n],
             radius: vec![f64::NAN; n],
             travel: vec![0.0; n],
+            nearest: vec![f64::INFINITY; n],
             inside: vec![false; n],
             last: vec![DVec3::ZERO; n],
             hint: vec![u32::MAX; n],
@@ -283,11 +287,16 @@ impl MeshFrame<'_> {
         // Inside a closed mesh's box an empty list needs the nearest triangle of all (the
         // inside flag and the clearance): the same search finds it.
         let deep = g.closed() && outside_box == 0.0;
+        // The nearest triangle lies within its distance at the last build and how far the
+        // particle and the surface have moved since (a bound that starts the deep search).
+        let known =
+            lists.nearest[j] + (x - lists.anchor[j]).length() + (g.travel - lists.travel[j]);
         let start = lists.tris.len();
         let (nearest, guard, riding) = match self.riding_search(lists, (x, from), radius, r, deep) {
             Some(found) => found,
             None => {
-                let nearest = g.within(x, radius, deep, &mut lists.tris);
+                let beyond = deep.then_some(known * (1.0 + 1e-9));
+                let nearest = g.within(x, radius, beyond, &mut lists.tris);
                 (nearest, 0, Riding::NONE)
             }
         };
@@ -298,6 +307,7 @@ impl MeshFrame<'_> {
         lists.riding[j] = riding;
         lists.anchor[j] = x;
         lists.travel[j] = g.travel_before;
+        lists.nearest[j] = nearest.map_or(f64::INFINITY, |p| p.distance.abs());
         let (clearance, inside) = match nearest {
             // The nearest listed triangle is the nearest of all (it is within R).
             Some(p) if len > 0 => (radius, p.distance < 0.0),

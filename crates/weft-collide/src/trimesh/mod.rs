@@ -418,21 +418,23 @@ impl MeshGeometry {
     }
 
     /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
-    /// a fixed order; returns the nearest of them or, with `beyond`, the nearest triangle of
-    /// all (found in the same search).
+    /// a fixed order; returns the nearest of them or, with `beyond` = Some(d), the nearest
+    /// triangle of all (found in the same search), known to lie within d of `x` (infinite:
+    /// anywhere; a d that rounding left short costs a second search, not the answer).
     pub fn within(
         &self,
         x: DVec3,
         radius: f64,
-        beyond: bool,
+        beyond: Option<f64>,
         out: &mut Vec<u32>,
     ) -> Option<MeshPoint> {
         let r2 = radius * radius;
         let faces = &self.faces;
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
         let mut best: Option<(f64, usize, Closest)> = None;
-        // What a triangle must be within to matter: r², or the best so far beyond it.
-        let mut limit = if beyond { f64::INFINITY } else { r2 };
+        // What a triangle must be within to matter: r², or the best so far beyond it (at
+        // first, what is known of the nearest).
+        let mut limit = beyond.map_or(r2, |d| (d * d).max(r2));
         self.bvh.branch_and_bound(x, limit, |t| {
             // Cheap reject on the planes (one cache line) before the corners.
             if f64::from(self.planes[t].distance_squared_bound(x32, margin)) > limit {
@@ -446,12 +448,16 @@ impl MeshGeometry {
             }
             if d2 <= limit && best.is_none_or(|b| d2 < b.0) {
                 best = Some((d2, t, q));
-                if beyond {
+                if beyond.is_some() {
                     limit = d2.max(r2);
                 }
             }
             limit
         });
+        // Nothing within a finite bound (and so nothing listed, r ≤ the bound): anywhere.
+        if best.is_none() && beyond.is_some_and(f64::is_finite) {
+            return self.within(x, radius, Some(f64::INFINITY), out);
+        }
         best.map(|(d2, t, q)| self.signed(x, t, q, d2))
     }
 
