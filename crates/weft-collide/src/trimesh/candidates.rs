@@ -287,15 +287,16 @@ impl MeshFrame<'_> {
         // Inside a closed mesh's box an empty list needs the nearest triangle of all (the
         // inside flag and the clearance): the same search finds it.
         let deep = g.closed() && outside_box == 0.0;
-        // The nearest triangle lies within its distance at the last build and how far the
-        // particle and the surface have moved since (a bound that starts the deep search).
-        let known =
-            lists.nearest[j] + (x - lists.anchor[j]).length() + (g.travel - lists.travel[j]);
         let start = lists.tris.len();
         let (nearest, guard, riding) = match self.riding_search(lists, (x, from), radius, r, deep) {
             Some(found) => found,
             None => {
-                let beyond = deep.then_some(known * (1.0 + 1e-9));
+                // The nearest triangle lies within its distance at the last build and how far
+                // the particle and the surface have moved since: the deep search starts there.
+                let beyond = deep.then(|| {
+                    let moved = (x - lists.anchor[j]).length() + (g.travel - lists.travel[j]);
+                    (lists.nearest[j] + moved) * (1.0 + 1e-9)
+                });
                 let nearest = g.within(x, radius, beyond, &mut lists.tris);
                 (nearest, 0, Riding::NONE)
             }

@@ -292,14 +292,15 @@ impl Lane {
 /// lane settles, substep starts `prev`, thicknesses `r`) against the triangle each touched
 /// last: marks each lane it settles `done` and each it cannot `open`; returns the contacts
 /// made. A lane settles where every other listed triangle is at least r away ([`below`] where
-/// they all lie below the face's plane, else [`others`]) and its last triangle is too. Where the lane's projection lies inside that face, in front
-/// of it at h < r, and the face is nearest of all (every other listed triangle at least h
-/// away, as `resolve`'s scan would find it), it is pushed to h = r along the normal and slid
-/// back by Coulomb friction against the surface's displacement at the touched point over the
-/// substep (Macklin et al. 2014, eq. 24; `Friction::correction`), and it settles if the
-/// others are then r away: by their distance less the push and the slip, or else from where
-/// it is now (as `MeshFrame::look_again`; beside a convex edge the face across it is within r
-/// before the push and r away after).
+/// they all lie below the face's plane, else [`others`]) and its last triangle is too. Where
+/// the lane's projection lies inside that face, in front of it at h < r, and the face is
+/// nearest of all (every other listed triangle at least h away, as `resolve`'s scan would
+/// find it), it is pushed to h = r along the normal and slid back by Coulomb friction against
+/// the surface's displacement at the touched point over the substep (Macklin et al. 2014,
+/// eq. 24; `Friction::correction`), and it settles if the others are then r away: by their
+/// distance less the push and the slip, or else from where it is now (as
+/// `MeshFrame::look_again`; beside a convex edge the face across it is within r before the
+/// push and r away after).
 #[inline(always)]
 fn settle<const L: usize>(
     frame: &MeshFrame<'_>,
