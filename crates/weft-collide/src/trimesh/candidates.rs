@@ -79,6 +79,10 @@ pub(crate) struct ChunkLists {
     guard: Vec<u32>,
     /// On a deforming mesh, each list's riding certificate.
     riding: Vec<Riding>,
+    /// The last frame in which a riding certificate was made for a list of the chunk (0:
+    /// none): where that is not the current frame, no certificate of the chunk holds, and
+    /// none is read.
+    riding_frame: u64,
     /// A build's guard, before it joins the arena.
     scratch: Vec<u32>,
     /// The lists, end to end; rebuilt lists are appended and the arena compacted when half
@@ -106,6 +110,7 @@ impl ChunkLists {
             range: vec![(0, 0); n],
             guard: vec![0; n],
             riding: vec![Riding::NONE; n],
+            riding_frame: 0,
             scratch: Vec::new(),
             tris: Vec::new(),
             live: 0,
@@ -248,7 +253,8 @@ impl MeshFrame<'_> {
     /// certificate.
     fn valid(&self, lists: &ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) -> bool {
         self.valid_by_travel(lists, j, x, from, r)
-            || lists.riding[j].holds(self.geometry, x, from, self.fresh, r)
+            || (lists.riding_frame == self.geometry.frame_id
+                && lists.riding[j].holds(self.geometry, x, from, self.fresh, r))
     }
 
     /// [`Self::valid`] by the bound on the whole mesh's travel since the build alone.
@@ -305,7 +311,12 @@ impl MeshFrame<'_> {
         lists.live += len + guard;
         lists.range[j] = (start as u32, len as u32);
         lists.guard[j] = guard as u32;
-        lists.riding[j] = riding;
+        // A certificate of an earlier frame no longer holds: left in place where none of
+        // this frame is in the chunk.
+        if riding.frame != 0 || lists.riding_frame == g.frame_id {
+            lists.riding[j] = riding;
+            lists.riding_frame = lists.riding_frame.max(riding.frame);
+        }
         lists.anchor[j] = x;
         lists.travel[j] = g.travel_before;
         lists.nearest[j] = nearest.map_or(f64::INFINITY, |p| p.distance.abs());

@@ -323,3 +323,49 @@ fn riding_lists_see_a_part_closing_in() {
         "{riding} lists stood on their riding certificate"
     );
 }
+
+/// A list built with a riding certificate on a substep's first projection and built again as
+/// a plain list on a later one (no motion to ride with) loses the certificate, so that it
+/// cannot vouch for the new list; and a chunk in which no certificate was made this frame
+/// reads none.
+#[test]
+fn a_plain_rebuild_drops_the_riding_certificate() {
+    let vertices = [
+        DVec3::new(-0.5, 0.0, -0.5),
+        DVec3::new(0.5, 0.0, -0.5),
+        DVec3::new(0.5, 0.0, 0.5),
+        DVec3::new(-0.5, 0.0, 0.5),
+    ];
+    let triangles = [[0, 2, 1], [0, 3, 2]];
+    let mut g = MeshGeometry::new(&vertices, &triangles);
+    let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+    // The floor slides 4 cm a frame: a plain list's skin would not last it.
+    g.begin_frame(&vertices.map(|v| v + DVec3::X * 0.04));
+    g.advance_to(0.1);
+    let r = 0.01;
+    let mut lists = ChunkLists::new(2);
+    let (from, x) = (DVec3::new(0.0, 0.012, 0.0), DVec3::new(0.004, 0.012, 0.0));
+    let first = MeshFrame::still(&g, &pose, Friction::NONE);
+    first.ensure(&mut lists, 0, x, from, r);
+    assert_eq!(lists.riding[0].frame, g.frame_id, "a riding list first");
+    assert_eq!(lists.riding_frame, g.frame_id);
+    let later = MeshFrame {
+        fresh: false,
+        ..MeshFrame::still(&g, &pose, Friction::NONE)
+    };
+    let moved = x + DVec3::X * 0.05;
+    later.ensure(&mut lists, 0, moved, moved, r);
+    assert_eq!(lists.builds, 2);
+    assert_eq!(
+        lists.riding[0],
+        super::Riding::NONE,
+        "the certificate stayed"
+    );
+    // Back where the certificate held: the plain list does not, so it is built again.
+    later.ensure(&mut lists, 0, x, x, r);
+    assert_eq!(lists.builds, 3);
+    // Another chunk, no certificate made in it this frame: none is read or written.
+    let mut other = ChunkLists::new(1);
+    later.ensure(&mut other, 0, x, x, r);
+    assert_eq!((other.riding_frame, other.riding[0].frame), (0, 0));
+}
