@@ -326,8 +326,8 @@ fn riding_lists_see_a_part_closing_in() {
 
 /// A list built with a riding certificate on a substep's first projection and built again as
 /// a plain list on a later one (no motion to ride with) loses the certificate, so that it
-/// cannot vouch for the new list; and a chunk in which no certificate was made this frame
-/// reads none.
+/// cannot vouch for the new list; and a plain build in a chunk that made no certificate
+/// records none for it (its checks then read none).
 #[test]
 fn a_plain_rebuild_drops_the_riding_certificate() {
     let vertices = [
@@ -364,7 +364,7 @@ fn a_plain_rebuild_drops_the_riding_certificate() {
     // Back where the certificate held: the plain list does not, so it is built again.
     later.ensure(&mut lists, 0, x, x, r);
     assert_eq!(lists.builds, 3);
-    // Another chunk, no certificate made in it this frame: none is read or written.
+    // A plain build in another chunk, which made no certificate: none recorded.
     let mut other = ChunkLists::new(1);
     later.ensure(&mut other, 0, x, x, r);
     assert_eq!((other.riding_frame, other.riding[0].frame), (0, 0));
