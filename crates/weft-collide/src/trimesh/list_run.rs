@@ -472,17 +472,22 @@ fn below<const L: usize>(
         }
         let a = [f[0][l], f[1][l], f[2][l]];
         let n = [f[9][l], f[10][l], f[11][l]];
-        let (start, len) = lists.range[s + l];
-        out[l] = lists.tris[start as usize..(start + len) as usize]
-            .iter()
-            .filter(|&&t| t != skip[l])
-            .all(|&t| {
-                let c = &g.faces[t as usize].corners;
-                let high = |k: usize| dot(n, sub(c[k].to_array(), a));
-                high(0).max(high(1)).max(high(2)) <= lift[l]
-            });
+        out[l] = listed_but(lists, s + l, skip[l]).all(|t| {
+            let c = &g.faces[t as usize].corners;
+            let high = |k: usize| dot(n, sub(c[k].to_array(), a));
+            high(0).max(high(1)).max(high(2)) <= lift[l]
+        });
     }
     out
+}
+
+/// The triangles of particle `j`'s list but `skip`, in its order.
+#[inline(always)]
+fn listed_but(lists: &ChunkLists, j: usize, skip: u32) -> impl Iterator<Item = u32> + '_ {
+    let (start, len) = lists.range[j];
+    (lists.tris[start as usize..(start + len) as usize].iter())
+        .copied()
+        .filter(move |&t| t != skip)
 }
 
 /// Lane `l` of `v`.
@@ -531,14 +536,10 @@ fn others<const L: usize>(
         if !which[l] {
             continue;
         }
-        let (start, len) = lists.range[s + l];
         let x32 = DVec3::new(x[0][l], x[1][l], x[2][l]).as_vec3();
         let r2 = r[l] * r[l];
         let mut bounds = f64::INFINITY;
-        for &t in &lists.tris[start as usize..(start + len) as usize] {
-            if t == skip[l] {
-                continue;
-            }
+        for t in listed_but(lists, s + l, skip[l]) {
             let bound = if g.moving {
                 0.0
             } else {
