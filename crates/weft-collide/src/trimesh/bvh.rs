@@ -31,6 +31,8 @@ pub(crate) struct Bvh {
     wide: WideBvh,
     /// Per node, a box worked out bottom-up (kept between refits, not to allocate).
     scratch: Vec<(DVec3, DVec3)>,
+    /// The same for the boxes of motions.
+    scratch_motions: Vec<(DVec3, DVec3)>,
 }
 
 /// Squared distance from `x` to the box [lo, hi] (0 inside).
@@ -97,6 +99,7 @@ impl Bvh {
             nodes,
             wide: WideBvh::default(),
             scratch: Vec::new(),
+            scratch_motions: Vec::new(),
         };
         bvh.wide = WideBvh::of(&bvh);
         let stored: Vec<(DVec3, DVec3)> = order.iter().map(|&i| boxes[i as usize]).collect();
@@ -119,14 +122,45 @@ impl Bvh {
         self.wide = wide;
     }
 
-    /// Sets how far the primitives' vertices move over the current frame, from the box of
-    /// each primitive's motions `leaf_motion(i)` (i in storage order), for
-    /// [`Self::visit_riding`].
-    pub fn set_motions(&mut self, leaf_motion: impl Fn(usize) -> (DVec3, DVec3)) {
+    /// [`Self::refit`], and how far the primitives' vertices move over the current frame (for
+    /// [`Self::visit_riding`]), in one pass over the tree, from each
+    /// primitive's box and box of motions `leaf(i)` (i in storage order).
+    pub fn refit_moving(&mut self, leaf: impl Fn(usize) -> [(DVec3, DVec3); 2]) {
         let mut boxes = std::mem::take(&mut self.scratch);
-        self.merge_up(leaf_motion, &mut boxes);
-        self.wide.set_motions(&boxes);
+        let mut motions = std::mem::take(&mut self.scratch_motions);
+        let n = self.nodes.len();
+        boxes.clear();
+        boxes.resize(n, (DVec3::ZERO, DVec3::ZERO));
+        motions.clear();
+        motions.resize(n, (DVec3::ZERO, DVec3::ZERO));
+        for k in (0..n).rev() {
+            let node = self.nodes[k];
+            let mut acc = [(DVec3::INFINITY, DVec3::NEG_INFINITY); 2];
+            let mut take = |b: [(DVec3, DVec3); 2]| {
+                for (a, (l, h)) in acc.iter_mut().zip(b) {
+                    a.0 = a.0.min(l);
+                    a.1 = a.1.max(h);
+                }
+            };
+            if node.count > 0 {
+                (node.first..node.first + node.count).for_each(|i| take(leaf(i as usize)));
+            } else {
+                for c in [node.first as usize, node.first as usize + 1] {
+                    take([boxes[c], motions[c]]);
+                }
+            }
+            [boxes[k], motions[k]] = acc;
+        }
+        for (node, &(lo, hi)) in self.nodes.iter_mut().zip(&boxes) {
+            node.lo = lo;
+            node.hi = hi;
+        }
+        let mut wide = std::mem::take(&mut self.wide);
+        wide.refit(self);
+        wide.set_motions(&motions);
+        self.wide = wide;
         self.scratch = boxes;
+        self.scratch_motions = motions;
     }
 
     /// Every node's box of its primitives' boxes `leaf(i)`, children before parents, into

@@ -10,6 +10,7 @@ pub(crate) mod ccd;
 pub(crate) mod closest;
 pub(crate) mod contact_grid;
 pub(crate) mod deforming;
+pub(crate) mod face_update;
 pub(crate) mod grid_contacts;
 pub(crate) mod grid_lanes;
 pub(crate) mod grid_run;
@@ -61,7 +62,7 @@ impl Face {
 /// plane n · x = n · a and its three edge lines' in-plane outward normals e_k · x = e_k · p_k.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(align(64))]
-pub(crate) struct Planes([f32; 16]);
+pub(crate) struct Planes(pub(crate) [f32; 16]);
 
 impl Planes {
     /// The planes of the triangle with `corners` and unit `normal`.
@@ -245,31 +246,16 @@ impl MeshGeometry {
         let (from, end) = (&self.frame.0, &self.frame.1);
         let triangles = &self.triangles;
         // In place: no allocation (nor its page faults) once a frame.
-        (self.planes.par_iter_mut().zip(triangles))
-            .with_min_len(1024)
-            .for_each(|(p, t)| {
-                let [a, b, c] = t.map(|i| end[i as usize]);
-                *p = Planes::new([a, b, c], face_normal(a, b, c));
-            });
-        self.bvh.refit(|i| {
-            let t = triangles[i];
-            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-            for v in t {
-                for p in [from[v as usize], end[v as usize]] {
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                }
-            }
-            (lo, hi)
-        });
-        self.bvh.set_motions(|i| {
-            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        face_update::update_planes(&mut self.planes, triangles, end);
+        self.bvh.refit_moving(|i| {
+            let mut b = [(DVec3::INFINITY, DVec3::NEG_INFINITY); 2];
             for v in triangles[i] {
-                let d = end[v as usize] - from[v as usize];
-                lo = lo.min(d);
-                hi = hi.max(d);
+                let (p, q) = (from[v as usize], end[v as usize]);
+                b[0] = (b[0].0.min(p).min(q), b[0].1.max(p).max(q));
+                let d = q - p;
+                b[1] = (b[1].0.min(d), b[1].1.max(d));
             }
-            (lo, hi)
+            b
         });
         let extent = (from.iter().chain(end)).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         self.slack = Self::remaining(&self.end, end);
@@ -333,10 +319,7 @@ impl MeshGeometry {
         if !self.moving {
             return;
         }
-        let now = &self.end;
-        (self.faces.par_iter_mut().zip(&self.triangles))
-            .with_min_len(1024)
-            .for_each(|(f, t)| *f = Face::at(t.map(|i| now[i as usize])));
+        face_update::update_faces(&mut self.faces, &self.triangles, &self.end);
     }
 
     /// Moves the surface to `next` at once (a frame of one substep).

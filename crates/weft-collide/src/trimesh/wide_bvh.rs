@@ -431,7 +431,7 @@ mod tests {
                 if i % 2 == 0 { (c, c) } else { (c - h, c + h) }
             })
             .collect();
-        bvh.set_motions(|i| motions[i]);
+        bvh.refit_moving(|i| [stored[i], motions[i]]);
         // The farthest a primitive's motions lie from `m`: at a corner of its box.
         let dev = |i: usize, m: DVec3| {
             let (lo, hi) = motions[i];
