@@ -213,6 +213,14 @@ impl CollisionWorld {
         chunks + self.run_lists.sum(|l| l.builds)
     }
 
+    /// Certificates made so far for triangle-mesh contacts (all mesh colliders with lists).
+    pub fn mesh_certificate_builds(&self) -> u64 {
+        let chunks: u64 = (self.mesh_lists.iter())
+            .flat_map(|chunk| chunk.iter().map(|l| l.certs.builds))
+            .sum();
+        chunks + self.run_lists.sum(|l| l.certs.builds)
+    }
+
     /// Triangles now listed for triangle-mesh contacts, over all particles and mesh
     /// colliders.
     pub fn mesh_list_entries(&self) -> usize {

@@ -25,6 +25,7 @@ use super::{MeshGeometry, MeshPoint};
 mod tests;
 use super::bvh::box_distance_squared;
 use super::ccd::{Crossing, moving_crossing, segment_crossing};
+use super::certificate::Certificates;
 use super::closest::closest_on_triangle;
 use super::riding::Riding;
 use crate::analytic::WorldPose;
@@ -94,6 +95,8 @@ pub(crate) struct ChunkLists {
     spare: Vec<u32>,
     /// Lists built so far.
     pub builds: u64,
+    /// Each particle's certificate (`certified`).
+    pub(crate) certs: Certificates,
 }
 
 impl ChunkLists {
@@ -116,6 +119,7 @@ impl ChunkLists {
             live: 0,
             spare: Vec::new(),
             builds: 0,
+            certs: Certificates::new(n),
         }
     }
 

@@ -187,7 +187,7 @@ pub(crate) fn settle<S: Simd, const L: usize>(
 /// across the normal corrected as [`Friction::correction`] does. Returns the new positions (a
 /// lane not pushed keeps its own) and each pushed lane's correction, squared.
 #[inline(always)]
-fn push_vectors<S: Simd>(
+pub(super) fn push_vectors<S: Simd>(
     o: Ops<S>,
     friction: Friction,
     x: &V3<S>,

@@ -25,14 +25,16 @@
 #![allow(clippy::needless_range_loop)]
 
 use glam::DVec3;
-use multiversion::multiversion;
-use weft_solver::{Contacts, ParticleRun, SimdPath};
+use pulp::{Scalar, Simd};
+use weft_solver::lane_ops::{LaneKernel, Ops, on_path};
+use weft_solver::{Contacts, ParticleRun};
 
 use super::MeshGeometry;
 use super::candidates::{ChunkLists, MeshFrame, Outcome};
+use super::certified::certified;
 use crate::friction::push_lanes;
 
-/// Particles per block: eight f64, one AVX-512 register or two AVX2 ones.
+/// Particles per block of the lane test: eight f64, one AVX-512 register or two AVX2 ones.
 const LANES: usize = 8;
 
 /// Projections nearer than this (barycentric) to an edge of the face are left to `resolve`.
@@ -54,68 +56,100 @@ impl MeshFrame<'_> {
 
 /// Every free particle of `run` (thickness `r`) against the mesh of `frame` (for which
 /// [`MeshFrame::lists_settle`] holds), through the run's candidate lists `lists` (indexed
-/// from the run's start): the block test, then `MeshFrame::resolve` for the particles it left
-/// open. Compiled for the run's kernel path (every path gives the same bits).
+/// from the run's start): the certified test (`certified`) a block at a time, then the lane
+/// test and `MeshFrame::resolve` for each particle it left open. Compiled for the run's kernel
+/// path (every path gives the same bits).
 pub(crate) fn resolve_list_run(
     frame: &MeshFrame<'_>,
     lists: &mut ChunkLists,
     r: &[f64],
     run: &mut ParticleRun<'_>,
 ) -> Contacts {
-    match run.path {
-        SimdPath::Avx512 => run_avx512(frame, lists, r, run),
-        SimdPath::Avx2 => run_avx2(frame, lists, r, run),
-        SimdPath::Neon => run_neon(frame, lists, r, run),
-        SimdPath::Scalar => run_scalar(frame, lists, r, run),
+    on_path(
+        run.path,
+        Blocks {
+            frame,
+            lists,
+            r,
+            run,
+        },
+    )
+}
+
+/// [`resolve_list_run`]'s arguments, a [`LaneKernel`] run on the vectors of whatever [`Simd`]
+/// [`on_path`] hands it.
+struct Blocks<'f, 'a, 'r, 'c> {
+    frame: &'f MeshFrame<'a>,
+    lists: &'f mut ChunkLists,
+    r: &'f [f64],
+    run: &'r mut ParticleRun<'c>,
+}
+
+impl LaneKernel for Blocks<'_, '_, '_, '_> {
+    type Output = Contacts;
+
+    #[inline(always)]
+    fn run<S: Simd, const L: usize>(self, s: S) -> Contacts {
+        run_blocks::<S, L>(Ops(s), self)
     }
 }
 
-/// [`resolve_list_run`] compiled for AVX-512 (the baseline build where the CPU lacks it).
-#[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
-fn run_avx512<'a, 'b, 'c>(
-    frame: &'b MeshFrame<'a>,
-    lists: &'b mut ChunkLists,
-    r: &'b [f64],
-    run: &'b mut ParticleRun<'c>,
-) -> Contacts {
-    run_body(frame, lists, r, run)
-}
-
-/// [`resolve_list_run`] compiled for AVX2 and FMA.
-#[multiversion(targets("x86_64+avx2+fma"))]
-fn run_avx2<'a, 'b, 'c>(
-    frame: &'b MeshFrame<'a>,
-    lists: &'b mut ChunkLists,
-    r: &'b [f64],
-    run: &'b mut ParticleRun<'c>,
-) -> Contacts {
-    run_body(frame, lists, r, run)
-}
-
-/// [`resolve_list_run`] compiled for NEON.
-#[multiversion(targets("aarch64+neon"))]
-fn run_neon<'a, 'b, 'c>(
-    frame: &'b MeshFrame<'a>,
-    lists: &'b mut ChunkLists,
-    r: &'b [f64],
-    run: &'b mut ParticleRun<'c>,
-) -> Contacts {
-    run_body(frame, lists, r, run)
-}
-
-/// [`resolve_list_run`] compiled for the baseline target.
-#[inline(never)]
-fn run_scalar<'a, 'b, 'c>(
-    frame: &'b MeshFrame<'a>,
-    lists: &'b mut ChunkLists,
-    r: &'b [f64],
-    run: &'b mut ParticleRun<'c>,
-) -> Contacts {
-    run_body(frame, lists, r, run)
-}
-
 #[inline(always)]
-fn run_body(
+fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> Contacts {
+    let Blocks {
+        frame,
+        lists,
+        r,
+        run,
+    } = b;
+    let n = run.w.len();
+    if !r[..n].iter().any(|&r| frame.certifies(r)) {
+        return lane_blocks(frame, lists, r, run);
+    }
+    let full = n - n % L;
+    let mut total = Contacts::default();
+    for s in (0..full).step_by(L) {
+        let (mut x, mut prev, mut rr) = ([[0.0; L]; 3], [[0.0; L]; 3], [0.0; L]);
+        for k in 0..3 {
+            x[k].copy_from_slice(&run.x[k][s..s + L]);
+            prev[k].copy_from_slice(&run.prev[k][s..s + L]);
+        }
+        rr.copy_from_slice(&r[s..s + L]);
+        let live: [bool; L] = std::array::from_fn(|l| run.w[s + l] != 0.0);
+        let done = certified::<S, L>(o, frame, lists, s, (&mut x, &prev), (&rr, live));
+        total = total.merge(done.contacts);
+        for l in (0..L).filter(|&l| live[l] && !done.settled[l]) {
+            let at = |v: &[[f64; L]; 3]| DVec3::new(v[0][l], v[1][l], v[2][l]);
+            let mut p = at(&x);
+            let out = frame.open(lists, s + l, at(&prev), &mut p, (rr[l], done.ring[l]));
+            total = total.merge(out.into());
+            for k in 0..3 {
+                x[k][l] = p[k];
+            }
+        }
+        for k in 0..3 {
+            run.x[k][s..s + L].copy_from_slice(&x[k]);
+        }
+    }
+    for j in full..n {
+        if run.w[j] == 0.0 {
+            continue;
+        }
+        let mut p = DVec3::new(run.x[0][j], run.x[1][j], run.x[2][j]);
+        let before = DVec3::new(run.prev[0][j], run.prev[1][j], run.prev[2][j]);
+        total = total.merge(frame.resolve_listed(lists, j, before, &mut p, r[j]).into());
+        for k in 0..3 {
+            run.x[k][j] = p[k];
+        }
+    }
+    total
+}
+
+/// A run none of whose particles the mesh certifies (`MeshFrame::certifies`): the lane test
+/// [`LANES`] particles at a time, then `resolve` for each lane it leaves open (the same bits
+/// as one at a time).
+#[inline(always)]
+fn lane_blocks(
     frame: &MeshFrame<'_>,
     lists: &mut ChunkLists,
     r: &[f64],
@@ -161,9 +195,9 @@ fn block<const L: usize>(
 
 impl MeshFrame<'_> {
     /// Particle `j` of `lists` (thickness `r`, previous position `prev`, current `x`) as a
-    /// run of one: the lane test where [`Self::lists_settle`] holds, else (and where the test
-    /// leaves it open) `resolve`. Every particle of a mesh with lists takes this path or a
-    /// block of the same test, so its bits do not depend on which.
+    /// run of one: the certified test and the lane test where [`Self::lists_settle`] holds,
+    /// else `resolve`. Every particle of a mesh with lists takes this path or a block of the
+    /// same tests, so its bits do not depend on which.
     pub(crate) fn resolve_listed(
         &self,
         lists: &mut ChunkLists,
@@ -175,6 +209,59 @@ impl MeshFrame<'_> {
         if !self.lists_settle() {
             return self.resolve(lists, j, prev, x, r);
         }
+        let mut at = [[x.x], [x.y], [x.z]];
+        let before = [[prev.x], [prev.y], [prev.z]];
+        let done = certified::<Scalar, 1>(
+            Ops(Scalar),
+            self,
+            lists,
+            j,
+            (&mut at, &before),
+            (&[r], [true]),
+        );
+        *x = DVec3::new(at[0][0], at[1][0], at[2][0]);
+        if done.settled[0] {
+            return done.contacts.into();
+        }
+        let out = self.open(lists, j, prev, x, (r, done.ring[0]));
+        Contacts::from(out).merge(done.contacts).into()
+    }
+
+    /// Particle `j` left open by the certified test: among its face's ring where its
+    /// certificate allows (`ring`), else through the lists; a new certificate where it has
+    /// come to rest on another face.
+    fn open(
+        &self,
+        lists: &mut ChunkLists,
+        j: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        (r, ring): (f64, bool),
+    ) -> Outcome {
+        let out = match ring
+            .then(|| self.resolve_ring(lists, j, prev, x, r))
+            .flatten()
+        {
+            Some(out) => out,
+            None => self.listed(lists, j, prev, x, r),
+        };
+        // As a run none of whose particles the mesh certifies would (`lane_blocks`).
+        if self.certifies(r) {
+            self.recertify(lists, j, *x, r);
+        }
+        out
+    }
+
+    /// Particle `j` through its lists: the lane test as a run of one, then `resolve` where it
+    /// leaves it open.
+    fn listed(
+        &self,
+        lists: &mut ChunkLists,
+        j: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        r: f64,
+    ) -> Outcome {
         let mut at = [[x.x], [x.y], [x.z]];
         let before = [[prev.x], [prev.y], [prev.z]];
         let total = lanes::<1>(self, lists, j, (&mut at, &before), (&[r], [true]));

@@ -7,8 +7,11 @@
 pub(crate) mod bvh;
 pub(crate) mod candidates;
 pub(crate) mod ccd;
+pub(crate) mod certificate;
+pub(crate) mod certified;
 pub(crate) mod closest;
 pub(crate) mod contact_grid;
+pub(crate) mod convexity;
 pub(crate) mod deforming;
 pub(crate) mod face_update;
 pub(crate) mod grid_contacts;
@@ -32,6 +35,7 @@ use rayon::prelude::*;
 
 use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
+use convexity::{Fronts, Rings};
 use normals::{Topology, face_normal, pseudo_normal};
 
 /// One triangle at the end of the substep: its corners and unit normal (what the contact
@@ -146,6 +150,13 @@ pub(crate) struct MeshGeometry {
     pub extent: f64,
     /// Adjacency and closedness.
     pub topology: Topology,
+    /// Each face's one-ring.
+    pub rings: Rings,
+    /// Per face, the ring triangles that may come in front of its plane over the current
+    /// frame (over the mesh's life while it is still).
+    pub fronts: Fronts,
+    /// How far the farthest-moving vertex moves over the current frame (m).
+    pub frame_reach: f64,
     /// Boxes of the triangles over the substep (start and end).
     pub bvh: Bvh,
     /// A bound on how far any vertex moved, summed over the substeps so far (m).
@@ -179,6 +190,7 @@ impl MeshGeometry {
         let (bvh, order) = Bvh::build(&boxes);
         let triangles: Vec<[u32; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
         let topology = Topology::new(vertices.len(), &triangles);
+        let rings = Rings::new(&triangles, &topology);
         let extent = vertices
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
@@ -192,6 +204,9 @@ impl MeshGeometry {
             start: vertices.to_vec(),
             end: vertices.to_vec(),
             topology,
+            rings,
+            fronts: Fronts::default(),
+            frame_reach: 0.0,
             bvh,
             travel: 0.0,
             travel_before: 0.0,
@@ -203,6 +218,8 @@ impl MeshGeometry {
         };
         (geometry.faces, geometry.planes) = geometry.compute_faces();
         geometry.set_margin(extent);
+        let ends = (&geometry.end[..], &geometry.end[..]);
+        (geometry.fronts).update(&geometry.triangles, &geometry.rings, ends, (extent, 0));
         geometry
     }
 
@@ -259,7 +276,10 @@ impl MeshGeometry {
         });
         let extent = (from.iter().chain(end)).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         self.slack = Self::remaining(&self.end, end);
+        self.frame_reach = self.slack;
         self.frame_id += 1;
+        let ends = (&self.frame.0[..], &self.frame.1[..]);
+        (self.fronts).update(&self.triangles, &self.rings, ends, (extent, self.frame_id));
         self.frame_span = (0.0, 0.0);
         self.set_margin(extent);
     }
@@ -381,6 +401,13 @@ impl MeshGeometry {
 
     /// The closest point of the whole mesh to `x` within `max_dist` (BVH branch and bound).
     pub fn nearest(&self, x: DVec3, max_dist: f64) -> Option<MeshPoint> {
+        let (t, d2, c) = self.nearest_unsigned(x, max_dist)?;
+        Some(self.signed(x, t, c, d2))
+    }
+
+    /// [`Self::nearest`] without its sign: the triangle, the squared distance and the closest
+    /// point.
+    pub fn nearest_unsigned(&self, x: DVec3, max_dist: f64) -> Option<(usize, f64, Closest)> {
         let faces = &self.faces;
         let limit = if max_dist.is_finite() {
             max_dist * max_dist
@@ -388,7 +415,7 @@ impl MeshGeometry {
             f64::INFINITY
         };
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
-        let (t, d2, c) = self.bvh.nearest(x, limit, |t, bound| {
+        self.bvh.nearest(x, limit, |t, bound| {
             // Cheap reject: a lower bound no nearer than the best so far.
             if f64::from(self.planes[t].distance_squared_bound(x32, margin)) >= bound {
                 return None;
@@ -396,8 +423,7 @@ impl MeshGeometry {
             let [a, b, cc] = faces[t].corners;
             let c = closest_on_triangle(x, a, b, cc);
             Some(((x - c.point).length_squared(), c))
-        })?;
-        Some(self.signed(x, t, c, d2))
+        })
     }
 
     /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
@@ -442,6 +468,28 @@ impl MeshGeometry {
             return self.within(x, radius, Some(f64::INFINITY), out);
         }
         best.map(|(d2, t, q)| self.signed(x, t, q, d2))
+    }
+
+    /// The distance from `x` to the nearest triangle sharing no corner with triangle `t` (off
+    /// its ring), or `radius` if none is nearer.
+    pub fn off_ring(&self, x: DVec3, t: usize, radius: f64) -> f64 {
+        let ring = self.triangles[t];
+        let faces = &self.faces;
+        let (x32, margin) = (x.as_vec3(), self.margin_at(x));
+        let mut limit = radius * radius;
+        self.bvh.branch_and_bound(x, limit, |u| {
+            if convexity::share_a_corner(ring, self.triangles[u]) {
+                return limit;
+            }
+            // Cheap reject on the planes (one cache line) before the corners.
+            if f64::from(self.planes[u].distance_squared_bound(x32, margin)) < limit {
+                let [a, b, c] = faces[u].corners;
+                let d2 = (x - closest_on_triangle(x, a, b, c).point).length_squared();
+                limit = limit.min(d2);
+            }
+            limit
+        });
+        limit.sqrt()
     }
 
     /// A riding list's search (`riding`): appends to `out` every triangle within `radius` of

@@ -1,0 +1,277 @@
+//! A particle's certificate against a mesh that keeps candidate lists (a deforming mesh, or a
+//! still one too large for a contact grid): what lets the certified test (`certified`) settle
+//! most of a resting cloth's particles with the one face under them and no list.
+//!
+//! A certificate is made by one BVH search about where the particle stood (its anchor): a
+//! face F near it and a distance ψ such that every triangle that does not share a corner with
+//! F (is off F's ring, `convexity`) lay at least ψ from the anchor; or, where no triangle was
+//! within the search's reach, ψ alone (a clear certificate, for a particle outside). Distances
+//! move by at most the particle's and the surface's displacements (the surface's bounded by
+//! its travel, as a candidate list's skin; Verlet 1967), so while
+//!
+//! max(|x − anchor|, |from − anchor|) + (travel of the surface since the build) + r ≤ ψ
+//!
+//! no triangle off F's ring (none at all, for a clear certificate) is within r of the particle
+//! or of its path `from → x`. A certificate is made again when it no longer holds, and when
+//! the particle comes to rest on another face. One that cannot hold where it is made (a
+//! triangle off the ring within r, as in a tight fold), or a particle inside a closed mesh,
+//! gets none: the particle goes to the lists until it has moved [`BACKOFF`] r.
+//!
+//! A particle whose certificate holds with a face, on a short path, that the block test does
+//! not settle has its contacts among F and its ring alone ([`MeshFrame::resolve_ring`]).
+
+use glam::DVec3;
+
+use super::MeshGeometry;
+use super::bvh::box_distance_squared;
+use super::candidates::{ChunkLists, MeshFrame, Outcome, ROUNDS};
+use super::closest::{Closest, Feature, closest_on_triangle};
+
+/// A certificate's face where no triangle lay within ψ: the particle is clear.
+pub(crate) const CLEAR: u32 = u32::MAX;
+
+/// A certificate's face where none could be made: the particle goes to the lists.
+pub(crate) const NO_FACE: u32 = u32::MAX - 1;
+
+/// How far a certificate's search reaches beyond the particle's thickness r, as a fraction of
+/// it (the certificate's skin; 1.0–5.0 were tried on the breathing ball, 2.0–2.5 fastest).
+pub(crate) const REACH: f64 = 2.0;
+
+/// How far a clear certificate's search for the nearest triangle reaches, as a multiple of
+/// the particle's thickness.
+const CLEAR_REACH: f64 = 50.0;
+
+/// How far a particle with no certificate moves (a fraction of its thickness, with the
+/// surface's travel) before another is tried.
+const BACKOFF: f64 = 0.5;
+
+/// The certificates of one chunk (or run) of particles, per particle, in struct-of-arrays
+/// (the block test loads each field of a block's lanes as one vector).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Certificates {
+    /// The anchors, per axis.
+    pub(super) anchor: [Vec<f64>; 3],
+    /// ψ plus the surface's travel bound before the substep of the build (NaN: none).
+    pub(super) reach: Vec<f64>,
+    /// The face, [`CLEAR`] or [`NO_FACE`].
+    pub(super) face: Vec<u32>,
+    /// A clear ball the block test found about a particle hovering over its face: its centre
+    /// per axis, then its radius less r plus the surface's travel bound when it was found
+    /// (NaN: none). No triangle was within r plus that radius of the centre.
+    pub(super) hover: [Vec<f64>; 4],
+    /// Certificates made so far.
+    pub builds: u64,
+}
+
+impl Certificates {
+    /// Certificates for `n` particles, none made.
+    pub fn new(n: usize) -> Self {
+        Self {
+            anchor: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
+            reach: vec![f64::NAN; n],
+            face: vec![NO_FACE; n],
+            hover: [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![f64::NAN; n]],
+            builds: 0,
+        }
+    }
+
+    /// Particle `j`'s anchor.
+    #[inline]
+    pub(super) fn anchor_of(&self, j: usize) -> DVec3 {
+        DVec3::new(self.anchor[0][j], self.anchor[1][j], self.anchor[2][j])
+    }
+
+    /// Sets particle `j`'s certificate (and drops its hover ball).
+    fn set(&mut self, j: usize, anchor: DVec3, reach: f64, face: u32) {
+        for k in 0..3 {
+            self.anchor[k][j] = anchor[k];
+        }
+        self.reach[j] = reach;
+        self.face[j] = face;
+        self.hover[3][j] = f64::NAN;
+    }
+
+    /// Sets particle `j`'s hover ball: about `centre`, no triangle within r + `room` at the
+    /// surface's travel bound `travel`.
+    pub(super) fn set_hover(&mut self, j: usize, centre: DVec3, room: f64, travel: f64) {
+        for k in 0..3 {
+            self.hover[k][j] = centre[k];
+        }
+        self.hover[3][j] = room * (1.0 - 1e-9) + travel;
+    }
+}
+
+impl MeshFrame<'_> {
+    /// Whether certificates are worth keeping for particles of thickness `r` on this mesh:
+    /// its fastest vertex does not use up a certificate's skin within a few frames (near a
+    /// fast limb they would be made again every frame, and the lists' riding certificates
+    /// serve better).
+    #[inline]
+    pub(crate) fn certifies(&self, r: f64) -> bool {
+        4.0 * self.geometry.frame_reach <= REACH * r
+    }
+
+    /// How far the surface moved over the path a particle takes in this projection: this
+    /// substep's travel on its first projection (the path starts at the substep's start),
+    /// none on a later one (as `MeshFrame::short_path` counts it).
+    #[inline]
+    pub(crate) fn surface_travel(&self) -> f64 {
+        let g = self.geometry;
+        if self.fresh && g.moving {
+            g.travel - g.travel_before
+        } else {
+            0.0
+        }
+    }
+
+    /// Makes particle `j`'s certificate at `x` on a path from `from` (the mesh's frame), for
+    /// thickness `r` (see the module's notes).
+    pub(crate) fn certify(&self, lists: &mut ChunkLists, j: usize, x: DVec3, from: DVec3, r: f64) {
+        let g = self.geometry;
+        let certs = &mut lists.certs;
+        certs.builds += 1;
+        let substep = g.travel - g.travel_before;
+        let path = (from - x).length();
+        let reach = r * (1.0 + REACH) + path + substep;
+        match certificate(g, x, (reach, CLEAR_REACH * r), certs.face[j]) {
+            // It must hold where it is made: ψ past the path and this substep's travel.
+            Some((psi, face)) if psi - substep - r >= path => {
+                certs.set(j, x, psi * (1.0 - 1e-12) + g.travel_before, face);
+            }
+            _ => certs.set(j, x, g.travel_before + r * (1.0 + BACKOFF), NO_FACE),
+        }
+    }
+
+    /// After the ring or the lists resolved particle `j` (now at `x`, the mesh's frame): a
+    /// new certificate where the particle has come to rest on another face's interior than
+    /// its certificate's (a contact with it, within r of it), or hovers in front of another
+    /// face across an edge of its certificate's (over a convex edge, where it projects onto
+    /// neither face, it keeps its certificate).
+    pub(crate) fn recertify(&self, lists: &mut ChunkLists, j: usize, x: DVec3, r: f64) {
+        let (face, hint) = (lists.certs.face[j], lists.hint[j]);
+        let g = self.geometry;
+        if face >= NO_FACE {
+            return;
+        }
+        let moved = if hint != face && (hint as usize) < g.faces.len() {
+            let [a, b, c] = g.faces[hint as usize].corners;
+            let q = closest_on_triangle(x, a, b, c);
+            q.feature == Feature::Face && (x - q.point).length_squared() <= r * r * (1.0 + 1e-6)
+        } else {
+            !over_face(g, face as usize, x)
+                && (g.topology.adjacent[face as usize].iter())
+                    .any(|&t| (t as usize) < g.faces.len() && over_face(g, t as usize, x))
+        };
+        if moved {
+            self.certify(lists, j, x, x, r);
+        }
+    }
+
+    /// Particle `j` (previous position `prev`, at `x`, thickness `r`), whose certificate
+    /// holds with a face and whose path is short: no triangle off the face's ring is within
+    /// r of it or of its path, so its contacts are among the face and its ring, made as
+    /// `MeshFrame::resolve` makes them (the nearest within r pushed out, with friction, up
+    /// to [`ROUNDS`] times). `None`, with `x` as it was, where the pushes carried it out of
+    /// its certificate's reach (the lists follow).
+    pub(crate) fn resolve_ring(
+        &self,
+        lists: &mut ChunkLists,
+        j: usize,
+        prev: DVec3,
+        x: &mut DVec3,
+        r: f64,
+    ) -> Option<Outcome> {
+        let g = self.geometry;
+        let face = lists.certs.face[j] as usize;
+        let (mut xl, from) = self.local_path(*x, prev, || lists.last[j]);
+        let start = *x;
+        let ring = g.rings.triangles_of(face);
+        let (mut keep, mut out, mut hint) = (None, Outcome::default(), lists.hint[j]);
+        let r2 = r * r;
+        for _ in 0..ROUNDS {
+            // The nearest of the face and its ring within r (the face first: it is kept on a
+            // tie), each passed over where its planes' bound clears r.
+            let mut best: Option<(f64, usize, Closest)> = None;
+            let x32 = xl.as_vec3();
+            for t in std::iter::once(face).chain(ring.iter().map(|&t| t as usize)) {
+                if f64::from(g.planes[t].distance_squared_bound(x32, g.margin)) >= r2 {
+                    continue;
+                }
+                let [a, b, c] = g.faces[t].corners;
+                let q = closest_on_triangle(xl, a, b, c);
+                let d2 = (xl - q.point).length_squared();
+                if d2 < r2 && best.is_none_or(|b| d2 < b.0) {
+                    best = Some((d2, t, q));
+                }
+            }
+            let Some(best) = best else { break };
+            let hit = self.contact(best, xl, from, &mut keep);
+            hint = hit.triangle as u32;
+            let Some((depth, _)) = self.push(&hit, &mut xl, x, prev, r) else {
+                break;
+            };
+            out.contacts += 1;
+            out.depth = out.depth.max(depth);
+        }
+        // Still within the certificate's reach where it ends.
+        let c = &lists.certs;
+        let slack = c.reach[j] - g.travel - r;
+        if !(slack >= 0.0 && (xl - c.anchor_of(j)).length_squared() <= slack * slack) {
+            *x = start;
+            return None;
+        }
+        lists.hint[j] = hint;
+        lists.last[j] = xl;
+        Some(out)
+    }
+}
+
+/// Whether `x` lies in front of triangle `t`'s face with its projection inside it.
+fn over_face(g: &MeshGeometry, t: usize, x: DVec3) -> bool {
+    let f = &g.faces[t];
+    let [a, b, c] = f.corners;
+    let q = closest_on_triangle(x, a, b, c);
+    q.feature == Feature::Face && f.normal.dot(x - a) > 0.0
+}
+
+/// The certificate of a particle at `x` searched out to `reach` (a face's) or `clear` (a
+/// particle with no triangle within `reach`): ψ and the face ([`CLEAR`] if none), or `None`
+/// if the particle is inside a closed mesh. `old` is the particle's certificate's face until
+/// now: unless it is [`NO_FACE`] the particle was outside, and still is (it cannot cross the
+/// surface unseen: a path long enough to is swept by the lists, a shorter one ends within r
+/// of the surface, where every contact pushes it out on its side), and a face whose interior
+/// it is still over serves again (any face serves a certificate; the block test decides
+/// whether it settles the particle).
+fn certificate(
+    g: &MeshGeometry,
+    x: DVec3,
+    (reach, clear): (f64, f64),
+    old: u32,
+) -> Option<(f64, u32)> {
+    let outside = old != NO_FACE;
+    if (old as usize) < g.faces.len() {
+        let [a, b, c] = g.faces[old as usize].corners;
+        let q = closest_on_triangle(x, a, b, c);
+        if q.feature == Feature::Face && (x - q.point).length_squared() < reach * reach {
+            return Some((g.off_ring(x, old as usize, reach), old));
+        }
+    }
+    let clear = clear.max(reach);
+    match g.nearest_unsigned(x, clear) {
+        // A particle not known to be outside is signed by its nearest triangle.
+        Some((t, d2, q)) if !outside && g.signed(x, t, q, d2).distance < 0.0 => None,
+        Some((t, d2, _)) if d2 < reach * reach => Some((g.off_ring(x, t, reach), t as u32)),
+        Some((_, d2, _)) => Some((d2.sqrt(), CLEAR)),
+        None => {
+            // Nothing within `clear`: outside, unless inside a closed mesh's box (where the
+            // side is known, or found by a search for the nearest triangle of all).
+            let (lo, hi) = g.bounds();
+            let outside_box = box_distance_squared(x, lo, hi).sqrt();
+            if outside_box > 0.0 || outside || !g.closed() {
+                return Some((clear.max(outside_box), CLEAR));
+            }
+            let p = g.nearest(x, f64::INFINITY)?;
+            (p.distance >= 0.0).then_some((p.distance.max(clear), CLEAR))
+        }
+    }
+}
