@@ -38,11 +38,11 @@ use pulp::Simd;
 use weft_solver::Contacts;
 use weft_solver::lane_ops::{Ops, V3, load, store};
 
-use super::MeshGeometry;
 use super::candidates::{ChunkLists, MeshFrame};
 use super::certificate::{CLEAR, Certificates, NO_FACE};
 use super::convexity::UNUSABLE;
 use super::grid_lanes::push_vectors;
+use super::{Face, MeshGeometry};
 
 /// Projections nearer than this (barycentric) to an edge of the face are left to the ring.
 const INSIDE: f64 = 1e-9;
@@ -236,15 +236,11 @@ fn settle<S: Simd, const L: usize>(
 ) -> Contacts {
     let g = frame.geometry;
     let near = b.near;
-    // Each near lane's face (a lane that is not near reads zeros, and is masked out).
+    // Each near lane's face (a lane that is not near reads face 0, and is masked out).
     let t: [usize; L] = std::array::from_fn(|l| if near[l] { b.face[l] as usize } else { 0 });
-    let faces = Gathered::<L>::of(g, &t, &near);
-    let (a, bb, c) = (
-        faces.corner::<S>(0),
-        faces.corner::<S>(1),
-        faces.corner::<S>(2),
-    );
-    let n = faces.normal::<S>();
+    let faces = Gathered::<S>::of::<L>(&g.faces, &t);
+    let [a, bb, c] = faces.corners;
+    let n = faces.normal;
     let count: [u8; L] = std::array::from_fn(|l| if near[l] { g.fronts.count[t[l]] } else { 0 });
     for l in (0..L).filter(|&l| near[l]) {
         g.fronts.mark(t[l], g.frame_id);
@@ -291,7 +287,7 @@ fn settle<S: Simd, const L: usize>(
         };
         let mut carried = v3::<S, L>(b.prev);
         if g.moving {
-            let start = start_corners::<S, L>(g, &t, &near);
+            let start = Gathered::<S>::of::<L>(&g.start_faces, &t).corners;
             let end = [a, bb, c];
             // As `MeshFrame::surface_displacement`: Σ wₖ endₖ − Σ wₖ startₖ.
             for i in 0..3 {
@@ -323,21 +319,24 @@ fn settle<S: Simd, const L: usize>(
         usable: &usable,
     };
     let need = o.sel(push, o.add(rv, o.sqrt(slip2)), o.min(h, rv));
-    let clear = fronts.clear(o, g, (&xv, &moved, &lifted), (h, rv, need), push);
+    let (clear, front) = fronts.clear(o, g, (&xv, &moved, &lifted), (h, rv, need), push);
     let done = o.and(o.and(ok, clear), o.ge(within, o.c(0.0)));
     let pushed = o.and(push, done);
     for k in 0..3 {
         b.x[k] = store::<S, L>(o.sel(pushed, moved[k], xv[k]));
     }
-    // A lane clear of r over a face with no front triangle: a hover ball about it.
+    // A lane clear of r: a hover ball about it (every triangle behind F's plane at least h
+    // away, each front triangle at least `front`, every other one what the certificate
+    // leaves).
     let hover = o.and(done, o.le(depth, o.c(0.0)));
     if o.any(hover) {
         let certs = &lists.certs;
         let e = o.dif(&xv, &anchors::<S, L>(&certs.anchor, b.s));
         let reach = load::<S, L>(lanes_at(&certs.reach, b.s));
         let far = o.sub(o.sub(reach, o.c(g.travel)), o.sqrt(o.dot(&e, &e)));
-        let room = store::<S, L>(o.sel(hover, o.sub(o.min(h, far), rv), o.c(0.0)));
-        for l in (0..L).filter(|&l| room[l] > 0.0 && count[l] == 0) {
+        let least = o.min(o.min(h, far), front);
+        let room = store::<S, L>(o.sel(hover, o.sub(least, rv), o.c(0.0)));
+        for l in (0..L).filter(|&l| room[l] > 0.0) {
             let at = DVec3::new(b.x[0][l], b.x[1][l], b.x[2][l]);
             lists.certs.set_hover(b.s + l, at, room[l], g.travel);
         }
@@ -369,7 +368,8 @@ impl<const L: usize> Fronts<'_, L> {
     /// Whether every front triangle of each lane is far enough: at least min(h, r) from `x`
     /// before the push and, where the lane is `pushed`, at least r from where it ends
     /// (`moved`), shown by the triangle's plane; else at least `need` from `lifted` (where the
-    /// push left it, before the slip), shown by its distance.
+    /// push left it, before the slip), shown by its distance. And, for a lane not pushed, how
+    /// near to `x` the front triangles may be, at least (infinite: none).
     #[inline(always)]
     fn clear<S: Simd>(
         &self,
@@ -378,9 +378,10 @@ impl<const L: usize> Fronts<'_, L> {
         (x, moved, lifted): (&V3<S>, &V3<S>, &V3<S>),
         (h, r, need): (S::f64s, S::f64s, S::f64s),
         pushed: S::m64s,
-    ) -> S::m64s {
+    ) -> (S::m64s, S::f64s) {
         let need2 = o.mul(need, need);
         let mut clear = mask::<S, L>(o, [true; L]);
+        let mut nearest = o.c(f64::INFINITY);
         let usable = self.usable;
         let most = (0..L).filter(|&l| usable[l]).map(|l| self.count[l]).max();
         for k in 0..usize::from(most.unwrap_or(0)) {
@@ -393,83 +394,67 @@ impl<const L: usize> Fronts<'_, L> {
                     0
                 }
             });
-            let tri = Gathered::<L>::of(g, &u, &on);
-            let (a, nt) = (tri.corner::<S>(0), tri.normal::<S>());
-            let before = o.ge(o.dot(&nt, &o.dif(x, &a)), o.min(h, r));
+            let tri = Gathered::<S>::of::<L>(&g.faces, &u);
+            let (a, nt) = (tri.corners[0], tri.normal);
+            let listed = mask::<S, L>(o, on);
+            let height = o.dot(&nt, &o.dif(x, &a));
+            let before = o.ge(height, o.min(h, r));
             let after = o.ge(o.dot(&nt, &o.dif(moved, &a)), r);
             let by_plane = o.and(before, o.or(o.not(pushed), after));
-            let open = o.and(mask::<S, L>(o, on), o.not(by_plane));
+            let open = o.and(listed, o.not(by_plane));
             if !o.any(open) {
+                // The plane's height is a lower bound on the distance to the triangle.
+                nearest = o.sel(listed, o.min(nearest, height), nearest);
                 continue;
             }
             #[cfg(test)]
             FRONT_DISTANCES
                 .with(|c| c.set(c.get() + o.bits::<L>(open).iter().filter(|&&b| b).count()));
-            let d2 = distance_squared(o, lifted, [&a, &tri.corner::<S>(1), &tri.corner::<S>(2)]);
+            let d2 = distance_squared(o, lifted, [&a, &tri.corners[1], &tri.corners[2]]);
             clear = o.and(clear, o.or(o.not(open), o.ge(d2, need2)));
+            // A lane not pushed was measured where it is (`lifted` is `x`): its distance;
+            // else the plane's height, a lower bound.
+            let exact = o.and(open, o.not(pushed));
+            let bound = o.sel(exact, o.sqrt(d2), height);
+            nearest = o.sel(listed, o.min(nearest, bound), nearest);
         }
-        clear
+        (clear, nearest)
     }
 }
 
-/// The faces of a block's lanes, read once per lane: corners and normal per axis.
-struct Gathered<const L: usize> {
-    corners: [[[f64; L]; 3]; 3],
-    normal: [[f64; L]; 3],
+/// The faces of a block's lanes, read once per lane: corners and unit normal per axis.
+struct Gathered<S: Simd> {
+    corners: [V3<S>; 3],
+    normal: V3<S>,
 }
 
-impl<const L: usize> Gathered<L> {
-    /// Faces `t[l]` of the lanes `on` (zeros elsewhere).
+impl<S: Simd> Gathered<S> {
+    /// Faces `t[l]` of `faces` (a lane that takes no part names face 0).
     #[inline(always)]
-    fn of(g: &MeshGeometry, t: &[usize; L], on: &[bool; L]) -> Self {
-        let mut out = Self {
-            corners: [[[0.0; L]; 3]; 3],
-            normal: [[0.0; L]; 3],
+    fn of<const L: usize>(faces: &[Face], t: &[usize; L]) -> Self {
+        // Per field (corner and axis, then the normal's axes), per lane.
+        let mut v = [[0.0; L]; 12];
+        for l in 0..L {
+            let f = &faces[t[l]];
+            for k in 0..3 {
+                v[k][l] = f.corners[0][k];
+                v[3 + k][l] = f.corners[1][k];
+                v[6 + k][l] = f.corners[2][k];
+                v[9 + k][l] = f.normal[k];
+            }
+        }
+        let at = |k: usize| -> V3<S> {
+            [
+                load::<S, L>(v[k]),
+                load::<S, L>(v[k + 1]),
+                load::<S, L>(v[k + 2]),
+            ]
         };
-        for l in (0..L).filter(|&l| on[l]) {
-            let f = &g.faces[t[l]];
-            for k in 0..3 {
-                for c in 0..3 {
-                    out.corners[c][k][l] = f.corners[c][k];
-                }
-                out.normal[k][l] = f.normal[k];
-            }
-        }
-        out
-    }
-
-    /// Corner `c`, per axis.
-    #[inline(always)]
-    fn corner<S: Simd>(&self, c: usize) -> V3<S> {
-        v3::<S, L>(&self.corners[c])
-    }
-
-    /// The unit normal, per axis.
-    #[inline(always)]
-    fn normal<S: Simd>(&self) -> V3<S> {
-        v3::<S, L>(&self.normal)
-    }
-}
-
-/// The corners of each lane's face `t[l]` at the substep's start, per corner and axis (zeros
-/// where not `on`).
-#[inline(always)]
-fn start_corners<S: Simd, const L: usize>(
-    g: &MeshGeometry,
-    t: &[usize; L],
-    on: &[bool; L],
-) -> [V3<S>; 3] {
-    let mut v = [[[0.0; L]; 3]; 3];
-    for l in (0..L).filter(|&l| on[l]) {
-        let tri = g.triangles[t[l]];
-        for c in 0..3 {
-            let p = g.start[tri[c] as usize];
-            for k in 0..3 {
-                v[c][k][l] = p[k];
-            }
+        Self {
+            corners: [at(0), at(3), at(6)],
+            normal: at(9),
         }
     }
-    [v3::<S, L>(&v[0]), v3::<S, L>(&v[1]), v3::<S, L>(&v[2])]
 }
 
 /// Lanes `s .. s + L` of a field kept per axis, as vectors.

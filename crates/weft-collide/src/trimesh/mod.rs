@@ -142,6 +142,9 @@ pub(crate) struct MeshGeometry {
     pub end: Vec<DVec3>,
     /// Faces at the end of the substep, in storage order.
     pub faces: Vec<Face>,
+    /// Faces at the start of the substep (those of the last substep that moved the vertices;
+    /// read only while they move).
+    pub start_faces: Vec<Face>,
     /// Their bounding planes, apart (a scan reads only these for most triangles).
     pub planes: Vec<Planes>,
     /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
@@ -196,6 +199,7 @@ impl MeshGeometry {
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         let mut geometry = Self {
             faces: Vec::new(),
+            start_faces: Vec::new(),
             planes: Vec::new(),
             margin: 0.0,
             extent: 0.0,
@@ -217,6 +221,7 @@ impl MeshGeometry {
             frame_span: (0.0, 0.0),
         };
         (geometry.faces, geometry.planes) = geometry.compute_faces();
+        geometry.start_faces.clone_from(&geometry.faces);
         geometry.set_margin(extent);
         let ends = (&geometry.end[..], &geometry.end[..]);
         (geometry.fronts).update(&geometry.triangles, &geometry.rings, ends, (extent, 0));
@@ -339,6 +344,7 @@ impl MeshGeometry {
         if !self.moving {
             return;
         }
+        std::mem::swap(&mut self.faces, &mut self.start_faces);
         face_update::update_faces(&mut self.faces, &self.triangles, &self.end);
     }
 
