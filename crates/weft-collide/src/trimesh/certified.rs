@@ -20,10 +20,10 @@
 //!   of the plane).
 //!
 //! A front triangle is at least d away where the particle is d in front of its plane, else by
-//! its distance, worked out a block of lanes at a time. A clear lane over a face with no front
-//! triangle keeps a hover ball about where it stands: every triangle is at least min(h, what
-//! its certificate leaves) away, so no triangle is within r of a point of the ball shrunk by
-//! that excess, less the surface's travel since.
+//! its distance, worked out a block of lanes at a time. A clear lane keeps a hover ball about
+//! where it stands: every triangle is at least min(h, the front triangles' bounds, what its
+//! certificate leaves) away, so no triangle is within r of a point of the ball shrunk by that
+//! excess, less the surface's travel since.
 //!
 //! What a lane does depends on that particle alone and every lane runs the same IEEE
 //! operations in the same order (no fused multiply-adds, every branch a select), so the bits
