@@ -207,18 +207,21 @@ impl CollisionWorld {
 
     /// Candidate lists built so far for triangle-mesh contacts (all mesh colliders).
     pub fn mesh_list_builds(&self) -> u64 {
-        let chunks: u64 = (self.mesh_lists.iter())
-            .flat_map(|chunk| chunk.iter().map(|l| l.builds))
-            .sum();
-        chunks + self.run_lists.sum(|l| l.builds)
+        self.sum_over_lists(|l| l.builds)
     }
 
     /// Certificates made so far for triangle-mesh contacts (all mesh colliders with lists).
     pub fn mesh_certificate_builds(&self) -> u64 {
+        self.sum_over_lists(|l| l.certs.builds)
+    }
+
+    /// `count` summed over every chunk of candidate lists, of the general loop and the fused
+    /// frame's runs.
+    fn sum_over_lists(&self, count: impl Fn(&ChunkLists) -> u64 + Copy) -> u64 {
         let chunks: u64 = (self.mesh_lists.iter())
-            .flat_map(|chunk| chunk.iter().map(|l| l.certs.builds))
+            .flat_map(|chunk| chunk.iter().map(count))
             .sum();
-        chunks + self.run_lists.sum(|l| l.certs.builds)
+        chunks + self.run_lists.sum(count)
     }
 
     /// Triangles now listed for triangle-mesh contacts, over all particles and mesh

@@ -65,6 +65,31 @@ pub fn store<S: Simd, const L: usize>(v: S::f64s) -> [f64; L] {
     bytemuck::cast(v)
 }
 
+/// Lanes per axis as one vector per axis.
+#[inline(always)]
+pub fn load3<S: Simd, const L: usize>(v: &[[f64; L]; 3]) -> V3<S> {
+    [load::<S, L>(v[0]), load::<S, L>(v[1]), load::<S, L>(v[2])]
+}
+
+/// One vector per axis as lanes per axis.
+#[inline(always)]
+pub fn store3<S: Simd, const L: usize>(v: &V3<S>) -> [[f64; L]; 3] {
+    [
+        store::<S, L>(v[0]),
+        store::<S, L>(v[1]),
+        store::<S, L>(v[2]),
+    ]
+}
+
+/// Values `s .. s + L` of `v` as one vector (NaN in every lane where they run past its end).
+#[inline(always)]
+pub fn load_at<S: Simd, const L: usize>(v: &[f64], s: usize) -> S::f64s {
+    match v.get(s..s + L).and_then(|c| c.first_chunk::<L>()) {
+        Some(c) => load::<S, L>(*c),
+        None => load::<S, L>([f64::NAN; L]),
+    }
+}
+
 /// The operations on `S`, as functions rather than closures: a closure is a function of its
 /// own without the target features, into which the intrinsics do not inline (measured:
 /// `_mm256_mul_pd` as a call, the dihedral kernel twice as slow as scalar code).

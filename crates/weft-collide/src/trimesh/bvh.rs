@@ -111,15 +111,9 @@ impl Bvh {
     /// children before parents; the tree's shape is kept.
     pub fn refit(&mut self, leaf_box: impl Fn(usize) -> (DVec3, DVec3)) {
         let mut boxes = std::mem::take(&mut self.scratch);
-        self.merge_up(leaf_box, &mut boxes);
-        for (node, &(lo, hi)) in self.nodes.iter_mut().zip(&boxes) {
-            node.lo = lo;
-            node.hi = hi;
-        }
+        self.merge_up(|i| [leaf_box(i)], [&mut boxes]);
+        self.set_boxes(&boxes);
         self.scratch = boxes;
-        let mut wide = std::mem::take(&mut self.wide);
-        wide.refit(self);
-        self.wide = wide;
     }
 
     /// [`Self::refit`], and how far the primitives' vertices move over the current frame (for
@@ -128,15 +122,41 @@ impl Bvh {
     pub fn refit_moving(&mut self, leaf: impl Fn(usize) -> [(DVec3, DVec3); 2]) {
         let mut boxes = std::mem::take(&mut self.scratch);
         let mut motions = std::mem::take(&mut self.scratch_motions);
+        self.merge_up(leaf, [&mut boxes, &mut motions]);
+        self.set_boxes(&boxes);
+        self.wide.set_motions(&motions);
+        self.scratch = boxes;
+        self.scratch_motions = motions;
+    }
+
+    /// Sets every node's box to `boxes` (indexed as the nodes) and refits the four-wide copy.
+    fn set_boxes(&mut self, boxes: &[(DVec3, DVec3)]) {
+        for (node, &(lo, hi)) in self.nodes.iter_mut().zip(boxes) {
+            node.lo = lo;
+            node.hi = hi;
+        }
+        let mut wide = std::mem::take(&mut self.wide);
+        wide.refit(self);
+        self.wide = wide;
+    }
+
+    /// Every node's `K` boxes of its primitives' boxes `leaf(i)` (box k of each into
+    /// `boxes[k]`, indexed as the nodes), children before parents.
+    fn merge_up<const K: usize>(
+        &self,
+        leaf: impl Fn(usize) -> [(DVec3, DVec3); K],
+        boxes: [&mut Vec<(DVec3, DVec3)>; K],
+    ) {
         let n = self.nodes.len();
-        boxes.clear();
-        boxes.resize(n, (DVec3::ZERO, DVec3::ZERO));
-        motions.clear();
-        motions.resize(n, (DVec3::ZERO, DVec3::ZERO));
+        let mut boxes = boxes.map(|b| {
+            b.clear();
+            b.resize(n, (DVec3::ZERO, DVec3::ZERO));
+            b
+        });
         for k in (0..n).rev() {
             let node = self.nodes[k];
-            let mut acc = [(DVec3::INFINITY, DVec3::NEG_INFINITY); 2];
-            let mut take = |b: [(DVec3, DVec3); 2]| {
+            let mut acc = [(DVec3::INFINITY, DVec3::NEG_INFINITY); K];
+            let mut take = |b: [(DVec3, DVec3); K]| {
                 for (a, (l, h)) in acc.iter_mut().zip(b) {
                     a.0 = a.0.min(l);
                     a.1 = a.1.max(h);
@@ -146,42 +166,12 @@ impl Bvh {
                 (node.first..node.first + node.count).for_each(|i| take(leaf(i as usize)));
             } else {
                 for c in [node.first as usize, node.first as usize + 1] {
-                    take([boxes[c], motions[c]]);
+                    take(std::array::from_fn(|j| boxes[j][c]));
                 }
             }
-            [boxes[k], motions[k]] = acc;
-        }
-        for (node, &(lo, hi)) in self.nodes.iter_mut().zip(&boxes) {
-            node.lo = lo;
-            node.hi = hi;
-        }
-        let mut wide = std::mem::take(&mut self.wide);
-        wide.refit(self);
-        wide.set_motions(&motions);
-        self.wide = wide;
-        self.scratch = boxes;
-        self.scratch_motions = motions;
-    }
-
-    /// Every node's box of its primitives' boxes `leaf(i)`, children before parents, into
-    /// `boxes` (indexed as the nodes).
-    fn merge_up(&self, leaf: impl Fn(usize) -> (DVec3, DVec3), boxes: &mut Vec<(DVec3, DVec3)>) {
-        boxes.clear();
-        boxes.resize(self.nodes.len(), (DVec3::ZERO, DVec3::ZERO));
-        for n in (0..self.nodes.len()).rev() {
-            let node = self.nodes[n];
-            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-            let mut take = |(l, h): (DVec3, DVec3)| {
-                lo = lo.min(l);
-                hi = hi.max(h);
-            };
-            if node.count > 0 {
-                (node.first..node.first + node.count).for_each(|i| take(leaf(i as usize)));
-            } else {
-                take(boxes[node.first as usize]);
-                take(boxes[node.first as usize + 1]);
+            for (b, a) in boxes.iter_mut().zip(acc) {
+                b[k] = a;
             }
-            boxes[n] = (lo, hi);
         }
     }
 

@@ -767,11 +767,8 @@ impl MeshFrame<'_> {
             let t = t as usize;
             t != left
                 && was.sqrt() - moved < r
-                && f64::from(g.planes[t].distance_squared_bound(x32, g.margin)) < r * r
-                && {
-                    let [a, b, c] = g.faces[t].corners;
-                    (xl - closest_on_triangle(xl, a, b, c).point).length_squared() < r * r
-                }
+                && g.closest_within(t, xl, (x32, g.margin), r * r)
+                    .is_some_and(|(d2, _)| d2 < r * r)
         })
     }
 }

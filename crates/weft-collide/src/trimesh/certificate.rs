@@ -194,12 +194,9 @@ impl MeshFrame<'_> {
             let mut best: Option<(f64, usize, Closest)> = None;
             let x32 = xl.as_vec3();
             for t in std::iter::once(face).chain(ring.iter().map(|&t| t as usize)) {
-                if f64::from(g.planes[t].distance_squared_bound(x32, g.margin)) >= r2 {
+                let Some((d2, q)) = g.closest_within(t, xl, (x32, g.margin), r2) else {
                     continue;
-                }
-                let [a, b, c] = g.faces[t].corners;
-                let q = closest_on_triangle(xl, a, b, c);
-                let d2 = (xl - q.point).length_squared();
+                };
                 if d2 < r2 && best.is_none_or(|b| d2 < b.0) {
                     best = Some((d2, t, q));
                 }

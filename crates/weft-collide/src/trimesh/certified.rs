@@ -36,7 +36,7 @@
 use glam::DVec3;
 use pulp::Simd;
 use weft_solver::Contacts;
-use weft_solver::lane_ops::{Ops, V3, load, store};
+use weft_solver::lane_ops::{Ops, V3, load, load_at, load3, store};
 
 use super::candidates::{ChunkLists, MeshFrame};
 use super::certificate::{CLEAR, Certificates, NO_FACE};
@@ -113,7 +113,7 @@ pub(crate) fn certified<S: Simd, const L: usize>(
             }
         }
     }
-    let path = (&v3::<S, L>(x), &v3::<S, L>(&from));
+    let path = (&load3::<S, L>(x), &load3::<S, L>(&from));
     let rv = load::<S, L>(*r);
     // Certificates that do not hold are made again, then read anew.
     let mut valid = holds::<S, L>(o, &lists.certs, s, path, (rv, g.travel));
@@ -127,7 +127,7 @@ pub(crate) fn certified<S: Simd, const L: usize>(
     }
     let certs = &lists.certs;
     let face: [u32; L] = std::array::from_fn(|l| certs.face[s + l]);
-    let hover_slack = o.sub(load::<S, L>(lanes_at(&certs.hover[3], s)), o.c(g.travel));
+    let hover_slack = o.sub(load_at::<S, L>(&certs.hover[3], s), o.c(g.travel));
     let hovers = in_ball::<S, L>(o, anchors::<S, L>(&certs.hover, s), hover_slack, path);
     let mut near = [false; L];
     for l in 0..L {
@@ -186,10 +186,7 @@ fn holds<S: Simd, const L: usize>(
     path: (&V3<S>, &V3<S>),
     (r, travel): (S::f64s, f64),
 ) -> [bool; L] {
-    let slack = o.sub(
-        o.sub(load::<S, L>(lanes_at(&certs.reach, s)), o.c(travel)),
-        r,
-    );
+    let slack = o.sub(o.sub(load_at::<S, L>(&certs.reach, s), o.c(travel)), r);
     in_ball::<S, L>(o, anchors::<S, L>(&certs.anchor, s), slack, path)
 }
 
@@ -245,11 +242,11 @@ fn settle<S: Simd, const L: usize>(
     for l in (0..L).filter(|&l| near[l]) {
         g.fronts.mark(t[l], g.frame_id);
     }
-    let xv = v3::<S, L>(b.x);
+    let xv = load3::<S, L>(b.x);
     let rv = load::<S, L>(*b.r);
     // A short path (no sweep due), relative to the surface on the substep's first projection.
     let half = o.sub(o.mul(o.c(0.5), rv), o.c(frame.surface_travel()));
-    let p = o.dif(&xv, &v3::<S, L>(b.from));
+    let p = o.dif(&xv, &load3::<S, L>(b.from));
     let short = o.and(o.ge(half, o.c(0.0)), o.le(o.dot(&p, &p), o.mul(half, half)));
     // With e₁ = b − a, e₂ = c − a, m = e₁ × e₂ and d = x − a, the projection of x is
     // a + β e₁ + γ e₂ with β |m|² = (d × e₂) · m and γ |m|² = (e₁ × d) · m.
@@ -285,7 +282,7 @@ fn settle<S: Simd, const L: usize>(
             let (beta, gamma) = (o.div(bm, m2), o.div(gm, m2));
             [o.sub(o.sub(o.c(1.0), beta), gamma), beta, gamma]
         };
-        let mut carried = v3::<S, L>(b.prev);
+        let mut carried = load3::<S, L>(b.prev);
         if g.moving {
             let start = Gathered::<S>::of::<L>(&g.start_faces, &t).corners;
             let end = [a, bb, c];
@@ -306,7 +303,7 @@ fn settle<S: Simd, const L: usize>(
         // Where it ends is still within the certificate's reach (a lane not pushed: 1).
         let certs = &lists.certs;
         let anchor = anchors::<S, L>(&certs.anchor, b.s);
-        let reach = load::<S, L>(lanes_at(&certs.reach, b.s));
+        let reach = load_at::<S, L>(&certs.reach, b.s);
         let slack = o.sub(o.sub(reach, o.c(g.travel)), rv);
         let e = o.dif(&moved, &anchor);
         within = o.sel(push, o.sub(o.mul(slack, slack), o.dot(&e, &e)), within);
@@ -332,7 +329,7 @@ fn settle<S: Simd, const L: usize>(
     if o.any(hover) {
         let certs = &lists.certs;
         let e = o.dif(&xv, &anchors::<S, L>(&certs.anchor, b.s));
-        let reach = load::<S, L>(lanes_at(&certs.reach, b.s));
+        let reach = load_at::<S, L>(&certs.reach, b.s);
         let far = o.sub(o.sub(reach, o.c(g.travel)), o.sqrt(o.dot(&e, &e)));
         let least = o.min(o.min(h, far), front);
         let room = store::<S, L>(o.sel(hover, o.sub(least, rv), o.c(0.0)));
@@ -432,27 +429,24 @@ impl<S: Simd> Gathered<S> {
     /// Faces `t[l]` of `faces` (a lane that takes no part names face 0).
     #[inline(always)]
     fn of<const L: usize>(faces: &[Face], t: &[usize; L]) -> Self {
-        // Per field (corner and axis, then the normal's axes), per lane.
-        let mut v = [[0.0; L]; 12];
+        // Per field (the corners, then the normal), axis and lane.
+        let mut v = [[[0.0; L]; 3]; 4];
         for l in 0..L {
             let f = &faces[t[l]];
             for k in 0..3 {
-                v[k][l] = f.corners[0][k];
-                v[3 + k][l] = f.corners[1][k];
-                v[6 + k][l] = f.corners[2][k];
-                v[9 + k][l] = f.normal[k];
+                v[0][k][l] = f.corners[0][k];
+                v[1][k][l] = f.corners[1][k];
+                v[2][k][l] = f.corners[2][k];
+                v[3][k][l] = f.normal[k];
             }
         }
-        let at = |k: usize| -> V3<S> {
-            [
-                load::<S, L>(v[k]),
-                load::<S, L>(v[k + 1]),
-                load::<S, L>(v[k + 2]),
-            ]
-        };
         Self {
-            corners: [at(0), at(3), at(6)],
-            normal: at(9),
+            corners: [
+                load3::<S, L>(&v[0]),
+                load3::<S, L>(&v[1]),
+                load3::<S, L>(&v[2]),
+            ],
+            normal: load3::<S, L>(&v[3]),
         }
     }
 }
@@ -461,25 +455,10 @@ impl<S: Simd> Gathered<S> {
 #[inline(always)]
 fn anchors<S: Simd, const L: usize>(field: &[Vec<f64>], s: usize) -> V3<S> {
     [
-        load::<S, L>(lanes_at(&field[0], s)),
-        load::<S, L>(lanes_at(&field[1], s)),
-        load::<S, L>(lanes_at(&field[2], s)),
+        load_at::<S, L>(&field[0], s),
+        load_at::<S, L>(&field[1], s),
+        load_at::<S, L>(&field[2], s),
     ]
-}
-
-/// `L` values of `v` from `s` (NaN past its end).
-#[inline(always)]
-fn lanes_at<const L: usize>(v: &[f64], s: usize) -> [f64; L] {
-    match v.get(s..s + L).and_then(|c| c.first_chunk::<L>()) {
-        Some(c) => *c,
-        None => [f64::NAN; L],
-    }
-}
-
-/// Lanes per axis as vectors.
-#[inline(always)]
-fn v3<S: Simd, const L: usize>(v: &[[f64; L]; 3]) -> V3<S> {
-    [load::<S, L>(v[0]), load::<S, L>(v[1]), load::<S, L>(v[2])]
 }
 
 /// `bits` as a mask of `S`.

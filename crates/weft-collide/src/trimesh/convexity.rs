@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use super::normals::Topology;
 
 /// Ring triangles a face may have in front of it and still be settled by [`Fronts`]: the
-/// lane test works out a particle's distance to each.
+/// certified test works out a particle's distance to each.
 pub(crate) const FRONT: usize = 8;
 
 /// [`Fronts::count`] of a face that settles nothing (degenerate, or more than [`FRONT`] ring

@@ -11,7 +11,7 @@ use glam::DVec3;
 use pulp::Simd;
 use rayon::prelude::*;
 use weft_solver::SimdPath;
-use weft_solver::lane_ops::{LaneKernel, Ops, V3, load, on_path, store};
+use weft_solver::lane_ops::{LaneKernel, Ops, V3, load3, on_path, store, store3};
 
 use super::{Face, Planes};
 
@@ -20,12 +20,24 @@ const PART: usize = 1024;
 
 /// Sets `faces[i]` to triangle `triangles[i]`'s face at the vertices `end`, as [`Face::at`].
 pub(crate) fn update_faces(faces: &mut [Face], triangles: &[[u32; 3]], end: &[DVec3]) {
+    update(faces, triangles, end);
+}
+
+/// Sets `planes[i]` to triangle `triangles[i]`'s planes at the vertices `end`, as
+/// [`Planes::new`] with [`super::normals::face_normal`].
+pub(crate) fn update_planes(planes: &mut [Planes], triangles: &[[u32; 3]], end: &[DVec3]) {
+    update(planes, triangles, end);
+}
+
+/// Sets `out[i]` to what triangle `triangles[i]` gives at the vertices `end`, in parallel
+/// parts, each a block of triangles at a time on the CPU's kernel path.
+fn update<T: OfCorners>(out: &mut [T], triangles: &[[u32; 3]], end: &[DVec3]) {
     let path = SimdPath::resolve(None);
-    (faces.par_chunks_mut(PART).zip(triangles.par_chunks(PART))).for_each(|(faces, triangles)| {
+    (out.par_chunks_mut(PART).zip(triangles.par_chunks(PART))).for_each(|(out, triangles)| {
         on_path(
             path,
             Part {
-                faces,
+                out,
                 triangles,
                 end,
             },
@@ -33,87 +45,98 @@ pub(crate) fn update_faces(faces: &mut [Face], triangles: &[[u32; 3]], end: &[DV
     });
 }
 
-/// Sets `planes[i]` to triangle `triangles[i]`'s planes at the vertices `end`, as
-/// [`Planes::new`] with [`super::normals::face_normal`].
-pub(crate) fn update_planes(planes: &mut [Planes], triangles: &[[u32; 3]], end: &[DVec3]) {
-    let path = SimdPath::resolve(None);
-    (planes.par_chunks_mut(PART).zip(triangles.par_chunks(PART))).for_each(
-        |(planes, triangles)| {
-            on_path(
-                path,
-                PlanesPart {
-                    planes,
-                    triangles,
-                    end,
-                },
-            );
-        },
-    );
+/// What a triangle's record is worked out from its corners: a block of triangles at a time in
+/// vectors, or one alone, with the same bits.
+trait OfCorners: Sized + Send {
+    /// Sets `out[l]` from the corners of lane l (`corners`: per corner, axis and lane).
+    fn block<S: Simd, const L: usize>(o: Ops<S>, corners: &[[[f64; L]; 3]; 3], out: &mut [Self]);
+
+    /// The record of one triangle with `corners`.
+    fn one(corners: [DVec3; 3]) -> Self;
 }
 
-/// One task's planes, as a [`LaneKernel`].
-struct PlanesPart<'a> {
-    planes: &'a mut [Planes],
+impl OfCorners for Face {
+    #[inline(always)]
+    fn block<S: Simd, const L: usize>(o: Ops<S>, corners: &[[[f64; L]; 3]; 3], out: &mut [Self]) {
+        let [a, b, c] = load_corners::<S, L>(corners);
+        let normal = store3::<S, L>(&unit_normal(o, [&a, &b, &c]));
+        for (l, face) in out.iter_mut().enumerate().take(L) {
+            for c in 0..3 {
+                face.corners[c] = DVec3::new(corners[c][0][l], corners[c][1][l], corners[c][2][l]);
+            }
+            face.normal = DVec3::new(normal[0][l], normal[1][l], normal[2][l]);
+        }
+    }
+
+    fn one(corners: [DVec3; 3]) -> Self {
+        Face::at(corners)
+    }
+}
+
+impl OfCorners for Planes {
+    #[inline(always)]
+    fn block<S: Simd, const L: usize>(o: Ops<S>, corners: &[[[f64; L]; 3]; 3], out: &mut [Self]) {
+        let [a, b, c] = load_corners::<S, L>(corners);
+        let n = unit_normal(o, [&a, &b, &c]);
+        // Each plane's unit normal and offset (n · point), per lane: the face's, then edge
+        // k's in-plane outward normal (corners k, k + 1) through corner k.
+        let ends = [(&b, &a), (&c, &b), (&a, &c)];
+        let at = [&a, &a, &b, &c];
+        let mut rows = [[[0.0; L]; 4]; 4];
+        for k in 0..4 {
+            let normal = if k == 0 {
+                n
+            } else {
+                let (to, from) = ends[k - 1];
+                unit(o, o.cross(&o.dif(to, from), &n))
+            };
+            for i in 0..3 {
+                rows[k][i] = store::<S, L>(normal[i]);
+            }
+            rows[k][3] = store::<S, L>(o.dot(&normal, at[k]));
+        }
+        for (l, p) in out.iter_mut().enumerate().take(L) {
+            for k in 0..4 {
+                for i in 0..4 {
+                    p.0[4 * k + i] = rows[k][i][l] as f32;
+                }
+            }
+        }
+    }
+
+    fn one([a, b, c]: [DVec3; 3]) -> Self {
+        Planes::new([a, b, c], super::normals::face_normal(a, b, c))
+    }
+}
+
+/// One task's triangles, as a [`LaneKernel`].
+struct Part<'a, T> {
+    out: &'a mut [T],
     triangles: &'a [[u32; 3]],
     end: &'a [DVec3],
 }
 
-impl LaneKernel for PlanesPart<'_> {
+impl<T: OfCorners> LaneKernel for Part<'_, T> {
     type Output = ();
 
     #[inline(always)]
     fn run<S: Simd, const L: usize>(self, s: S) {
-        let PlanesPart {
-            planes,
+        let Part {
+            out,
             triangles,
             end,
         } = self;
         let o = Ops(s);
-        let full = planes.len() - planes.len() % L;
+        let full = out.len() - out.len() % L;
         for f in (0..full).step_by(L) {
             let tri: &[[u32; 3]; L] = match triangles[f..f + L].first_chunk::<L>() {
                 Some(t) => t,
                 None => continue,
             };
-            let corners = gather::<L>(tri, end);
-            let v = |c: usize| -> V3<S> {
-                [
-                    load::<S, L>(corners[c][0]),
-                    load::<S, L>(corners[c][1]),
-                    load::<S, L>(corners[c][2]),
-                ]
-            };
-            let (a, b, c) = (v(0), v(1), v(2));
-            let n = unit(o, o.cross(&o.dif(&b, &a), &o.dif(&c, &a)));
-            // Each plane's unit normal and offset (n · point), per lane: the face's, then
-            // edge k's in-plane outward normal (corners k, k + 1) through corner k.
-            let ends = [(&b, &a), (&c, &b), (&a, &c)];
-            let at = [&a, &a, &b, &c];
-            let mut rows = [[[0.0; L]; 4]; 4];
-            for k in 0..4 {
-                let normal = if k == 0 {
-                    n
-                } else {
-                    let (to, from) = ends[k - 1];
-                    unit(o, o.cross(&o.dif(to, from), &n))
-                };
-                for i in 0..3 {
-                    rows[k][i] = store::<S, L>(normal[i]);
-                }
-                rows[k][3] = store::<S, L>(o.dot(&normal, at[k]));
-            }
-            for l in 0..L {
-                let p = &mut planes[f + l].0;
-                for k in 0..4 {
-                    for i in 0..4 {
-                        p[4 * k + i] = rows[k][i][l] as f32;
-                    }
-                }
-            }
+            T::block::<S, L>(o, &gather::<L>(tri, end), &mut out[f..f + L]);
         }
-        for (p, t) in planes[full..].iter_mut().zip(&triangles[full..]) {
-            let [a, b, c] = t.map(|i| end[i as usize]);
-            *p = Planes::new([a, b, c], super::normals::face_normal(a, b, c));
+        for (record, t) in out[full..].iter_mut().zip(&triangles[full..]) {
+            *record = T::one(t.map(|i| end[i as usize]));
         }
     }
 }
@@ -133,6 +156,23 @@ fn gather<const L: usize>(tri: &[[u32; 3]; L], end: &[DVec3]) -> [[[f64; L]; 3];
     corners
 }
 
+/// The corners per corner, axis and lane as vectors.
+#[inline(always)]
+fn load_corners<S: Simd, const L: usize>(corners: &[[[f64; L]; 3]; 3]) -> [V3<S>; 3] {
+    [
+        load3::<S, L>(&corners[0]),
+        load3::<S, L>(&corners[1]),
+        load3::<S, L>(&corners[2]),
+    ]
+}
+
+/// Each lane's unit normal (b − a) × (c − a) / |…| from its corners a, b, c, or zero where
+/// that is not finite, as glam's `normalize_or_zero` gives it.
+#[inline(always)]
+fn unit_normal<S: Simd>(o: Ops<S>, [a, b, c]: [&V3<S>; 3]) -> V3<S> {
+    unit(o, o.cross(&o.dif(b, a), &o.dif(c, a)))
+}
+
 /// `m` / |m| per lane, or zero where that is not finite (glam's `normalize_or_zero`).
 #[inline(always)]
 fn unit<S: Simd>(o: Ops<S>, m: V3<S>) -> V3<S> {
@@ -143,67 +183,6 @@ fn unit<S: Simd>(o: Ops<S>, m: V3<S>) -> V3<S> {
         n[k] = o.sel(ok, o.mul(m[k], rcp), o.c(0.0));
     }
     n
-}
-
-/// One task's faces, as a [`LaneKernel`].
-struct Part<'a> {
-    faces: &'a mut [Face],
-    triangles: &'a [[u32; 3]],
-    end: &'a [DVec3],
-}
-
-impl LaneKernel for Part<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn run<S: Simd, const L: usize>(self, s: S) {
-        let Part {
-            faces,
-            triangles,
-            end,
-        } = self;
-        let o = Ops(s);
-        let full = faces.len() - faces.len() % L;
-        for f in (0..full).step_by(L) {
-            let tri: &[[u32; 3]; L] = match triangles[f..f + L].first_chunk::<L>() {
-                Some(t) => t,
-                None => continue,
-            };
-            let corners = gather::<L>(tri, end);
-            let normal = normals::<S, L>(o, &corners);
-            for l in 0..L {
-                let face = &mut faces[f + l];
-                for c in 0..3 {
-                    face.corners[c] =
-                        DVec3::new(corners[c][0][l], corners[c][1][l], corners[c][2][l]);
-                }
-                face.normal = DVec3::new(normal[0][l], normal[1][l], normal[2][l]);
-            }
-        }
-        for (face, t) in faces[full..].iter_mut().zip(&triangles[full..]) {
-            *face = Face::at(t.map(|i| end[i as usize]));
-        }
-    }
-}
-
-/// Each lane's unit normal (b − a) × (c − a) / |…| from its corners a, b, c per axis, or zero
-/// where that is not finite, as glam's `normalize_or_zero` gives it.
-#[inline(always)]
-fn normals<S: Simd, const L: usize>(o: Ops<S>, corners: &[[[f64; L]; 3]; 3]) -> [[f64; L]; 3] {
-    let v = |c: usize| -> V3<S> {
-        [
-            load::<S, L>(corners[c][0]),
-            load::<S, L>(corners[c][1]),
-            load::<S, L>(corners[c][2]),
-        ]
-    };
-    let (a, b, c) = (v(0), v(1), v(2));
-    let m = unit(o, o.cross(&o.dif(&b, &a), &o.dif(&c, &a)));
-    [
-        store::<S, L>(m[0]),
-        store::<S, L>(m[1]),
-        store::<S, L>(m[2]),
-    ]
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@
 
 use glam::DVec3;
 use pulp::Simd;
-use weft_solver::lane_ops::{LaneKernel, Ops, V3, load, on_path, store};
+use weft_solver::lane_ops::{LaneKernel, Ops, V3, load, load_at, on_path, store};
 use weft_solver::{Contacts, ParticleRun};
 
 use super::candidates::MeshFrame;
@@ -251,15 +251,6 @@ impl LaneKernel for Blocks<'_, '_, '_, '_> {
     }
 }
 
-/// `L` values of `v` from `s`.
-#[inline(always)]
-fn lanes_at<const L: usize>(v: &[f64], s: usize) -> [f64; L] {
-    match v[s..s + L].first_chunk::<L>() {
-        Some(c) => *c,
-        None => [0.0; L],
-    }
-}
-
 #[inline(always)]
 fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> Contacts {
     let Blocks {
@@ -280,11 +271,11 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
     let full = n - n % L;
     let place = Placement::of(frame);
     for s in (0..full).step_by(L) {
-        let wx: V3<S> = std::array::from_fn(|k| load::<S, L>(lanes_at(x[k], s)));
-        let wp: V3<S> = std::array::from_fn(|k| load::<S, L>(lanes_at(prev[k], s)));
-        let wb = load::<S, L>(lanes_at(w, s));
+        let wx: V3<S> = std::array::from_fn(|k| load_at::<S, L>(x[k], s));
+        let wp: V3<S> = std::array::from_fn(|k| load_at::<S, L>(prev[k], s));
+        let wb = load_at::<S, L>(w, s);
         let live = o.not(o.eq(wb, o.c(0.0)));
-        let rb = load::<S, L>(lanes_at(r, s));
+        let rb = load_at::<S, L>(r, s);
         let tested = first_test::<S, L>(
             o,
             frame,

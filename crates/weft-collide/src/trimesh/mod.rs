@@ -414,22 +414,37 @@ impl MeshGeometry {
     /// [`Self::nearest`] without its sign: the triangle, the squared distance and the closest
     /// point.
     pub fn nearest_unsigned(&self, x: DVec3, max_dist: f64) -> Option<(usize, f64, Closest)> {
-        let faces = &self.faces;
         let limit = if max_dist.is_finite() {
             max_dist * max_dist
         } else {
             f64::INFINITY
         };
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
+        // Each triangle passed over where its planes' bound is no nearer than the best so far.
         self.bvh.nearest(x, limit, |t, bound| {
-            // Cheap reject: a lower bound no nearer than the best so far.
-            if f64::from(self.planes[t].distance_squared_bound(x32, margin)) >= bound {
-                return None;
-            }
-            let [a, b, cc] = faces[t].corners;
-            let c = closest_on_triangle(x, a, b, cc);
-            Some(((x - c.point).length_squared(), c))
+            self.closest_within(t, x, (x32, margin), bound)
         })
+    }
+
+    /// Triangle `t`'s squared distance from `x` and closest point, or `None` where the cheap
+    /// bound of its planes (one cache line; `x32` is `x` in f32, `margin` the rounding bound
+    /// there) shows it is no nearer than `bound` (squared) before its corners are read.
+    // Always inlined: as a call (plain `#[inline]` left it one) the breathing ball's frame
+    // measured 10 % slower.
+    #[inline(always)]
+    pub fn closest_within(
+        &self,
+        t: usize,
+        x: DVec3,
+        (x32, margin): (glam::Vec3, f32),
+        bound: f64,
+    ) -> Option<(f64, Closest)> {
+        if f64::from(self.planes[t].distance_squared_bound(x32, margin)) >= bound {
+            return None;
+        }
+        let [a, b, c] = self.faces[t].corners;
+        let q = closest_on_triangle(x, a, b, c);
+        Some(((x - q.point).length_squared(), q))
     }
 
     /// Appends to `out` every triangle within `radius` of `x` at the end of the substep, in
@@ -480,17 +495,13 @@ impl MeshGeometry {
     /// its ring), or `radius` if none is nearer.
     pub fn off_ring(&self, x: DVec3, t: usize, radius: f64) -> f64 {
         let ring = self.triangles[t];
-        let faces = &self.faces;
-        let (x32, margin) = (x.as_vec3(), self.margin_at(x));
+        let at = (x.as_vec3(), self.margin_at(x));
         let mut limit = radius * radius;
         self.bvh.branch_and_bound(x, limit, |u| {
             if convexity::share_a_corner(ring, self.triangles[u]) {
                 return limit;
             }
-            // Cheap reject on the planes (one cache line) before the corners.
-            if f64::from(self.planes[u].distance_squared_bound(x32, margin)) < limit {
-                let [a, b, c] = faces[u].corners;
-                let d2 = (x - closest_on_triangle(x, a, b, c).point).length_squared();
+            if let Some((d2, _)) = self.closest_within(u, x, at, limit) {
                 limit = limit.min(d2);
             }
             limit
