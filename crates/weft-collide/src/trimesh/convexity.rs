@@ -106,7 +106,8 @@ pub(crate) fn share_a_corner(a: [u32; 3], b: [u32; 3]) -> bool {
 
 /// Per face, over a frame: how many of its ring triangles may come in front of its plane
 /// (0: the whole ring stays behind it; [`UNUSABLE`]: more than [`FRONT`], a degenerate face,
-/// or a face no particle's certificate named in the frame before), and which.
+/// or a face neither named by a particle's certificate in the frame before nor in the ring of
+/// one that was), and which.
 #[derive(Debug, Default)]
 pub(crate) struct Fronts {
     /// Per face, how many ring triangles may be in front, or [`UNUSABLE`].
@@ -114,7 +115,7 @@ pub(crate) struct Fronts {
     /// Per face, those triangles (the first `count`).
     pub front: Vec<[u32; FRONT]>,
     /// Per face, the last frame in which a certified test read it (`certified`): only those
-    /// read in the frame before are worked out for a frame.
+    /// read in the frame before, and their rings, are worked out for a frame.
     used: Vec<AtomicU64>,
 }
 
@@ -136,7 +137,8 @@ impl Fronts {
     /// `from` to `to` (see the module's notes): every other one lies strictly behind it
     /// throughout. `extent` bounds the vertices' coordinates (for the rounding margin). Every
     /// face for `frame` 0 (a still mesh, passing the same vertices twice), else those read in
-    /// the frame before `frame` (the others are left [`UNUSABLE`] for this one).
+    /// the frame before `frame` and the faces of their rings (the others are left
+    /// [`UNUSABLE`] for this one).
     pub fn update(
         &mut self,
         triangles: &[[u32; 3]],
@@ -156,7 +158,6 @@ impl Fronts {
         .enumerate()
         .for_each(|(k, (count, front))| {
             let faces = (k * PART, triangles, rings);
-            let used = &used[k * PART..];
             update_part(faces, (from, to), (extent, frame), used, (count, front));
         });
     }
@@ -186,9 +187,16 @@ fn update_part(
     (count, front): (&mut [u8], &mut [[u32; FRONT]]),
 ) {
     let mut ahead = [0u32; AHEAD];
+    let read = |t: u32| {
+        used.get(t as usize)
+            .is_some_and(|u| u.load(Relaxed) + 1 >= frame)
+    };
     for (k, (count, front)) in count.iter_mut().zip(front.iter_mut()).enumerate() {
-        *count = if frame == 0 || used[k].load(Relaxed) + 1 >= frame {
-            fronts_of(first + k, triangles, rings, ends, extent, &mut ahead, front)
+        let f = first + k;
+        // Read in the frame before, or beside a face that was (where particles go next).
+        let wanted = read(f as u32) || rings.triangles_of(f).iter().any(|&t| read(t));
+        *count = if frame == 0 || wanted {
+            fronts_of(f, triangles, rings, ends, extent, &mut ahead, front)
         } else {
             UNUSABLE
         };
@@ -443,5 +451,35 @@ mod tests {
         flat[2] = flat[1] * 2.0;
         fronts.update(&triangles, &rings, (&flat, &flat), (1.0, 0));
         assert_eq!(fronts.count[0], UNUSABLE, "degenerate face 0");
+    }
+
+    /// Past the first frame, a face's list is worked out where a certified test read it in
+    /// the frame before or read a face of its ring (where particles go next), and no other.
+    #[test]
+    fn the_faces_read_and_their_rings_are_worked_out() {
+        let m = TriangleMesh::icosphere(0.5, 2);
+        let topology = Topology::new(m.vertices.len(), &m.triangles);
+        let rings = Rings::new(&m.triangles, &topology);
+        let still = (&m.vertices[..], &m.vertices[..]);
+        let mut fronts = Fronts::default();
+        fronts.update(&m.triangles, &rings, still, (0.6, 1));
+        let read = [3, 17];
+        for f in read {
+            fronts.mark(f, 1);
+        }
+        fronts.update(&m.triangles, &rings, still, (0.6, 2));
+        let mut worked = 0;
+        for f in 0..m.triangles.len() {
+            let near = read
+                .iter()
+                .any(|&t| share_a_corner(m.triangles[t], m.triangles[f]));
+            // The convex sphere: a face worked out lists nothing in front.
+            assert_eq!(fronts.count[f] == 0, near, "face {f}");
+            worked += usize::from(near);
+        }
+        assert!(worked > 12 && worked < m.triangles.len() / 4, "{worked}");
+        // Read in neither frame 1 nor 2: none for frame 3.
+        fronts.update(&m.triangles, &rings, still, (0.6, 3));
+        assert!(fronts.count.iter().all(|&c| c == UNUSABLE));
     }
 }
