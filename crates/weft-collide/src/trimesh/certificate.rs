@@ -249,23 +249,17 @@ fn certificate(
     if (old as usize) < g.faces.len() {
         // The old face, else the nearest face of its ring whose interior the particle is over
         // (where it has most often gone), saves the search for the nearest triangle.
-        let ring = g.rings.triangles_of(old as usize);
-        let mut best: Option<(f64, usize)> = None;
-        for t in std::iter::once(old as usize).chain(ring.iter().map(|&t| t as usize)) {
-            let [a, b, c] = g.faces[t].corners;
-            let q = closest_on_triangle(x, a, b, c);
-            let d2 = (x - q.point).length_squared();
-            if q.feature == Feature::Face && d2 < reach * reach {
-                if t == old as usize {
-                    best = Some((d2, t));
-                    break;
-                }
-                if best.is_none_or(|(b2, _)| d2 < b2) {
-                    best = Some((d2, t));
-                }
-            }
-        }
-        if let Some((_, t)) = best {
+        let at = (x.as_vec3(), g.margin_at(x));
+        let over = |t: usize| {
+            g.closest_within(t, x, at, reach * reach)
+                .filter(|(d2, q)| q.feature == Feature::Face && *d2 < reach * reach)
+                .map(|(d2, _)| (d2, t))
+        };
+        let ring = g.rings.triangles_of(old as usize).iter();
+        let face = over(old as usize).or_else(|| {
+            (ring.filter_map(|&t| over(t as usize))).min_by(|a, b| a.0.total_cmp(&b.0))
+        });
+        if let Some((_, t)) = face {
             return Some((g.off_ring(x, t, reach), t as u32));
         }
     }
