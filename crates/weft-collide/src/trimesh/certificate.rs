@@ -38,8 +38,10 @@ pub(crate) const NO_FACE: u32 = u32::MAX - 1;
 pub(crate) const REACH: f64 = 2.0;
 
 /// How far a clear certificate's search for the nearest triangle reaches, as a multiple of
-/// the particle's thickness.
-const CLEAR_REACH: f64 = 50.0;
+/// the particle's thickness (50 measured 3 % slower on the breathing ball than 4–8: a far
+/// particle's search for its nearest triangle costs more than the builds a longer-lived
+/// certificate saves).
+const CLEAR_REACH: f64 = 6.0;
 
 /// How far a particle with no certificate moves (a fraction of its thickness, with the
 /// surface's travel) before another is tried.
@@ -55,6 +57,9 @@ pub(crate) struct Certificates {
     pub(super) reach: Vec<f64>,
     /// The face, [`CLEAR`] or [`NO_FACE`].
     pub(super) face: Vec<u32>,
+    /// For a clear certificate, the nearest triangle its search found ([`NO_FACE`]: none
+    /// within its reach): where the next certificate looks first.
+    pub(super) near: Vec<u32>,
     /// A clear ball the block test found about a particle hovering over its face: its centre
     /// per axis, then its radius less r plus the surface's travel bound when it was found
     /// (NaN: none). No triangle was within r plus that radius of the centre.
@@ -70,6 +75,7 @@ impl Certificates {
             anchor: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             reach: vec![f64::NAN; n],
             face: vec![NO_FACE; n],
+            near: vec![NO_FACE; n],
             hover: [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![f64::NAN; n]],
             builds: 0,
         }
@@ -81,13 +87,15 @@ impl Certificates {
         DVec3::new(self.anchor[0][j], self.anchor[1][j], self.anchor[2][j])
     }
 
-    /// Sets particle `j`'s certificate (and drops its hover ball).
-    fn set(&mut self, j: usize, anchor: DVec3, reach: f64, face: u32) {
+    /// Sets particle `j`'s certificate (and drops its hover ball): anchor, reach, face and,
+    /// for a clear one, the nearest triangle found.
+    fn set(&mut self, j: usize, anchor: DVec3, reach: f64, (face, near): (u32, u32)) {
         for k in 0..3 {
             self.anchor[k][j] = anchor[k];
         }
         self.reach[j] = reach;
         self.face[j] = face;
+        self.near[j] = near;
         self.hover[3][j] = f64::NAN;
     }
 
@@ -133,12 +141,16 @@ impl MeshFrame<'_> {
         let substep = g.travel - g.travel_before;
         let path = (from - x).length();
         let reach = r * (1.0 + REACH) + path + substep;
-        match certificate(g, x, (reach, CLEAR_REACH * r), certs.face[j]) {
+        let old = (certs.face[j], certs.near[j]);
+        match certificate(g, x, (reach, CLEAR_REACH * r), old) {
             // It must hold where it is made: ψ past the path and this substep's travel.
-            Some((psi, face)) if psi - substep - r >= path => {
-                certs.set(j, x, psi * (1.0 - 1e-12) + g.travel_before, face);
+            Some(((psi, face), near)) if psi - substep - r >= path => {
+                certs.set(j, x, psi * (1.0 - 1e-12) + g.travel_before, (face, near));
             }
-            _ => certs.set(j, x, g.travel_before + r * (1.0 + BACKOFF), NO_FACE),
+            _ => {
+                let reach = g.travel_before + r * (1.0 + BACKOFF);
+                certs.set(j, x, reach, (NO_FACE, NO_FACE));
+            }
         }
     }
 
@@ -232,20 +244,24 @@ fn over_face(g: &MeshGeometry, t: usize, x: DVec3) -> bool {
 }
 
 /// The certificate of a particle at `x` searched out to `reach` (a face's) or `clear` (a
-/// particle with no triangle within `reach`): ψ and the face ([`CLEAR`] if none), or `None`
-/// if the particle is inside a closed mesh. `old` is the particle's certificate's face until
-/// now: unless it is [`NO_FACE`] the particle was outside, and still is (it cannot cross the
-/// surface unseen: a path long enough to is swept by the lists, a shorter one ends within r
-/// of the surface, where every contact pushes it out on its side), and a face whose interior
-/// it is still over serves again, or else the nearest such face of its ring (any face serves
-/// a certificate; the block test decides whether it settles the particle).
+/// particle with no triangle within `reach`): ψ and the face ([`CLEAR`] if none), with the
+/// nearest triangle found for a clear one ([`NO_FACE`] if none), or `None` if the particle is
+/// inside a closed mesh. `old` is the particle's certificate's face until now and, if that
+/// was clear, the nearest triangle it found: unless the face is [`NO_FACE`] the particle was
+/// outside, and still is (it cannot cross the surface unseen: a path long enough to is swept
+/// by the lists, a shorter one ends within r of the surface, where every contact pushes it
+/// out on its side), and a face whose interior it is still over serves again, or else the
+/// nearest such face of its ring (any face serves a certificate; the block test decides
+/// whether it settles the particle); a clear one's nearest triangle serves as its face did.
 fn certificate(
     g: &MeshGeometry,
     x: DVec3,
     (reach, clear): (f64, f64),
-    old: u32,
-) -> Option<(f64, u32)> {
+    (old, near): (u32, u32),
+) -> Option<((f64, u32), u32)> {
     let outside = old != NO_FACE;
+    // A clear certificate's nearest triangle, where the particle has most often come in to.
+    let old = if old == CLEAR { near } else { old };
     if (old as usize) < g.faces.len() {
         // The old face, else the nearest face of its ring whose interior the particle is over
         // (where it has most often gone), saves the search for the nearest triangle.
@@ -260,25 +276,27 @@ fn certificate(
             (ring.filter_map(|&t| over(t as usize))).min_by(|a, b| a.0.total_cmp(&b.0))
         });
         if let Some((_, t)) = face {
-            return Some((g.off_ring(x, t, reach), t as u32));
+            return Some(((g.off_ring(x, t, reach), t as u32), NO_FACE));
         }
     }
     let clear = clear.max(reach);
     match g.nearest_unsigned(x, clear) {
         // A particle not known to be outside is signed by its nearest triangle.
         Some((t, d2, q)) if !outside && g.signed(x, t, q, d2).distance < 0.0 => None,
-        Some((t, d2, _)) if d2 < reach * reach => Some((g.off_ring(x, t, reach), t as u32)),
-        Some((_, d2, _)) => Some((d2.sqrt(), CLEAR)),
+        Some((t, d2, _)) if d2 < reach * reach => {
+            Some(((g.off_ring(x, t, reach), t as u32), NO_FACE))
+        }
+        Some((t, d2, _)) => Some(((d2.sqrt(), CLEAR), t as u32)),
         None => {
             // Nothing within `clear`: outside, unless inside a closed mesh's box (where the
             // side is known, or found by a search for the nearest triangle of all).
             let (lo, hi) = g.bounds();
             let outside_box = box_distance_squared(x, lo, hi).sqrt();
             if outside_box > 0.0 || outside || !g.closed() {
-                return Some((clear.max(outside_box), CLEAR));
+                return Some(((clear.max(outside_box), CLEAR), NO_FACE));
             }
             let p = g.nearest(x, f64::INFINITY)?;
-            (p.distance >= 0.0).then_some((p.distance.max(clear), CLEAR))
+            (p.distance >= 0.0).then_some(((p.distance.max(clear), CLEAR), NO_FACE))
         }
     }
 }
@@ -287,7 +305,7 @@ fn certificate(
 mod tests {
     use glam::DVec3;
 
-    use super::{CLEAR, MeshGeometry, certificate};
+    use super::{CLEAR, MeshGeometry, NO_FACE, certificate};
     use crate::analytic_vs_parry::Rng;
     use crate::trimesh::closest::closest_on_triangle;
     use crate::trimesh::convexity::share_a_corner;
@@ -303,7 +321,8 @@ mod tests {
     /// farther than any triangle off the face's ring (than any triangle, clear of all),
     /// checked against every triangle at points about the bumpy meshes, made from no face
     /// (clear), from the nearest face, and from each face of its ring (which often hands the
-    /// certificate to another face of that ring).
+    /// certificate to another face of that ring), as a face or as a clear certificate's
+    /// nearest triangle; a clear certificate's nearest triangle lies ψ away.
     #[test]
     fn a_certificate_is_no_farther_than_any_triangle_off_its_face_s_ring() {
         for (m, seed) in [(bumpy_sphere(), 7), (bumpy_sheet(), 9)] {
@@ -322,9 +341,11 @@ mod tests {
                     .iter()
                     .map(|&t| t as usize);
                 for old in std::iter::once(near.triangle).chain(ring) {
-                    for old in [old as u32, CLEAR] {
+                    let old = old as u32;
+                    for from in [(old, NO_FACE), (CLEAR, NO_FACE), (CLEAR, old)] {
                         made += 1;
-                        let Some((psi, face)) = certificate(&g, x, (reach, 2.0 * reach), old)
+                        let Some(((psi, face), near)) =
+                            certificate(&g, x, (reach, 2.0 * reach), from)
                         else {
                             panic!("{x}: called inside though known outside");
                         };
@@ -332,11 +353,15 @@ mod tests {
                             for t in 0..g.faces.len() {
                                 assert!(distance(&g, x, t) >= psi * (1.0 - 1e-12), "{x} {t}");
                             }
+                            if near != NO_FACE {
+                                let d = distance(&g, x, near as usize);
+                                assert!((d - psi).abs() <= 1e-12, "{x}: {near} {d} {psi}");
+                            }
                             continue;
                         }
                         let f = face as usize;
                         assert!(psi <= reach && distance(&g, x, f) < reach, "{x}: {f}");
-                        handed_on += usize::from(old != CLEAR && face != old);
+                        handed_on += usize::from(from != (CLEAR, NO_FACE) && face != old);
                         for t in 0..g.faces.len() {
                             if !share_a_corner(g.triangles[f], g.triangles[t]) {
                                 let d = distance(&g, x, t);
