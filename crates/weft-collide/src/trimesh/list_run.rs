@@ -238,10 +238,12 @@ impl MeshFrame<'_> {
         x: &mut DVec3,
         (r, ring): (f64, bool),
     ) -> Outcome {
-        let out = match ring
-            .then(|| self.resolve_ring(lists, j, prev, x, r))
-            .flatten()
-        {
+        // Over a convex edge of its face by that edge, else among the face's ring.
+        let by_ring = |lists: &mut ChunkLists, x: &mut DVec3| {
+            (self.edge_contact(lists, j, prev, x, r))
+                .or_else(|| self.resolve_ring(lists, j, prev, x, r))
+        };
+        let out = match ring.then(|| by_ring(lists, x)).flatten() {
             Some(out) => out,
             None => self.listed(lists, j, prev, x, r),
         };

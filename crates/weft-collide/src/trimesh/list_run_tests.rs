@@ -12,9 +12,9 @@ use crate::friction::Friction;
 use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
 use crate::trimesh::candidates::{ChunkLists, MeshFrame};
-use crate::trimesh::certified;
 use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
+use crate::trimesh::{certified, edge_contact};
 
 thread_local! {
     /// Lanes the lane test settled itself (clear, or pushed out of their face) on this thread.
@@ -200,6 +200,8 @@ struct Settled {
     certified: [usize; 3],
     /// (lane, front triangle) distances the certified test worked out.
     fronts: usize,
+    /// Particles the edge of their face settled (`edge_contact`).
+    edges: usize,
 }
 
 /// From the same positions in every pass, `resolve_listed` (the certified test, or without
@@ -215,6 +217,7 @@ fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) 
     FLAT.with(|c| c.set(0));
     certified::SETTLED.with(|c| c.set([0; 3]));
     certified::FRONT_DISTANCES.with(|c| c.set(0));
+    edge_contact::EDGES.with(|c| c.set(0));
     passes_from(m, case, (n, resting), |frame, prev, a| {
         let mut b = a.clone();
         let mut contacts = 0;
@@ -235,6 +238,7 @@ fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) 
         flat: FLAT.with(|c| c.get()),
         certified: certified::SETTLED.with(|c| c.get()),
         fronts: certified::FRONT_DISTANCES.with(|c| c.get()),
+        edges: edge_contact::EDGES.with(|c| c.get()),
     }
 }
 
@@ -259,7 +263,8 @@ fn the_lane_test_moves_particles_as_resolve_does() {
 
 /// With certificates, on particles resting on the mesh (drifting 0.2 mm a substep), the
 /// certified test settles most of the particles itself (clear, in a hover ball, or pushed out
-/// of their face), and works out front triangles' distances on the bumpy meshes; particles
+/// of their face), works out front triangles' distances on the bumpy meshes, and leaves
+/// particles over a convex edge of the smooth ball to that edge (`edge_contact`); particles
 /// about the mesh, deep inside and far away among them, still agree with `resolve` (on a
 /// still closed mesh from the first pass: the deep ones get no certificate).
 #[test]
@@ -275,8 +280,10 @@ fn the_certified_test_moves_particles_as_resolve_does() {
         let [_, pushed, hover] = s.certified;
         assert!(pushed > 1000, "{s:?}");
         if seed == 52 {
-            // The smooth ball: most of its resting particles settled here.
+            // The smooth ball: most of its resting particles settled here, and hundreds over
+            // an edge of their face by that edge.
             assert!(4 * (pushed + hover) > s.tested && hover > 1000, "{s:?}");
+            assert!(s.edges > 300, "{s:?}");
         } else {
             // The bumpy meshes: their faces' front triangles worked out.
             assert!(s.fronts > 1000, "{s:?}");

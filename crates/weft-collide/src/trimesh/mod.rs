@@ -13,6 +13,7 @@ pub(crate) mod closest;
 pub(crate) mod contact_grid;
 pub(crate) mod convexity;
 pub(crate) mod deforming;
+pub(crate) mod edge_contact;
 pub(crate) mod face_update;
 pub(crate) mod grid_contacts;
 pub(crate) mod grid_lanes;
