@@ -47,6 +47,11 @@ pub(crate) struct Rings {
     triangle_start: Vec<u32>,
     /// Ring triangles, face by face, each once, in increasing order.
     triangles: Vec<u32>,
+    /// Face f's ring triangles sharing neither end of its edge k (those about its third
+    /// corner alone): `beyond[beyond_start[3 f + k]..beyond_start[3 f + k + 1]]`.
+    beyond_start: Vec<u32>,
+    /// Those triangles, face by face and edge by edge, in increasing order.
+    beyond: Vec<u32>,
 }
 
 impl Rings {
@@ -55,6 +60,7 @@ impl Rings {
         let mut rings = Self {
             vertex_start: vec![0],
             triangle_start: vec![0],
+            beyond_start: vec![0],
             ..Self::default()
         };
         let (mut verts, mut tris): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
@@ -81,8 +87,21 @@ impl Rings {
             rings.vertex_start.push(rings.vertices.len() as u32);
             rings.triangles.extend_from_slice(&tris);
             rings.triangle_start.push(rings.triangles.len() as u32);
+            for k in 0..3 {
+                let (p, q) = (tri[k], tri[(k + 1) % 3]);
+                let off = |&&t: &&u32| !triangles[t as usize].iter().any(|&v| v == p || v == q);
+                rings.beyond.extend(tris.iter().filter(off));
+                rings.beyond_start.push(rings.beyond.len() as u32);
+            }
         }
         rings
+    }
+
+    /// Face `f`'s ring triangles that share neither end of its edge `k` (corners k, k + 1).
+    #[inline]
+    pub fn beyond_edge(&self, f: usize, k: usize) -> &[u32] {
+        let i = 3 * f + k;
+        &self.beyond[self.beyond_start[i] as usize..self.beyond_start[i + 1] as usize]
     }
 
     /// Face `f`'s ring vertices.

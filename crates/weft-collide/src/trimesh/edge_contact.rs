@@ -150,11 +150,13 @@ impl MeshFrame<'_> {
         if other == NONE || g.fronts.count[other as usize] != 0 {
             return None;
         }
-        // Wound as f: it runs the edge the other way.
-        let (vp, vq) = (g.triangles[f][k], g.triangles[f][(k + 1) % 3]);
-        let across = g.triangles[other as usize];
-        if !(0..3).any(|i| across[i] == vq && across[(i + 1) % 3] == vp) {
-            return None;
+        // Wound as f: it runs the edge the other way (every edge of a closed mesh does).
+        if !g.closed() {
+            let (vp, vq) = (g.triangles[f][k], g.triangles[f][(k + 1) % 3]);
+            let across = g.triangles[other as usize];
+            if !(0..3).any(|i| across[i] == vq && across[(i + 1) % 3] == vp) {
+                return None;
+            }
         }
         let (p, q) = (face.corners[k], face.corners[(k + 1) % 3]);
         let u = q - p;
@@ -189,15 +191,10 @@ impl MeshFrame<'_> {
     /// (sharing neither end of the edge) lies at least √`d2` from `x`.
     fn third_corner_clear(&self, f: usize, k: usize, x: DVec3, d2: f64) -> bool {
         let g = self.geometry;
-        let tri = g.triangles[f];
-        let (p, q) = (tri[k], tri[(k + 1) % 3]);
         let at = (x.as_vec3(), g.margin_at(x));
-        (g.rings.triangles_of(f).iter()).all(|&t| {
-            let corners = g.triangles[t as usize];
-            corners.contains(&p)
-                || corners.contains(&q)
-                || g.closest_within(t as usize, x, at, d2)
-                    .is_none_or(|(e2, _)| e2 >= d2)
+        (g.rings.beyond_edge(f, k).iter()).all(|&t| {
+            g.closest_within(t as usize, x, at, d2)
+                .is_none_or(|(e2, _)| e2 >= d2)
         })
     }
 }
