@@ -99,6 +99,15 @@ impl Certificates {
         self.hover[3][j] = f64::NAN;
     }
 
+    /// Whether particle `j`'s certificate still covers a particle of thickness `r` at `x`
+    /// (the mesh's frame) with the surface's travel bound now `travel`: every triangle off
+    /// its face's ring (every triangle, if clear) at least r away.
+    #[inline]
+    pub(super) fn covers(&self, j: usize, x: DVec3, (r, travel): (f64, f64)) -> bool {
+        let slack = self.reach[j] - travel - r;
+        slack >= 0.0 && (x - self.anchor_of(j)).length_squared() <= slack * slack
+    }
+
     /// Sets particle `j`'s hover ball: about `centre`, no triangle within r + `room` at the
     /// surface's travel bound `travel`.
     pub(super) fn set_hover(&mut self, j: usize, centre: DVec3, room: f64, travel: f64) {
@@ -223,9 +232,7 @@ impl MeshFrame<'_> {
             out.depth = out.depth.max(depth);
         }
         // Still within the certificate's reach where it ends.
-        let c = &lists.certs;
-        let slack = c.reach[j] - g.travel - r;
-        if !(slack >= 0.0 && (xl - c.anchor_of(j)).length_squared() <= slack * slack) {
+        if !lists.certs.covers(j, xl, (r, g.travel)) {
             *x = start;
             return None;
         }

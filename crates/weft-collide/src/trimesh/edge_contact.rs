@@ -106,9 +106,7 @@ impl MeshFrame<'_> {
             }
         }
         // Within the certificate's reach where it ends.
-        let c = &lists.certs;
-        let slack = c.reach[j] - g.travel - r;
-        if !(slack >= 0.0 && (xl - c.anchor_of(j)).length_squared() <= slack * slack) {
+        if !lists.certs.covers(j, xl, (r, g.travel)) {
             *x = start;
             return None;
         }
