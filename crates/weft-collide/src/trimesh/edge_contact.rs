@@ -4,21 +4,23 @@
 //!
 //! Let F be a particle's certificate face, e = (p, q) the edge of F it projects beyond, and G
 //! the face across e, wound as F (G runs e from q to p, as on every edge of a closed mesh),
-//! both with empty front lists (`convexity`): every triangle of F's ring lies behind F's plane and every
-//! triangle of G's ring behind G's plane throughout the frame. The triangles about p or q
-//! are in both rings (as are F and G), so they lie in the wedge K behind both planes. Where
-//! x lies in front of both planes, beyond e within F's plane and beyond e within G's, x − x_L
-//! (x_L its projection onto e's line L) lies in the cone of the two normals, which is K's
-//! normal cone along L: the point of K nearest x is x_L, and each triangle about p or q is at
-//! least |x − x_L| away. Where x_L lies within e, that is e's distance d, F's and G's. The
-//! rest of F's ring (the triangles about its third corner alone) is checked by the planes'
-//! bound (else the distance), and the rest of G's ring is off F's ring, which the
-//! certificate puts at least r away. So e is nearest of all, as `MeshFrame::resolve_ring`
-//! finds it, and the particle is pushed to r along x − x_L with friction by the same
-//! `MeshFrame::push`. It then lies √(r² + s²) from L (s its slip, across the push); if it is
-//! still in the wedge over e, clear of the third corner's triangles by r, and within its
-//! certificate's reach, nothing is within r (the ring's next round would find nothing), and
-//! it is done. Anything else (a vertex region, a front triangle, a third-corner triangle too
+//! both with usable front lists (`convexity`):
+//! every triangle of F's ring but its front ones lies behind F's plane throughout the frame,
+//! and every triangle of G's ring but its front ones behind G's plane. The triangles about p
+//! or q are in both rings (as are F and G), so all but the front ones lie in the wedge K
+//! behind both planes. Where x lies in front of both planes, beyond e within F's plane and
+//! beyond e within G's, x − x_L (x_L its projection onto e's line L) lies in the cone of the
+//! two normals, which is K's normal cone along L: the point of K nearest x is x_L, and each
+//! triangle in K is at least |x − x_L| away. (Across a concave edge no point lies in front of
+//! both planes and beyond e in both: the four conditions leave no room.) Where x_L lies within e, that is e's distance d,
+//! F's and G's. The front triangles of both and the rest of F's ring (the triangles about its
+//! third corner alone) are checked by the planes' bound, else the distance; the rest of G's
+//! ring is off F's ring, which the certificate puts at least r away. So e is nearest of all,
+//! as `MeshFrame::resolve_ring` finds it, and the particle is pushed to r along x − x_L with
+//! friction by the same `MeshFrame::push`. It then lies √(r² + s²) from L (s its slip, across
+//! the push); if it is still in the wedge over e, those checked triangles are clear of r, and
+//! it is within its certificate's reach, nothing is within r (the ring's next round would
+//! find nothing), and it is done. Anything else (a vertex region, a checked triangle too
 //! near, a slip out of the wedge, a push beyond the reach) leaves the particle as it was, to
 //! the ring.
 
@@ -27,6 +29,7 @@ use glam::DVec3;
 use super::MeshPoint;
 use super::candidates::{ChunkLists, MeshFrame, Outcome};
 use super::closest::{Closest, Feature};
+use super::convexity::UNUSABLE;
 use super::normals::NONE;
 
 /// How far inside the wedge's sides, and within the edge's ends (as fractions of the face's
@@ -44,6 +47,8 @@ thread_local! {
 struct OverEdge {
     /// The edge: corners k and k + 1 of the face.
     k: usize,
+    /// The face across it.
+    other: usize,
     /// The edge's point nearest the particle, its weights of the face's corners, and the
     /// particle less that point.
     point: DVec3,
@@ -66,14 +71,14 @@ impl MeshFrame<'_> {
     ) -> Option<Outcome> {
         let g = self.geometry;
         let f = lists.certs.face[j] as usize;
-        if f >= g.faces.len() || g.fronts.count[f] != 0 {
+        if f >= g.faces.len() || g.fronts.count[f] == UNUSABLE {
             return None;
         }
         let (mut xl, _) = self.local_path(*x, prev, || lists.last[j]);
         let over = self.over_edge(f, xl, None)?;
         let d2 = over.delta.length_squared();
         let d = d2.sqrt();
-        if d <= 1e-12 || !self.third_corner_clear(f, over.k, xl, d2) {
+        if d <= 1e-12 || !self.others_clear(f, &over, xl, d2) {
             return None;
         }
         let start = *x;
@@ -94,10 +99,10 @@ impl MeshFrame<'_> {
             if let Some((depth, _)) = self.push(&hit, &mut xl, x, prev, r) {
                 out.contacts = 1;
                 out.depth = depth;
-                // Still over the same edge, the third corner's triangles clear of r.
+                // Still over the same edge, the checked triangles clear of r.
                 let still = self.over_edge(f, xl, Some(over.k)).is_some_and(|o| {
                     o.delta.length_squared() >= r * r * (1.0 - 1e-9)
-                        && self.third_corner_clear(f, o.k, xl, r * r)
+                        && self.others_clear(f, &o, xl, r * r)
                 });
                 if !still {
                     *x = start;
@@ -118,8 +123,8 @@ impl MeshFrame<'_> {
     }
 
     /// Where `x` lies over a convex edge of face `f` (edge `only`, if given) with a
-    /// neighbour across it, wound as `f`, whose front list is empty, well inside the wedge of
-    /// the two faces' normals and within the edge's ends; `None` elsewhere.
+    /// neighbour across it, wound as `f`, whose front list is usable, well inside the wedge
+    /// of the two faces' normals and within the edge's ends; `None` elsewhere.
     fn over_edge(&self, f: usize, x: DVec3, only: Option<usize>) -> Option<OverEdge> {
         let g = self.geometry;
         let face = &g.faces[f];
@@ -145,7 +150,7 @@ impl MeshFrame<'_> {
             return None;
         }
         let other = g.topology.adjacent[f][k];
-        if other == NONE || g.fronts.count[other as usize] != 0 {
+        if other == NONE || g.fronts.count[other as usize] == UNUSABLE {
             return None;
         }
         // Wound as f: it runs the edge the other way (every edge of a closed mesh does).
@@ -179,21 +184,31 @@ impl MeshFrame<'_> {
         bary[(k + 1) % 3] = t;
         Some(OverEdge {
             k,
+            other: other as usize,
             point,
             bary,
             delta: x - point,
         })
     }
 
-    /// Whether every triangle of face `f`'s ring about its corner opposite edge `k` alone
-    /// (sharing neither end of the edge) lies at least √`d2` from `x`.
-    fn third_corner_clear(&self, f: usize, k: usize, x: DVec3, d2: f64) -> bool {
+    /// Whether every triangle the edge must check (see the module's notes) lies at least
+    /// √`d2` from `x`: those of face `f`'s ring about its corner opposite the edge alone
+    /// (sharing neither end of it), and the front triangles of `f` and of the face across,
+    /// but those two faces.
+    fn others_clear(&self, f: usize, over: &OverEdge, x: DVec3, d2: f64) -> bool {
         let g = self.geometry;
         let at = (x.as_vec3(), g.margin_at(x));
-        (g.rings.beyond_edge(f, k).iter()).all(|&t| {
-            g.closest_within(t as usize, x, at, d2)
-                .is_none_or(|(e2, _)| e2 >= d2)
-        })
+        let fronts = [f, over.other].map(|t| {
+            let n = usize::from(g.fronts.count[t]);
+            &g.fronts.front[t][..n]
+        });
+        let (third, [of_f, of_other]) = (g.rings.beyond_edge(f, over.k), fronts);
+        (third.iter().chain(of_f).chain(of_other))
+            .filter(|&&t| t as usize != f && t as usize != over.other)
+            .all(|&t| {
+                g.closest_within(t as usize, x, at, d2)
+                    .is_none_or(|(e2, _)| e2 >= d2)
+            })
     }
 }
 
@@ -213,12 +228,22 @@ mod tests {
     /// the right (normal (3, 1, 0)/√10), and a flap T about F's third corner alone, under F's
     /// plane by `under` and reaching out over G's side. Returns the mesh and F's index.
     fn ridge(under: f64) -> (MeshGeometry, usize) {
+        ridge_with(under, None)
+    }
+
+    /// [`ridge`], and, where given, a fin from the ridge's end p to the two points `fin`
+    /// (in F's and G's rings, in front of F's plane: one of F's front triangles).
+    fn ridge_with(under: f64, fin: Option<[DVec3; 2]>) -> (MeshGeometry, usize) {
         let (p, q) = (DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.0, 0.0, -1.0));
         let (c, d) = (DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, -3.0, 0.0));
         let (s1, s2) = (DVec3::new(0.3, -under, 0.3), DVec3::new(0.3, -under, -0.3));
-        let vertices = [p, q, c, d, s1, s2];
+        let mut vertices = vec![p, q, c, d, s1, s2];
         // F = (p, q, c) runs the ridge from p to q, G = (q, p, d) from q to p; T faces up.
-        let triangles = [[0, 1, 2], [1, 0, 3], [2, 4, 5]];
+        let mut triangles = vec![[0, 1, 2], [1, 0, 3], [2, 4, 5]];
+        if let Some(fin) = fin {
+            vertices.extend(fin);
+            triangles.push([0, 6, 7]);
+        }
         let g = MeshGeometry::new(&vertices, &triangles);
         let f = (g.triangles.iter())
             .position(|t| *t == [0, 1, 2])
@@ -307,6 +332,37 @@ mod tests {
             let mut lists = certified_at(f, x0);
             let out = frame.edge_contact(&mut lists, 0, x0, &mut x, R);
             assert_eq!(out.is_some(), settles, "{degrees}° at z = {z}");
+        }
+    }
+
+    /// A fin from the ridge's end down to just above a particle over the ridge, one of F's
+    /// front triangles, nearer the particle than the ridge: the edge leaves it to the ring
+    /// (and `resolve` pushes it off the fin); with the fin's tip raised out of reach, the
+    /// edge settles it as `resolve` does, F's front list notwithstanding.
+    #[test]
+    fn an_edge_leaves_a_particle_nearer_a_front_triangle_to_the_ring() {
+        let pose = WorldPose::new(DVec3::ZERO, DQuat::IDENTITY);
+        let angle = 60f64.to_radians();
+        let x0 = DVec3::new(angle.sin(), angle.cos(), 0.1) * 0.75 * R;
+        for (tip, settles) in [(0.6 * R, false), (5.0 * R, true)] {
+            let fin = [-0.01, 0.01].map(|z| DVec3::new(x0.x, x0.y + tip, z));
+            let (g, f) = ridge_with(0.5, Some(fin));
+            assert!(g.fronts.count[f] > 0, "the fin in front of F");
+            let frame = MeshFrame::still(&g, &pose, Friction::NONE);
+            let (mut x, mut by_resolve) = (x0, x0);
+            frame.resolve(&mut ChunkLists::new(1), 0, x0, &mut by_resolve, R);
+            let mut lists = certified_at(f, x0);
+            let out = frame.edge_contact(&mut lists, 0, x0, &mut x, R);
+            assert_eq!(out.is_some(), settles, "fin's tip {tip} above");
+            if settles {
+                assert!(
+                    (x - by_resolve).length() <= 1e-12,
+                    "{x} against {by_resolve}"
+                );
+            } else {
+                assert_eq!(x, x0, "left as it was");
+                assert!((by_resolve - x0).length() > 1e-3, "{by_resolve}");
+            }
         }
     }
 }

@@ -264,7 +264,7 @@ fn the_lane_test_moves_particles_as_resolve_does() {
 /// With certificates, on particles resting on the mesh (drifting 0.2 mm a substep), the
 /// certified test settles most of the particles itself (clear, in a hover ball, or pushed out
 /// of their face), works out front triangles' distances on the bumpy meshes, and leaves
-/// particles over a convex edge of the smooth ball to that edge (`edge_contact`); particles
+/// particles over a convex edge to that edge (`edge_contact`); particles
 /// about the mesh, deep inside and far away among them, still agree with `resolve` (on a
 /// still closed mesh from the first pass: the deep ones get no certificate).
 #[test]
@@ -285,8 +285,9 @@ fn the_certified_test_moves_particles_as_resolve_does() {
             assert!(4 * (pushed + hover) > s.tested && hover > 1000, "{s:?}");
             assert!(s.edges > 300, "{s:?}");
         } else {
-            // The bumpy meshes: their faces' front triangles worked out.
-            assert!(s.fronts > 1000, "{s:?}");
+            // The bumpy meshes: their faces' front triangles worked out, and a few particles
+            // over an edge settled by it past its faces' front triangles.
+            assert!(s.fronts > 1000 && s.edges > 50, "{s:?}");
         }
     }
 }
