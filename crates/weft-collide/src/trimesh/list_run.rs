@@ -238,12 +238,15 @@ impl MeshFrame<'_> {
         x: &mut DVec3,
         (r, ring): (f64, bool),
     ) -> Outcome {
-        // Over a convex edge of its face by that edge, else among the face's ring.
-        let by_ring = |lists: &mut ChunkLists, x: &mut DVec3| {
+        // Over a convex edge of its face by that edge, else among the face's ring, else
+        // through the lists.
+        let settled = if ring {
             (self.edge_contact(lists, j, prev, x, r))
                 .or_else(|| self.resolve_ring(lists, j, prev, x, r))
+        } else {
+            None
         };
-        let out = match ring.then(|| by_ring(lists, x)).flatten() {
+        let out = match settled {
             Some(out) => out,
             None => self.listed(lists, j, prev, x, r),
         };
