@@ -329,7 +329,7 @@ mod tests {
     /// checked against every triangle at points about the bumpy meshes, made from no face
     /// (clear), from the nearest face, and from each face of its ring (which often hands the
     /// certificate to another face of that ring), as a face or as a clear certificate's
-    /// nearest triangle; a clear certificate's nearest triangle lies ψ away.
+    /// nearest triangle (alike); a clear certificate's nearest triangle lies ψ away.
     #[test]
     fn a_certificate_is_no_farther_than_any_triangle_off_its_face_s_ring() {
         for (m, seed) in [(bumpy_sphere(), 7), (bumpy_sheet(), 9)] {
@@ -349,6 +349,10 @@ mod tests {
                     .map(|&t| t as usize);
                 for old in std::iter::once(near.triangle).chain(ring) {
                     let old = old as u32;
+                    // A clear certificate's triangle serves as a face would, no search.
+                    let as_face = certificate(&g, x, (reach, 2.0 * reach), (old, NO_FACE));
+                    let as_near = certificate(&g, x, (reach, 2.0 * reach), (CLEAR, old));
+                    assert_eq!(as_face, as_near, "{x}: from face {old}");
                     for from in [(old, NO_FACE), (CLEAR, NO_FACE), (CLEAR, old)] {
                         made += 1;
                         let Some(((psi, face), near)) =
