@@ -172,6 +172,9 @@ pub(crate) struct MeshGeometry {
     /// A deforming mesh's frame: its vertices at the frame's start and end, between which
     /// they move linearly over the frame's substeps (empty until the first frame).
     frame: (Vec<DVec3>, Vec<DVec3>),
+    /// Per vertex over the current frame: the box of its two ends and its motion (kept
+    /// between frames, not to allocate).
+    vertex_boxes: Vec<[DVec3; 3]>,
     /// A bound on how far any vertex has still to move before the frame's end (m): the
     /// planes are the frame end's, so every bound on them is this much less.
     slack: f64,
@@ -217,6 +220,7 @@ impl MeshGeometry {
             travel_before: 0.0,
             moving: false,
             frame: (Vec::new(), Vec::new()),
+            vertex_boxes: Vec::new(),
             slack: 0.0,
             frame_id: 0,
             frame_span: (0.0, 0.0),
@@ -270,15 +274,18 @@ impl MeshGeometry {
         let triangles = &self.triangles;
         // In place: no allocation (nor its page faults) once a frame.
         face_update::update_planes(&mut self.planes, triangles, end);
+        // Each vertex's box and motion once (a vertex is a corner of about six triangles),
+        // then each triangle's as their bounds (exact: min and max do not round).
+        let vertex = &mut self.vertex_boxes;
+        vertex.clear();
+        vertex.extend((from.iter().zip(end)).map(|(&p, &q)| [p.min(q), p.max(q), q - p]));
+        let vertex = &self.vertex_boxes;
         self.bvh.refit_moving(|i| {
-            let mut b = [(DVec3::INFINITY, DVec3::NEG_INFINITY); 2];
-            for v in triangles[i] {
-                let (p, q) = (from[v as usize], end[v as usize]);
-                b[0] = (b[0].0.min(p).min(q), b[0].1.max(p).max(q));
-                let d = q - p;
-                b[1] = (b[1].0.min(d), b[1].1.max(d));
-            }
-            b
+            let [a, b, c] = triangles[i].map(|v| vertex[v as usize]);
+            [
+                (a[0].min(b[0]).min(c[0]), a[1].max(b[1]).max(c[1])),
+                (a[2].min(b[2]).min(c[2]), a[2].max(b[2]).max(c[2])),
+            ]
         });
         let extent = (from.iter().chain(end)).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         self.slack = Self::remaining(&self.end, end);

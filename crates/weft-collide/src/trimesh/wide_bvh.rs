@@ -70,23 +70,25 @@ pub(crate) struct WideBvh {
     motions: Vec<Motions>,
 }
 
-/// The largest f32 no greater than `x` (selects, not branches: a refit converts every box
-/// once a frame).
+/// The largest f32 no greater than `x`, by integer selects alone (no branch: a refit
+/// converts every box once a frame, four children at a time).
+#[inline(always)]
 fn down(x: f64) -> f32 {
     let f = x as f32;
     let bits = f.to_bits();
-    // The next f32 toward −∞ (f32::MAX from +∞).
-    let lower = if f == 0.0 {
+    // The next f32 toward −∞: one step down the bits of a positive value (f32::MAX from +∞),
+    // one up those of a negative one, and the least negative subnormal from a zero.
+    let step = ((bits >> 31) << 1).wrapping_sub(1);
+    let lower = if bits << 1 == 0 {
         0x8000_0001
-    } else if bits >> 31 == 0 {
-        bits - 1
     } else {
-        bits + 1
+        bits.wrapping_add(step)
     };
     f32::from_bits(if f64::from(f) > x { lower } else { bits })
 }
 
 /// The smallest f32 no less than `x`.
+#[inline(always)]
 fn up(x: f64) -> f32 {
     -down(-x)
 }
@@ -159,14 +161,20 @@ impl WideBvh {
     /// Copies the binary tree's boxes (after its own refit), rounded outwards.
     pub fn refit(&mut self, bvh: &Bvh) {
         for (node, source) in self.nodes.iter_mut().zip(&self.source) {
+            // Per axis and child, each side's f64 bound (a child with no source keeps its
+            // box: the f64 infinities round to themselves).
+            let mut lo = [[0.0f64; WIDTH]; 3];
+            let mut hi = [[0.0f64; WIDTH]; 3];
             for (k, &s) in source.iter().enumerate() {
-                let Some(b) = bvh.nodes.get(s as usize) else {
-                    continue;
-                };
+                let b = bvh.nodes.get(s as usize);
                 for a in 0..3 {
-                    node.lo[a][k] = down(b.lo[a]);
-                    node.hi[a][k] = up(b.hi[a]);
+                    lo[a][k] = b.map_or(f64::from(node.lo[a][k]), |b| b.lo[a]);
+                    hi[a][k] = b.map_or(f64::from(node.hi[a][k]), |b| b.hi[a]);
                 }
+            }
+            for a in 0..3 {
+                node.lo[a] = lo[a].map(down);
+                node.hi[a] = hi[a].map(up);
             }
         }
     }
@@ -176,23 +184,40 @@ impl WideBvh {
     pub fn set_motions(&mut self, boxes: &[(DVec3, DVec3)]) {
         self.motions.clear();
         for source in &self.source {
+            // Per axis and child, the box of motions (a child with none: an empty slot,
+            // whose radius stays infinite).
+            let (mut lo, mut hi) = ([[0.0f64; WIDTH]; 3], [[0.0f64; WIDTH]; 3]);
+            let mut some = [false; WIDTH];
+            for (k, &s) in source.iter().enumerate() {
+                if let Some(&(l, h)) = boxes.get(s as usize) {
+                    some[k] = true;
+                    for a in 0..3 {
+                        (lo[a][k], hi[a][k]) = (l[a], h[a]);
+                    }
+                }
+            }
             let mut m = Motions {
                 centre: [[0.0; WIDTH]; 3],
                 radius: [f32::INFINITY; WIDTH],
             };
-            for (k, &s) in source.iter().enumerate() {
-                let Some(&(lo, hi)) = boxes.get(s as usize) else {
-                    continue;
-                };
-                let centre = 0.5 * (lo + hi);
-                let c32 = centre.as_vec3();
-                // Every motion within the half-diagonal of the centre, and the f32 centre
-                // within its rounding of the f64 one.
-                let radius = 0.5 * (hi - lo).length() + (centre - c32.as_dvec3()).length();
-                for a in 0..3 {
-                    m.centre[a][k] = c32[a];
+            // Every motion within the half-diagonal of the centre, and the f32 centre within
+            // its rounding of the f64 one (the same operations, in the same order, as on
+            // `DVec3`s, lane by lane).
+            let (mut half2, mut off2) = ([0.0f64; WIDTH], [0.0f64; WIDTH]);
+            for a in 0..3 {
+                for k in 0..WIDTH {
+                    let centre = 0.5 * (lo[a][k] + hi[a][k]);
+                    let c32 = centre as f32;
+                    let (d, e) = (hi[a][k] - lo[a][k], centre - f64::from(c32));
+                    half2[k] += d * d;
+                    off2[k] += e * e;
+                    m.centre[a][k] = if some[k] { c32 } else { 0.0 };
                 }
-                m.radius[k] = up(radius * (1.0 + 1e-9));
+            }
+            for k in 0..WIDTH {
+                let radius = 0.5 * half2[k].sqrt() + off2[k].sqrt();
+                let r32 = up(radius * (1.0 + 1e-9));
+                m.radius[k] = if some[k] { r32 } else { f32::INFINITY };
             }
             self.motions.push(m);
         }
