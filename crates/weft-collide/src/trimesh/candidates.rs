@@ -424,7 +424,7 @@ impl MeshFrame<'_> {
         let mut best: Option<(Crossing, usize)> = None;
         for &t in list {
             let t = t as usize;
-            let f = &g.faces[t];
+            let f = g.face(t);
             let hit = if moving {
                 let start = g.start_corners(t);
                 // Cheap reject: the path's box misses the triangle's swept box.
@@ -479,7 +479,7 @@ impl MeshFrame<'_> {
         if let Some((c, t)) =
             self.first_crossing(&lists.tris[s as usize..(s + len) as usize], from, xl, r)
         {
-            let f = &g.faces[t];
+            let f = g.face(t);
             let [a, b, cc] = f.corners;
             let hit = a * c.bary[0] + b * c.bary[1] + cc * c.bary[2];
             self.move_to(&mut xl, x, hit + f.normal * (c.side * r));
@@ -584,7 +584,7 @@ impl MeshFrame<'_> {
                 others = 0.0; // too many to follow
             }
         };
-        if let (Some(f), Some(planes)) = (g.faces.get(hint as usize), g.planes.get(hint as usize)) {
+        if let (Some(f), Some(planes)) = (g.face_get(hint as usize), g.planes.get(hint as usize)) {
             let mut lower = f64::from(planes.distance_squared_bound(x32, g.margin));
             if lower < bound {
                 let [a, b, c] = f.corners;
@@ -620,7 +620,7 @@ impl MeshFrame<'_> {
                     second = second.min(lower);
                     continue;
                 }
-                let [a, b, c] = g.faces[t as usize].corners;
+                let [a, b, c] = g.corners(t as usize);
                 let q = closest_on_triangle(xl, a, b, c);
                 let d2 = (xl - q.point).length_squared();
                 note(t, d2);
@@ -665,7 +665,7 @@ impl MeshFrame<'_> {
             return p;
         }
         if d2 <= 1e-24 {
-            let n = g.faces[t].normal;
+            let n = g.normals[t];
             p.normal = if n.dot(from - q.point) < 0.0 { -n } else { n };
         }
         // Clearly on a side: within 60° of the feature's pseudo-normal or its opposite (not

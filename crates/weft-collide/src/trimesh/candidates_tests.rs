@@ -64,10 +64,9 @@ fn compaction_keeps_the_lists_in_particle_order() {
 
 /// The distance from `x` to the nearest triangle, by brute force.
 fn distance(g: &MeshGeometry, x: DVec3) -> f64 {
-    g.faces
-        .iter()
-        .map(|f| {
-            let [a, b, c] = f.corners;
+    (0..g.face_count())
+        .map(|t| {
+            let [a, b, c] = g.corners(t);
             (x - closest_on_triangle(x, a, b, c).point).length()
         })
         .fold(f64::INFINITY, f64::min)
@@ -139,8 +138,8 @@ fn standing_list(
     let (s, len) = lists.range[j];
     let list = &lists.tris[s as usize..(s + len) as usize];
     let mut in_reach = Vec::new();
-    for (t, f) in g.faces.iter().enumerate() {
-        let [a, b, c] = f.corners;
+    for t in 0..g.face_count() {
+        let [a, b, c] = g.corners(t);
         let d_end = (x - closest_on_triangle(x, a, b, c).point).length();
         let [a, b, c] = g.start_corners(t);
         let d_start = (from - closest_on_triangle(from, a, b, c).point).length();

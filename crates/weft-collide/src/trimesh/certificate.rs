@@ -174,14 +174,14 @@ impl MeshFrame<'_> {
         if face >= NO_FACE {
             return;
         }
-        let moved = if hint != face && (hint as usize) < g.faces.len() {
-            let [a, b, c] = g.faces[hint as usize].corners;
+        let moved = if hint != face && (hint as usize) < g.face_count() {
+            let [a, b, c] = g.corners(hint as usize);
             let q = closest_on_triangle(x, a, b, c);
             q.feature == Feature::Face && (x - q.point).length_squared() <= r * r * (1.0 + 1e-6)
         } else {
             !over_face(g, face as usize, x)
                 && (g.topology.adjacent[face as usize].iter())
-                    .any(|&t| (t as usize) < g.faces.len() && over_face(g, t as usize, x))
+                    .any(|&t| (t as usize) < g.face_count() && over_face(g, t as usize, x))
         };
         if moved {
             self.certify(lists, j, x, x, r);
@@ -244,7 +244,7 @@ impl MeshFrame<'_> {
 
 /// Whether `x` lies in front of triangle `t`'s face with its projection inside it.
 fn over_face(g: &MeshGeometry, t: usize, x: DVec3) -> bool {
-    let f = &g.faces[t];
+    let f = g.face(t);
     let [a, b, c] = f.corners;
     let q = closest_on_triangle(x, a, b, c);
     q.feature == Feature::Face && f.normal.dot(x - a) > 0.0
@@ -269,7 +269,7 @@ fn certificate(
     let outside = old != NO_FACE;
     // A clear certificate's nearest triangle, where the particle has most often come in to.
     let old = if old == CLEAR { near } else { old };
-    if (old as usize) < g.faces.len() {
+    if (old as usize) < g.face_count() {
         // The old face, else the nearest face of its ring whose interior the particle is over
         // (where it has most often gone), saves the search for the nearest triangle.
         let at = (x.as_vec3(), g.margin_at(x));
@@ -320,7 +320,7 @@ mod tests {
 
     /// The distance from `x` to triangle `t`, by its closest point.
     fn distance(g: &MeshGeometry, x: DVec3, t: usize) -> f64 {
-        let [a, b, c] = g.faces[t].corners;
+        let [a, b, c] = g.corners(t);
         (x - closest_on_triangle(x, a, b, c).point).length()
     }
 
@@ -361,7 +361,7 @@ mod tests {
                             panic!("{x}: called inside though known outside");
                         };
                         if face == CLEAR {
-                            for t in 0..g.faces.len() {
+                            for t in 0..g.face_count() {
                                 assert!(distance(&g, x, t) >= psi * (1.0 - 1e-12), "{x} {t}");
                             }
                             if near != NO_FACE {
@@ -373,7 +373,7 @@ mod tests {
                         let f = face as usize;
                         assert!(psi <= reach && distance(&g, x, f) < reach, "{x}: {f}");
                         handed_on += usize::from(from != (CLEAR, NO_FACE) && face != old);
-                        for t in 0..g.faces.len() {
+                        for t in 0..g.face_count() {
                             if !share_a_corner(g.triangles[f], g.triangles[t]) {
                                 let d = distance(&g, x, t);
                                 assert!(d >= psi * (1.0 - 1e-12), "{x}: {f} {t} {d} < {psi}");

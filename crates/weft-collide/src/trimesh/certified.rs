@@ -38,11 +38,11 @@ use pulp::Simd;
 use weft_solver::Contacts;
 use weft_solver::lane_ops::{Ops, V3, load, load_at, load3, store};
 
+use super::MeshGeometry;
 use super::candidates::{ChunkLists, MeshFrame};
 use super::certificate::{CLEAR, Certificates, NO_FACE};
 use super::convexity::UNUSABLE;
 use super::grid_lanes::push_vectors;
-use super::{Face, MeshGeometry};
 
 /// Projections nearer than this (barycentric) to an edge of the face are left to the ring.
 const INSIDE: f64 = 1e-9;
@@ -236,9 +236,8 @@ fn settle<S: Simd, const L: usize>(
     let near = b.near;
     // Each near lane's face (a lane that is not near reads face 0, and is masked out).
     let t: [usize; L] = std::array::from_fn(|l| if near[l] { b.face[l] as usize } else { 0 });
-    let faces = Gathered::<S>::of::<L>(&g.faces, &t);
-    let [a, bb, c] = faces.corners;
-    let n = faces.normal;
+    let [a, bb, c] = corners::<S, L, 3>(&g.triangles, &g.end, &t, [0, 1, 2]);
+    let n = normals::<S, L>(&g.normals, &t);
     let count: [u8; L] = std::array::from_fn(|l| if near[l] { g.fronts.count[t[l]] } else { 0 });
     for l in (0..L).filter(|&l| near[l]) {
         g.fronts.mark(t[l], g.frame_id);
@@ -285,7 +284,7 @@ fn settle<S: Simd, const L: usize>(
         };
         let mut carried = load3::<S, L>(b.prev);
         if g.moving {
-            let start = Gathered::<S>::of::<L>(&g.start_faces, &t).corners;
+            let start = corners::<S, L, 3>(&g.triangles, &g.start, &t, [0, 1, 2]);
             let end = [a, bb, c];
             // As `MeshFrame::surface_displacement`: Σ wₖ endₖ − Σ wₖ startₖ.
             for i in 0..3 {
@@ -392,8 +391,10 @@ impl<const L: usize> Fronts<'_, L> {
                     0
                 }
             });
-            let tri = Gathered::<S>::of::<L>(&g.faces, &u);
-            let (a, nt) = (tri.corners[0], tri.normal);
+            // The plane first (a corner and the normal); the other corners only for a
+            // distance.
+            let [a] = corners::<S, L, 1>(&g.triangles, &g.end, &u, [0]);
+            let nt = normals::<S, L>(&g.normals, &u);
             let listed = mask::<S, L>(o, on);
             let height = o.dot(&nt, &o.dif(x, &a));
             let before = o.ge(height, o.min(h, r));
@@ -426,7 +427,8 @@ impl<const L: usize> Fronts<'_, L> {
                 nearest = o.sel(listed, o.min(nearest, height), nearest);
                 continue;
             }
-            let d2 = distance_squared(o, lifted, [&a, &tri.corners[1], &tri.corners[2]]);
+            let [b, c] = corners::<S, L, 2>(&g.triangles, &g.end, &u, [1, 2]);
+            let d2 = distance_squared(o, lifted, [&a, &b, &c]);
             clear = o.and(clear, o.or(o.not(open), o.ge(d2, need2)));
             // A lane not pushed was measured where it is (`lifted` is `x`): its distance;
             // else the plane's height, a lower bound.
@@ -438,36 +440,39 @@ impl<const L: usize> Fronts<'_, L> {
     }
 }
 
-/// The faces of a block's lanes, read once per lane: corners and unit normal per axis.
-struct Gathered<S: Simd> {
-    corners: [V3<S>; 3],
-    normal: V3<S>,
-}
-
-impl<S: Simd> Gathered<S> {
-    /// Faces `t[l]` of `faces` (a lane that takes no part names face 0).
-    #[inline(always)]
-    fn of<const L: usize>(faces: &[Face], t: &[usize; L]) -> Self {
-        // Per field (the corners, then the normal), axis and lane.
-        let mut v = [[[0.0; L]; 3]; 4];
-        for l in 0..L {
-            let f = &faces[t[l]];
-            for k in 0..3 {
-                v[0][k][l] = f.corners[0][k];
-                v[1][k][l] = f.corners[1][k];
-                v[2][k][l] = f.corners[2][k];
-                v[3][k][l] = f.normal[k];
+/// Corners `k` of the triangles `t[l]` (vertex indices `triangles`, positions `vertices`),
+/// per corner as vectors (a lane that takes no part names triangle 0).
+#[inline(always)]
+fn corners<S: Simd, const L: usize, const K: usize>(
+    triangles: &[[u32; 3]],
+    vertices: &[DVec3],
+    t: &[usize; L],
+    k: [usize; K],
+) -> [V3<S>; K] {
+    let mut v = [[[0.0; L]; 3]; K];
+    for l in 0..L {
+        let tri = triangles[t[l]];
+        for i in 0..K {
+            let p = vertices[tri[k[i]] as usize];
+            for a in 0..3 {
+                v[i][a][l] = p[a];
             }
         }
-        Self {
-            corners: [
-                load3::<S, L>(&v[0]),
-                load3::<S, L>(&v[1]),
-                load3::<S, L>(&v[2]),
-            ],
-            normal: load3::<S, L>(&v[3]),
+    }
+    std::array::from_fn(|i| load3::<S, L>(&v[i]))
+}
+
+/// The unit normals `normals[t[l]]`, as vectors.
+#[inline(always)]
+fn normals<S: Simd, const L: usize>(normals: &[DVec3], t: &[usize; L]) -> V3<S> {
+    let mut v = [[0.0; L]; 3];
+    for l in 0..L {
+        let n = normals[t[l]];
+        for a in 0..3 {
+            v[a][l] = n[a];
         }
     }
+    load3::<S, L>(&v)
 }
 
 /// Lanes `s .. s + L` of a field kept per axis, as vectors.

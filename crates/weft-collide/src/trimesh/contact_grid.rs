@@ -160,8 +160,11 @@ impl ContactGrid {
         // Sought as far as a particle with triangles in its cell may be from them.
         let clearance = clearances(mesh, 2.0 * (within + half_diagonal));
         // One more record, settling nothing, for the particles that touched no triangle.
-        let certs = (mesh.faces.iter().zip(&clearance))
-            .map(|(f, &clear)| FaceCert::new(f.corners, f.normal, clear))
+        let certs = (clearance.iter().enumerate())
+            .map(|(t, &clear)| {
+                let f = mesh.face(t);
+                FaceCert::new(f.corners, f.normal, clear)
+            })
             .chain([FaceCert::NONE])
             .collect();
         Some(Self {
@@ -254,11 +257,11 @@ impl ContactGrid {
 /// triangle's radius about c (a lower bound on the distance between the two triangles).
 fn clearances(mesh: &MeshGeometry, cap: f64) -> Vec<f64> {
     let eps = 1e-12 * (1.0 + mesh.extent);
-    (0..mesh.faces.len())
+    (0..mesh.face_count())
         .into_par_iter()
         .with_min_len(256)
         .map(|t| {
-            let f = &mesh.faces[t];
+            let f = mesh.face(t);
             let [a, b, c] = f.corners;
             let n = f.normal;
             if n == DVec3::ZERO {
@@ -272,7 +275,7 @@ fn clearances(mesh: &MeshGeometry, cap: f64) -> Vec<f64> {
             let mut clear = cap;
             mesh.bvh
                 .branch_and_bound(centre, (cap + radius) * (cap + radius), |u| {
-                    let [ua, ub, uc] = mesh.faces[u].corners;
+                    let [ua, ub, uc] = mesh.corners(u);
                     if [ua, ub, uc].iter().any(|v| n.dot(*v - a) > eps) {
                         let q = closest_on_triangle(centre, ua, ub, uc).point;
                         clear = clear.min(((q - centre).length() - radius).max(0.0));

@@ -21,7 +21,7 @@ fn geometry(m: &TriangleMesh) -> MeshGeometry {
 
 /// Distance from `x` to triangle `t`.
 fn distance(g: &MeshGeometry, t: usize, x: DVec3) -> f64 {
-    let [a, b, c] = g.faces[t].corners;
+    let [a, b, c] = g.corners(t);
     (x - closest_on_triangle(x, a, b, c).point).length()
 }
 
@@ -32,7 +32,7 @@ fn points(g: &MeshGeometry, rng: &mut Rng, count: usize, near: f64) -> Vec<DVec3
             if k % 2 == 0 {
                 rng.cube(0.8)
             } else {
-                let f = &g.faces[(rng.next() * g.faces.len() as f64) as usize % g.faces.len()];
+                let f = g.face((rng.next() * g.face_count() as f64) as usize % g.face_count());
                 let centre = f.corners.iter().sum::<DVec3>() / 3.0;
                 centre + f.normal * near * (2.0 * rng.next() - 1.0) + rng.cube(near)
             }
@@ -53,7 +53,7 @@ fn a_cell_lists_every_triangle_within_reach_of_its_points() {
         let mut within = 0;
         for x in points(&g, &mut rng, 4000, 2.0 * reach) {
             let list = grid.cell(x).map_or(&[][..], |c| grid.list(c));
-            for t in 0..g.faces.len() {
+            for t in 0..g.face_count() {
                 if distance(&g, t, x) <= reach {
                     within += 1;
                     assert!(list.contains(&(t as u32)), "{x}: triangle {t} not listed");
@@ -105,8 +105,8 @@ fn clearance_is_a_lower_bound_on_the_distance_to_triangles_in_front() {
     let reach = 0.02;
     let grid = ContactGrid::new(&g, reach).expect("small grid");
     let (mut clear, mut blocked) = (0, 0);
-    for t in (0..g.faces.len()).step_by(7) {
-        let f = &g.faces[t];
+    for t in (0..g.face_count()).step_by(7) {
+        let f = g.face(t);
         let [a, b, c] = f.corners;
         // Points on the triangle: the least distance from them to a triangle is at least the
         // triangles' distance, hence at least the clearance.
@@ -118,8 +118,8 @@ fn clearance_is_a_lower_bound_on_the_distance_to_triangles_in_front() {
             })
             .collect();
         let bound = grid.clearance(t);
-        for u in 0..g.faces.len() {
-            if g.faces[u]
+        for u in 0..g.face_count() {
+            if g.face(u)
                 .corners
                 .iter()
                 .any(|v| f.normal.dot(*v - a) > 1e-9)
@@ -145,7 +145,7 @@ fn clearance_is_a_lower_bound_on_the_distance_to_triangles_in_front() {
     // A convex mesh: every triangle is clear well beyond the contact reach.
     let ball = geometry(&TriangleMesh::icosphere(0.5, 3));
     let grid = ContactGrid::new(&ball, reach).expect("small grid");
-    assert!((0..ball.faces.len()).all(|t| grid.clearance(t) >= 4.0 * reach));
+    assert!((0..ball.face_count()).all(|t| grid.clearance(t) >= 4.0 * reach));
 }
 
 /// Particles started around and on a mesh, stepping towards its centre and sideways for
@@ -190,7 +190,7 @@ fn grid_matches_lists(m: &TriangleMesh, seed: u64) {
             let oa = frame.resolve(&mut lists, j, pa, &mut a[j], r);
             let ob = frame.resolve_in_grid((&grid, &state), j, pb, &mut b[j], r);
             if ob.contacts < ROUNDS {
-                let d = (0..g.faces.len())
+                let d = (0..g.face_count())
                     .map(|t| distance(&g, t, b[j]))
                     .fold(f64::INFINITY, f64::min);
                 assert!(
@@ -281,7 +281,7 @@ fn a_clear_ball_holds_no_point_within_reach_of_the_mesh() {
                 continue;
             }
             let bound = grid.clear_distance(cell, x);
-            let least = (0..g.faces.len())
+            let least = (0..g.face_count())
                 .map(|t| distance(&g, t, x))
                 .fold(f64::INFINITY, f64::min);
             assert!(least >= bound, "{x}: nearest triangle {least} < {bound}");

@@ -71,7 +71,7 @@ impl MeshFrame<'_> {
     ) -> Option<Outcome> {
         let g = self.geometry;
         let f = lists.certs.face[j] as usize;
-        if f >= g.faces.len() || g.fronts.count[f] == UNUSABLE {
+        if f >= g.face_count() || g.fronts.count[f] == UNUSABLE {
             return None;
         }
         let (mut xl, _) = self.local_path(*x, prev, || lists.last[j]);
@@ -127,7 +127,7 @@ impl MeshFrame<'_> {
     /// of the two faces' normals and within the edge's ends; `None` elsewhere.
     fn over_edge(&self, f: usize, x: DVec3, only: Option<usize>) -> Option<OverEdge> {
         let g = self.geometry;
-        let face = &g.faces[f];
+        let face = g.face(f);
         let [a, b, c] = face.corners;
         // With e₁ = b − a, e₂ = c − a, m = e₁ × e₂ and w = x − a, the projection of x is
         // a + β e₁ + γ e₂ with β |m|² = (w × e₂) · m and γ |m|² = (e₁ × w) · m.
@@ -165,7 +165,7 @@ impl MeshFrame<'_> {
         let u = q - p;
         let uu = u.dot(u);
         let t = (x - p).dot(u) / uu;
-        let ng = g.faces[other as usize].normal;
+        let ng = g.normals[other as usize];
         let v = x - p;
         // In front of both planes, and beyond e within G's plane (G runs e from q to p, so
         // its outward normal there is (p − q) × n_G).
@@ -248,7 +248,7 @@ mod tests {
         let f = (g.triangles.iter())
             .position(|t| *t == [0, 1, 2])
             .expect("F stored");
-        assert!(g.faces[f].normal.y > 0.999, "F faces up");
+        assert!(g.normals[f].y > 0.999, "F faces up");
         (g, f)
     }
 

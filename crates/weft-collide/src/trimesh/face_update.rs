@@ -1,7 +1,8 @@
-//! A moving mesh's faces (corners and unit normal) worked out anew at every substep, and their
-//! bounding planes at every frame's end, a block of faces at a time in explicit vectors: the
-//! same IEEE operations in the same order as [`Face::at`] and [`Planes::new`] (glam's cross
-//! product and `normalize_or_zero`), so the same bits, on every kernel path.
+//! A moving mesh's faces' unit normals worked out anew at every substep (their corners are
+//! the vertices themselves), and their bounding planes at every frame's end, a block of
+//! faces at a time in explicit vectors: the same IEEE operations in the same order as
+//! [`face_normal`] and [`Planes::new`] (glam's cross product and `normalize_or_zero`), so the
+//! same bits, on every kernel path.
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
@@ -13,14 +14,16 @@ use rayon::prelude::*;
 use weft_solver::SimdPath;
 use weft_solver::lane_ops::{LaneKernel, Ops, V3, load3, on_path, store, store3};
 
-use super::{Face, Planes};
+use super::Planes;
+use super::normals::face_normal;
 
 /// Faces a parallel task works out.
 const PART: usize = 1024;
 
-/// Sets `faces[i]` to triangle `triangles[i]`'s face at the vertices `end`, as [`Face::at`].
-pub(crate) fn update_faces(faces: &mut [Face], triangles: &[[u32; 3]], end: &[DVec3]) {
-    update(faces, triangles, end);
+/// Sets `normals[i]` to triangle `triangles[i]`'s unit normal at the vertices `end`, as
+/// [`face_normal`] (its corners are those vertices: `MeshGeometry::face`).
+pub(crate) fn update_normals(normals: &mut [DVec3], triangles: &[[u32; 3]], end: &[DVec3]) {
+    update(normals, triangles, end);
 }
 
 /// Sets `planes[i]` to triangle `triangles[i]`'s planes at the vertices `end`, as
@@ -55,21 +58,18 @@ trait OfCorners: Sized + Send {
     fn one(corners: [DVec3; 3]) -> Self;
 }
 
-impl OfCorners for Face {
+impl OfCorners for DVec3 {
     #[inline(always)]
     fn block<S: Simd, const L: usize>(o: Ops<S>, corners: &[[[f64; L]; 3]; 3], out: &mut [Self]) {
         let [a, b, c] = load_corners::<S, L>(corners);
         let normal = store3::<S, L>(&unit_normal(o, [&a, &b, &c]));
-        for (l, face) in out.iter_mut().enumerate().take(L) {
-            for c in 0..3 {
-                face.corners[c] = DVec3::new(corners[c][0][l], corners[c][1][l], corners[c][2][l]);
-            }
-            face.normal = DVec3::new(normal[0][l], normal[1][l], normal[2][l]);
+        for (l, n) in out.iter_mut().enumerate().take(L) {
+            *n = DVec3::new(normal[0][l], normal[1][l], normal[2][l]);
         }
     }
 
-    fn one(corners: [DVec3; 3]) -> Self {
-        Face::at(corners)
+    fn one([a, b, c]: [DVec3; 3]) -> Self {
+        face_normal(a, b, c)
     }
 }
 
@@ -189,14 +189,14 @@ fn unit<S: Simd>(o: Ops<S>, m: V3<S>) -> V3<S> {
 mod tests {
     use glam::DVec3;
 
-    use super::{update_faces, update_planes};
+    use super::{update_normals, update_planes};
     use crate::analytic_vs_parry::Rng;
+    use crate::trimesh::Planes;
     use crate::trimesh::normals::face_normal;
-    use crate::trimesh::{Face, Planes};
 
-    /// The block updates give every face and its planes the bits `Face::at` and `Planes::new`
-    /// give them, degenerate faces (zero normal) and a run's last faces (past the last full
-    /// block) included.
+    /// The block updates give every face's normal and its planes the bits `face_normal` and
+    /// `Planes::new` give them, degenerate faces (zero normal) and a run's last faces (past
+    /// the last full block) included.
     #[test]
     fn faces_and_planes_match_the_one_face_forms_bit_for_bit() {
         let mut rng = Rng(5);
@@ -206,17 +206,17 @@ mod tests {
             .map(|_| [0, 1, 2].map(|_| (rng.next() * 300.0) as u32 % 300))
             .collect();
         triangles[11] = [3, 7, 9];
-        let mut faces = vec![Face::at([DVec3::ZERO; 3]); triangles.len()];
-        update_faces(&mut faces, &triangles, &vertices);
-        for (f, t) in faces.iter().zip(&triangles) {
-            let want = Face::at(t.map(|i| vertices[i as usize]));
-            assert_eq!(f.corners, want.corners);
+        let mut normals = vec![DVec3::NAN; triangles.len()];
+        update_normals(&mut normals, &triangles, &vertices);
+        for (n, t) in normals.iter().zip(&triangles) {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            let want = face_normal(a, b, c);
             assert_eq!(
-                f.normal.to_array().map(f64::to_bits),
-                want.normal.to_array().map(f64::to_bits)
+                n.to_array().map(f64::to_bits),
+                want.to_array().map(f64::to_bits)
             );
         }
-        assert_eq!(faces[11].normal, DVec3::ZERO);
+        assert_eq!(normals[11], DVec3::ZERO);
         let mut planes = vec![Planes::default(); triangles.len()];
         update_planes(&mut planes, &triangles, &vertices);
         for (p, t) in planes.iter().zip(&triangles) {

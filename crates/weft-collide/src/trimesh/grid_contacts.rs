@@ -268,7 +268,7 @@ impl MeshFrame<'_> {
             WALK
         };
         for _ in 0..walk {
-            let Some(f) = g.faces.get(t) else { break };
+            let Some(f) = g.face_get(t) else { break };
             let [a, b, c] = f.corners;
             // Clear of everything without the closest point: r or more in front of the plane
             // (so r from every triangle behind it), and near enough to a corner that the
@@ -296,7 +296,7 @@ impl MeshFrame<'_> {
                 Feature::Face => (f.normal.dot(xl - q.point) > 0.0).then(|| grid.clearance(t)),
                 Feature::Edge(k) => match adjacent[usize::from(k)] {
                     NONE => None,
-                    u => g.faces.get(u as usize).and_then(|fu| {
+                    u => g.face_get(u as usize).and_then(|fu| {
                         let [ua, ub, uc] = fu.corners;
                         let across = closest_on_triangle(xl, ua, ub, uc);
                         let shared = matches!(across.feature,

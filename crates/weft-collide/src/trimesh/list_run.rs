@@ -407,7 +407,7 @@ fn settle<const L: usize>(
     let mut tri = [u32::MAX; L];
     for l in 0..L {
         let t = lists.hint[s + l];
-        if let (true, Some(face)) = (near[l], g.faces.get(t as usize)) {
+        if let (true, Some(face)) = (near[l], g.face_get(t as usize)) {
             tri[l] = t;
             for c in 0..3 {
                 for k in 0..3 {
@@ -565,7 +565,7 @@ fn below<const L: usize>(
         let a = [f[0][l], f[1][l], f[2][l]];
         let n = [f[9][l], f[10][l], f[11][l]];
         out[l] = listed_but(lists, s + l, skip[l]).all(|t| {
-            let c = &g.faces[t as usize].corners;
+            let c = g.corners(t as usize);
             let high = |k: usize| dot(n, sub(c[k].to_array(), a));
             high(0).max(high(1)).max(high(2)) <= lift[l]
         });
@@ -689,7 +689,7 @@ impl Pending {
         for k in 0..PENDING {
             // Unused entries repeat the first pair.
             let e = if k < self.len { k } else { 0 };
-            let face = &g.faces[self.tri[e] as usize];
+            let face = g.face(self.tri[e] as usize);
             for a in 0..3 {
                 p[a][k] = x[a][self.lane[e]];
                 for c in 0..3 {

@@ -86,7 +86,7 @@ fn passes_from(
         Some(drift) => (0..n)
             .map(|_| {
                 loop {
-                    let f = &g.faces[(rng.next() * g.faces.len() as f64) as usize % g.faces.len()];
+                    let f = g.face((rng.next() * g.face_count() as f64) as usize % g.face_count());
                     let (u, v) = (rng.next(), rng.next());
                     let (u, v) = if u + v > 1.0 {
                         (1.0 - u, 1.0 - v)

@@ -40,9 +40,9 @@ use convexity::{Fronts, Rings};
 use normals::{Topology, face_normal, pseudo_normal};
 
 /// One triangle at the end of the substep: its corners and unit normal (what the contact
-/// loops read after a triangle passes its [`Planes`] bound), in adjacent cache lines.
+/// loops read after a triangle passes its [`Planes`] bound), put together from the vertices
+/// and the normals kept per face ([`MeshGeometry::face`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
 pub(crate) struct Face {
     /// Corners a, b, c (m, the collider's frame).
     pub corners: [DVec3; 3],
@@ -141,11 +141,9 @@ pub(crate) struct MeshGeometry {
     pub start: Vec<DVec3>,
     /// Vertices at the end of the substep: the current surface.
     pub end: Vec<DVec3>,
-    /// Faces at the end of the substep, in storage order.
-    pub faces: Vec<Face>,
-    /// Faces at the start of the substep (those of the last substep that moved the vertices;
-    /// read only while they move).
-    pub start_faces: Vec<Face>,
+    /// The faces' unit normals at the end of the substep, in storage order (their corners
+    /// are `end`'s: [`Self::face`]).
+    pub normals: Vec<DVec3>,
     /// Their bounding planes, apart (a scan reads only these for most triangles).
     pub planes: Vec<Planes>,
     /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
@@ -202,8 +200,7 @@ impl MeshGeometry {
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         let mut geometry = Self {
-            faces: Vec::new(),
-            start_faces: Vec::new(),
+            normals: Vec::new(),
             planes: Vec::new(),
             margin: 0.0,
             extent: 0.0,
@@ -225,8 +222,7 @@ impl MeshGeometry {
             frame_id: 0,
             frame_span: (0.0, 0.0),
         };
-        (geometry.faces, geometry.planes) = geometry.compute_faces();
-        geometry.start_faces.clone_from(&geometry.faces);
+        (geometry.normals, geometry.planes) = geometry.compute_faces();
         geometry.set_margin(extent);
         let ends = (&geometry.end[..], &geometry.end[..]);
         (geometry.fronts).update(&geometry.triangles, &geometry.rings, ends, (extent, 0));
@@ -247,13 +243,43 @@ impl MeshGeometry {
         widen(1e-6 * (self.extent + x.abs().max_element() + 1.0) + self.slack)
     }
 
-    fn compute_faces(&self) -> (Vec<Face>, Vec<Planes>) {
+    fn compute_faces(&self) -> (Vec<DVec3>, Vec<Planes>) {
         let end = &self.end;
         self.triangles
             .par_iter()
             .with_min_len(1024)
-            .map(|t| Face::new(t.map(|i| end[i as usize])))
+            .map(|t| {
+                let (f, p) = Face::new(t.map(|i| end[i as usize]));
+                (f.normal, p)
+            })
             .unzip()
+    }
+
+    /// Triangle `t`'s corners at the end of the substep.
+    #[inline(always)]
+    pub fn corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.end[i as usize])
+    }
+
+    /// Triangle `t`'s face at the end of the substep: its corners and unit normal.
+    #[inline(always)]
+    pub fn face(&self, t: usize) -> Face {
+        Face {
+            corners: self.corners(t),
+            normal: self.normals[t],
+        }
+    }
+
+    /// [`Self::face`], or `None` for an index past the last triangle.
+    #[inline(always)]
+    pub fn face_get(&self, t: usize) -> Option<Face> {
+        (t < self.normals.len()).then(|| self.face(t))
+    }
+
+    /// How many triangles (faces) the mesh has.
+    #[inline]
+    pub fn face_count(&self) -> usize {
+        self.triangles.len()
     }
 
     /// Whether the mesh is closed and consistently wound.
@@ -352,8 +378,7 @@ impl MeshGeometry {
         if !self.moving {
             return;
         }
-        std::mem::swap(&mut self.faces, &mut self.start_faces);
-        face_update::update_faces(&mut self.faces, &self.triangles, &self.end);
+        face_update::update_normals(&mut self.normals, &self.triangles, &self.end);
     }
 
     /// Moves the surface to `next` at once (a frame of one substep).
@@ -375,8 +400,8 @@ impl MeshGeometry {
             &self.triangles,
             t,
             feature,
-            |u| self.faces[u].normal,
-            |u, k| self.faces[u].corners[k],
+            |u| self.normals[u],
+            |u, k| self.corners(u)[k],
         )
     }
 
@@ -402,7 +427,7 @@ impl MeshGeometry {
         let normal = if len > 1e-12 {
             if inside { -delta / len } else { delta / len }
         } else {
-            pn.normalize_or(self.faces[t].normal)
+            pn.normalize_or(self.normals[t])
         };
         let p = MeshPoint {
             triangle: t,
@@ -450,7 +475,7 @@ impl MeshGeometry {
         if f64::from(self.planes[t].distance_squared_bound(x32, margin)) >= bound {
             return None;
         }
-        let [a, b, c] = self.faces[t].corners;
+        let [a, b, c] = self.corners(t);
         let q = closest_on_triangle(x, a, b, c);
         Some(((x - q.point).length_squared(), q))
     }
@@ -467,7 +492,6 @@ impl MeshGeometry {
         out: &mut Vec<u32>,
     ) -> Option<MeshPoint> {
         let r2 = radius * radius;
-        let faces = &self.faces;
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
         let mut best: Option<(f64, usize, Closest)> = None;
         // What a triangle must be within to matter: r², or the best so far beyond it (at
@@ -478,7 +502,7 @@ impl MeshGeometry {
             if f64::from(self.planes[t].distance_squared_bound(x32, margin)) > limit {
                 return limit;
             }
-            let [a, b, c] = faces[t].corners;
+            let [a, b, c] = self.corners(t);
             let q = closest_on_triangle(x, a, b, c);
             let d2 = (x - q.point).length_squared();
             if d2 <= r2 {
@@ -533,7 +557,6 @@ impl MeshGeometry {
         guard: &mut Vec<u32>,
     ) -> (Option<MeshPoint>, f64) {
         let r2 = radius * radius;
-        let faces = &self.faces;
         let (x32, margin) = (x.as_vec3(), self.margin_at(x));
         let mut best: Option<(f64, usize, Closest)> = None;
         let mut spread = 0.0f64;
@@ -541,7 +564,7 @@ impl MeshGeometry {
             // A lower bound on the distance² now (and until the frame's end).
             let lower = f64::from(self.planes[t].distance_squared_bound(x32, margin));
             if lower <= r2 {
-                let [a, b, c] = faces[t].corners;
+                let [a, b, c] = self.corners(t);
                 let q = closest_on_triangle(x, a, b, c);
                 let d2 = (x - q.point).length_squared();
                 if d2 <= r2 {
@@ -582,7 +605,7 @@ impl MeshGeometry {
         self.bvh.visit(
             |l, h| l.cmple(hi).all() && h.cmpge(lo).all(),
             |t| {
-                let f = &self.faces[t];
+                let f = self.face(t);
                 if let Some(c) = ccd::segment_crossing(from, to, f.corners, f.normal, closed)
                     && best.is_none_or(|b| c.t < b.0)
                 {

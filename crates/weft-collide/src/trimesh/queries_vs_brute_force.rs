@@ -35,10 +35,9 @@ fn meshes() -> Vec<MeshGeometry> {
 
 /// Squared distance from `x` to every triangle, in storage order.
 fn distances_squared(g: &MeshGeometry, x: DVec3) -> Vec<f64> {
-    g.faces
-        .iter()
-        .map(|f| {
-            let [a, b, c] = f.corners;
+    (0..g.face_count())
+        .map(|t| {
+            let [a, b, c] = g.corners(t);
             (x - closest_on_triangle(x, a, b, c).point).length_squared()
         })
         .collect()
@@ -49,7 +48,7 @@ fn distances_squared(g: &MeshGeometry, x: DVec3) -> Vec<f64> {
 fn points(g: &MeshGeometry, rng: &mut Rng, count: usize) -> Vec<DVec3> {
     (0..count)
         .map(|k| {
-            let f = &g.faces[(rng.next() * g.faces.len() as f64) as usize % g.faces.len()];
+            let f = g.face((rng.next() * g.face_count() as f64) as usize % g.face_count());
             let above = |h: f64| f.corners.iter().sum::<DVec3>() / 3.0 + f.normal * h;
             match k % 6 {
                 0 => rng.cube(0.8),

@@ -80,10 +80,9 @@ fn icosphere_is_closed_and_wound_outwards() {
     let g = MeshGeometry::new(&m.vertices, &m.triangles);
     assert!(g.closed());
     // Outward winding: positive volume (divergence theorem), near (4/3)π.
-    let volume: f64 = g
-        .faces
-        .iter()
-        .map(|f| f.corners[0].dot(f.corners[1].cross(f.corners[2])) / 6.0)
+    let volume: f64 = (0..g.face_count())
+        .map(|t| g.corners(t))
+        .map(|[a, b, c]| a.dot(b.cross(c)) / 6.0)
         .sum();
     // The inscribed polyhedron's volume is a little below the ball's (4/3)π.
     assert!(
