@@ -193,7 +193,7 @@ impl Fronts {
 }
 
 /// Faces a parallel task updates.
-const PART: usize = 1024;
+const PART: usize = 256;
 
 /// [`Fronts::update`] for the faces from `first` on (as many as `count` holds), compiled for
 /// the widest vector unit the CPU has (the same operations, so the same bits, on every one).
