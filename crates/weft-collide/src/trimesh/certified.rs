@@ -62,9 +62,8 @@ pub(crate) struct Certified<const L: usize> {
 thread_local! {
     /// Lanes the certified test settled on this thread: clear, pushed, in a hover ball.
     pub(crate) static SETTLED: std::cell::Cell<[usize; 3]> = const { std::cell::Cell::new([0; 3]) };
-    /// (lane, front triangle) pairs the test worked out beyond the triangle's plane (by the
-    /// bound of its planes, else its distance) on this thread.
-    pub(crate) static FRONT_CHECKS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    /// (lane, front triangle) pairs whose distance the test worked out on this thread.
+    pub(crate) static FRONT_DISTANCES: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 /// Adds `n` to counter `k` of [`SETTLED`] (tests only).
@@ -401,32 +400,14 @@ impl<const L: usize> Fronts<'_, L> {
             let after = o.ge(o.dot(&nt, &o.dif(moved, &a)), r);
             let by_plane = o.and(before, o.or(o.not(pushed), after));
             let open = o.and(listed, o.not(by_plane));
-            // A lane is shown clear without its distance where the bound of the triangle's
-            // planes (its plane and edge lines, f32, `Planes::distance_squared_bound`)
-            // already clears `need`: a pushed one's nearest bound is the plane's height
-            // either way, one not pushed takes that bound's root instead of its distance.
-            let (mut shown, mut lower) = ([false; L], [0.0; L]);
-            if o.any(open) {
-                let open_b = o.bits::<L>(open);
-                #[cfg(test)]
-                FRONT_CHECKS.with(|c| c.set(c.get() + open_b.iter().filter(|&&b| b).count()));
-                let (need2_a, at) = (store::<S, L>(need2), lifted.map(|v| store::<S, L>(v)));
-                for l in (0..L).filter(|&l| open_b[l]) {
-                    let p = glam::Vec3::new(at[0][l] as f32, at[1][l] as f32, at[2][l] as f32);
-                    let margin = g.margin_at(DVec3::new(at[0][l], at[1][l], at[2][l]));
-                    let b = f64::from(g.planes[u[l]].distance_squared_bound(p, margin));
-                    shown[l] = b >= need2_a[l];
-                    lower[l] = b.sqrt();
-                }
-            }
-            let shown = mask::<S, L>(o, shown);
-            let open = o.and(open, o.not(shown));
-            let height = o.sel(o.and(shown, o.not(pushed)), load::<S, L>(lower), height);
             if !o.any(open) {
-                // The plane's height (or the planes' bound) is a lower bound on the distance.
+                // The plane's height is a lower bound on the distance to the triangle.
                 nearest = o.sel(listed, o.min(nearest, height), nearest);
                 continue;
             }
+            #[cfg(test)]
+            FRONT_DISTANCES
+                .with(|c| c.set(c.get() + o.bits::<L>(open).iter().filter(|&&b| b).count()));
             let [b, c] = corners::<S, L, 2>(&g.triangles, &g.end, &u, [1, 2]);
             let d2 = distance_squared(o, lifted, [&a, &b, &c]);
             clear = o.and(clear, o.or(o.not(open), o.ge(d2, need2)));

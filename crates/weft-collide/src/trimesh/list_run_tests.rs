@@ -216,7 +216,7 @@ fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) 
     SETTLED.with(|c| c.set(0));
     FLAT.with(|c| c.set(0));
     certified::SETTLED.with(|c| c.set([0; 3]));
-    certified::FRONT_CHECKS.with(|c| c.set(0));
+    certified::FRONT_DISTANCES.with(|c| c.set(0));
     edge_contact::EDGES.with(|c| c.set(0));
     passes_from(m, case, (n, resting), |frame, prev, a| {
         let mut b = a.clone();
@@ -237,7 +237,7 @@ fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) 
         lanes: SETTLED.with(|c| c.get()),
         flat: FLAT.with(|c| c.get()),
         certified: certified::SETTLED.with(|c| c.get()),
-        fronts: certified::FRONT_CHECKS.with(|c| c.get()),
+        fronts: certified::FRONT_DISTANCES.with(|c| c.get()),
         edges: edge_contact::EDGES.with(|c| c.get()),
     }
 }
