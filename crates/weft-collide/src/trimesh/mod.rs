@@ -258,7 +258,12 @@ impl MeshGeometry {
     /// Triangle `t`'s corners at the end of the substep.
     #[inline(always)]
     pub fn corners(&self, t: usize) -> [DVec3; 3] {
-        self.triangles[t].map(|i| self.end[i as usize])
+        let [a, b, c] = self.triangles[t];
+        [
+            self.end[a as usize],
+            self.end[b as usize],
+            self.end[c as usize],
+        ]
     }
 
     /// Triangle `t`'s face at the end of the substep: its corners and unit normal.
