@@ -109,20 +109,19 @@ fn draped_mesh(c: &mut Criterion) {
 }
 
 fn deforming_mesh(c: &mut Criterion) {
-    let n = 90;
-    let (solver, world) = in_contact(breathing_drop(Method::Xpbd, n).expect("scene"));
-    let mut g = c.benchmark_group(format!("deforming_mesh/{}", n * n));
-    quick(&mut g);
-    g.throughput(Throughput::Elements((n * n) as u64));
-    g.bench_function("constraint_solve", |b| step_copies(b, &solver));
-    g.bench_function("deforming", |b| step_with_copies(b, &solver, &world));
-    g.finish();
+    deforming_group(c, "deforming_mesh", PREROLL);
 }
 
 fn deforming_mesh_draped(c: &mut Criterion) {
+    deforming_group(c, "deforming_mesh_draped", DRAPED);
+}
+
+/// The group `name` of the breathing ball's 90² cloth after `frames` frames: its bare solve
+/// and its frame with the ball and the ground.
+fn deforming_group(c: &mut Criterion, name: &str, frames: usize) {
     let n = 90;
-    let (solver, world) = after(DRAPED, breathing_drop(Method::Xpbd, n).expect("scene"));
-    let mut g = c.benchmark_group(format!("deforming_mesh_draped/{}", n * n));
+    let (solver, world) = after(frames, breathing_drop(Method::Xpbd, n).expect("scene"));
+    let mut g = c.benchmark_group(format!("{name}/{}", n * n));
     quick(&mut g);
     g.throughput(Throughput::Elements((n * n) as u64));
     g.bench_function("constraint_solve", |b| step_copies(b, &solver));
