@@ -32,12 +32,11 @@ mod vs_parry;
 pub(crate) mod wide_bvh;
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
 use convexity::{Fronts, Rings};
-use normals::{Topology, face_normal, pseudo_normal};
+use normals::{Topology, pseudo_normal};
 
 /// One triangle at the end of the substep: its corners and unit normal (what the contact
 /// loops read after a triangle passes its [`Planes`] bound), put together from the vertices
@@ -48,19 +47,6 @@ pub(crate) struct Face {
     pub corners: [DVec3; 3],
     /// Unit normal (b − a) × (c − a) / |…|, zero if degenerate.
     pub normal: DVec3,
-}
-
-impl Face {
-    /// The face with `corners`, its normal worked out.
-    fn at(corners: [DVec3; 3]) -> Self {
-        let normal = face_normal(corners[0], corners[1], corners[2]);
-        Self { corners, normal }
-    }
-
-    fn new(corners: [DVec3; 3]) -> (Self, Planes) {
-        let f = Self::at(corners);
-        (f, Planes::new(corners, f.normal))
-    }
 }
 
 /// A triangle's planes in f32, one cache line, for a cheap conservative distance bound: its
@@ -222,7 +208,12 @@ impl MeshGeometry {
             frame_id: 0,
             frame_span: (0.0, 0.0),
         };
-        (geometry.normals, geometry.planes) = geometry.compute_faces();
+        // The faces' normals and planes as a moving mesh's are worked out (the same bits).
+        let n = geometry.triangles.len();
+        geometry.normals = vec![DVec3::ZERO; n];
+        geometry.planes = vec![Planes::default(); n];
+        face_update::update_normals(&mut geometry.normals, &geometry.triangles, &geometry.end);
+        face_update::update_planes(&mut geometry.planes, &geometry.triangles, &geometry.end);
         geometry.set_margin(extent);
         let ends = (&geometry.end[..], &geometry.end[..]);
         (geometry.fronts).update(&geometry.triangles, &geometry.rings, ends, (extent, 0));
@@ -241,18 +232,6 @@ impl MeshGeometry {
     /// anywhere: as [`Self::margin`] with x's own size added.
     fn margin_at(&self, x: DVec3) -> f32 {
         widen(1e-6 * (self.extent + x.abs().max_element() + 1.0) + self.slack)
-    }
-
-    fn compute_faces(&self) -> (Vec<DVec3>, Vec<Planes>) {
-        let end = &self.end;
-        self.triangles
-            .par_iter()
-            .with_min_len(1024)
-            .map(|t| {
-                let (f, p) = Face::new(t.map(|i| end[i as usize]));
-                (f.normal, p)
-            })
-            .unzip()
     }
 
     /// Triangle `t`'s corners at the end of the substep.
