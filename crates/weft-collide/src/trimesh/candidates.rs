@@ -97,6 +97,9 @@ pub(crate) struct ChunkLists {
     pub builds: u64,
     /// Each particle's certificate (`certified`).
     pub(crate) certs: Certificates,
+    /// The block test's queue of particles for the face test (`list_run`), kept between
+    /// runs for its allocation.
+    pub(super) queue: Vec<usize>,
 }
 
 impl ChunkLists {
@@ -120,6 +123,7 @@ impl ChunkLists {
             spare: Vec::new(),
             builds: 0,
             certs: Certificates::new(n),
+            queue: Vec::new(),
         }
     }
 

@@ -27,7 +27,10 @@
 //!
 //! What a lane does depends on that particle alone and every lane runs the same IEEE
 //! operations in the same order (no fused multiply-adds, every branch a select), so the bits
-//! do not depend on the kernel path or on where a particle falls in a run.
+//! do not depend on the kernel path, on where a particle falls in a run, or on which lanes
+//! share its block: a run screens its particles a block at a time ([`screen`]: certificates,
+//! clear lanes, hover balls) and packs those sent on to the face test ([`face_test`]) into
+//! full blocks.
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
@@ -77,42 +80,68 @@ fn tally(_k: usize, _n: usize) {
     });
 }
 
-/// The certified test (see the module's notes) of particles `s .. s + L` of `lists` at
-/// positions `x` (the mesh's frame, moved in place where settled), `prev` at the substep's
-/// start, thicknesses `r`, taking part where `live` and certified (`MeshFrame::certifies`),
-/// against the mesh of `frame` (for which `MeshFrame::lists_settle` holds). The block path and
-/// the one-particle path test alike through this.
+/// The certified test (see the module's notes) of particle `j` of `lists` at `x` (the mesh's
+/// frame, moved in place where settled), `prev` at the substep's start, thickness `r`, taking
+/// part where `live` and certified (`MeshFrame::certifies`), against the mesh of `frame` (for
+/// which `MeshFrame::lists_settle` holds): [`screen`], then [`face_test`], as a block's
+/// particles take them.
 #[inline(always)]
-pub(crate) fn certified<S: Simd, const L: usize>(
+pub(crate) fn certified<S: Simd>(
+    o: Ops<S>,
+    frame: &MeshFrame<'_>,
+    lists: &mut ChunkLists,
+    j: usize,
+    (x, prev): (&mut [[f64; 1]; 3], &[[f64; 1]; 3]),
+    (r, live): (&[f64; 1], [bool; 1]),
+) -> Certified<1> {
+    let screened = screen::<S, 1>(o, frame, lists, j, (x, prev), (r, live));
+    if !screened.near[0] {
+        return Certified {
+            settled: screened.settled,
+            ring: [false],
+            contacts: Contacts::default(),
+        };
+    }
+    face_test::<S, 1>(o, frame, lists, &[j], (x, prev), (r, screened.near))
+}
+
+/// What [`screen`] found of a block's lanes.
+pub(crate) struct Screened<const L: usize> {
+    /// Lanes settled by a clear certificate or by their hover ball: nothing more to do.
+    pub settled: [bool; L],
+    /// Lanes whose certificate holds and names a face, not in their hover ball: for
+    /// [`face_test`].
+    pub near: [bool; L],
+}
+
+/// The first part of the certified test of particles `s .. s + L` of `lists` at positions `x`
+/// (the mesh's frame), `prev` at the substep's start, thicknesses `r`, taking part where
+/// `live` and certified (`MeshFrame::certifies`): certificates that do not hold made again,
+/// then each lane settled where its certificate is clear or its path lies in its hover ball,
+/// or marked for the face test where its certificate names a face. A lane neither settled
+/// nor near is left open.
+#[inline(always)]
+pub(crate) fn screen<S: Simd, const L: usize>(
     o: Ops<S>,
     frame: &MeshFrame<'_>,
     lists: &mut ChunkLists,
     s: usize,
-    (x, prev): (&mut [[f64; L]; 3], &[[f64; L]; 3]),
+    (x, prev): (&[[f64; L]; 3], &[[f64; L]; 3]),
     (r, mut live): (&[f64; L], [bool; L]),
-) -> Certified<L> {
+) -> Screened<L> {
     debug_assert_eq!(L, S::F64_LANES);
     let g = frame.geometry;
     for l in 0..L {
         live[l] &= frame.certifies(r[l]);
     }
-    let mut out = Certified {
+    let mut out = Screened {
         settled: [false; L],
-        ring: [false; L],
-        contacts: Contacts::default(),
+        near: [false; L],
     };
     if !live.contains(&true) {
         return out;
     }
-    let mut from = *prev;
-    if !frame.fresh {
-        for l in 0..L {
-            let f = lists.last[s + l];
-            for k in 0..3 {
-                from[k][l] = f[k];
-            }
-        }
-    }
+    let from = path_starts::<L>(frame, lists, &std::array::from_fn(|l| s + l), prev);
     let path = (&load3::<S, L>(x), &load3::<S, L>(&from));
     let rv = load::<S, L>(*r);
     // Certificates that do not hold are made again, then read anew.
@@ -126,52 +155,97 @@ pub(crate) fn certified<S: Simd, const L: usize>(
         valid = holds::<S, L>(o, &lists.certs, s, path, (rv, g.travel));
     }
     let certs = &lists.certs;
-    let face: [u32; L] = std::array::from_fn(|l| certs.face[s + l]);
     let hover_slack = o.sub(load_at::<S, L>(&certs.hover[3], s), o.c(g.travel));
     let hovers = in_ball::<S, L>(o, anchors::<S, L>(&certs.hover, s), hover_slack, path);
-    let mut near = [false; L];
     for l in 0..L {
         let ok = live[l] & valid[l];
-        out.settled[l] = ok & ((face[l] == CLEAR) | hovers[l]);
-        near[l] = ok & (face[l] < NO_FACE) & !hovers[l];
+        let face = certs.face[s + l];
+        out.settled[l] = ok & ((face == CLEAR) | hovers[l]);
+        out.near[l] = ok & (face < NO_FACE) & !hovers[l];
     }
     tally(
         0,
         (0..L)
-            .filter(|&l| out.settled[l] & (face[l] == CLEAR))
+            .filter(|&l| out.settled[l] & (certs.face[s + l] == CLEAR))
             .count(),
     );
     tally(
         2,
         (0..L)
-            .filter(|&l| out.settled[l] & (face[l] != CLEAR))
+            .filter(|&l| out.settled[l] & (certs.face[s + l] != CLEAR))
             .count(),
     );
-    if near.contains(&true) {
-        let lanes = Lanes {
-            s,
-            x,
-            from: &from,
-            prev,
-            r,
-            face: &face,
-            near,
-        };
-        out.contacts = settle::<S, L>(o, frame, lists, lanes, &mut out.settled);
-        let surface = frame.surface_travel();
-        for l in 0..L {
-            let p = DVec3::new(
-                x[0][l] - from[0][l],
-                x[1][l] - from[1][l],
-                x[2][l] - from[2][l],
-            );
-            let half = 0.5 * r[l] - surface;
-            let short = half >= 0.0 && p.length_squared() <= half * half;
-            out.ring[l] = near[l] & !out.settled[l] & short;
-        }
-    }
     for l in (0..L).filter(|&l| out.settled[l]) {
         lists.last[s + l] = DVec3::new(x[0][l], x[1][l], x[2][l]);
+    }
+    out
+}
+
+/// Where each lane's path starts: the substep's start `prev` on its first projection, else
+/// where the last left particle `j[l]`.
+#[inline(always)]
+fn path_starts<const L: usize>(
+    frame: &MeshFrame<'_>,
+    lists: &ChunkLists,
+    j: &[usize; L],
+    prev: &[[f64; L]; 3],
+) -> [[f64; L]; 3] {
+    let mut from = *prev;
+    if !frame.fresh {
+        for l in 0..L {
+            let f = lists.last[j[l]];
+            for k in 0..3 {
+                from[k][l] = f[k];
+            }
+        }
+    }
+    from
+}
+
+/// The second part of the certified test: the face test (see the module's notes) of the
+/// `near` lanes ([`screen`]'s), particles `j[l]` of `lists` at `x` (moved in place where
+/// settled), `prev` at the substep's start, thicknesses `r`. A block's lanes may be any
+/// particles of the run (a lane not near takes no part and is left as it is).
+#[inline(always)]
+pub(crate) fn face_test<S: Simd, const L: usize>(
+    o: Ops<S>,
+    frame: &MeshFrame<'_>,
+    lists: &mut ChunkLists,
+    j: &[usize; L],
+    (x, prev): (&mut [[f64; L]; 3], &[[f64; L]; 3]),
+    (r, near): (&[f64; L], [bool; L]),
+) -> Certified<L> {
+    debug_assert_eq!(L, S::F64_LANES);
+    let mut out = Certified {
+        settled: [false; L],
+        ring: [false; L],
+        contacts: Contacts::default(),
+    };
+    let from = path_starts::<L>(frame, lists, j, prev);
+    let face: [u32; L] = std::array::from_fn(|l| if near[l] { lists.certs.face[j[l]] } else { 0 });
+    let lanes = Lanes {
+        j,
+        x,
+        from: &from,
+        prev,
+        r,
+        face: &face,
+        near,
+    };
+    out.contacts = settle::<S, L>(o, frame, lists, lanes, &mut out.settled);
+    let surface = frame.surface_travel();
+    for l in 0..L {
+        let p = DVec3::new(
+            x[0][l] - from[0][l],
+            x[1][l] - from[1][l],
+            x[2][l] - from[2][l],
+        );
+        let half = 0.5 * r[l] - surface;
+        let short = half >= 0.0 && p.length_squared() <= half * half;
+        out.ring[l] = near[l] & !out.settled[l] & short;
+    }
+    for l in (0..L).filter(|&l| out.settled[l]) {
+        lists.last[j[l]] = DVec3::new(x[0][l], x[1][l], x[2][l]);
     }
     out
 }
@@ -208,11 +282,11 @@ fn in_ball<S: Simd, const L: usize>(
     o.bits::<L>(ok)
 }
 
-/// The lanes of a block that [`settle`] tests: the first's index `s` in the lists, positions
+/// The lanes of a block that [`settle`] tests: their particles `j` in the lists, positions
 /// `x` (moved in place), path starts `from`, substep starts `prev`, thicknesses `r`, and the
 /// faces of the `near` lanes (whose certificates hold and name a face).
 struct Lanes<'b, const L: usize> {
-    s: usize,
+    j: &'b [usize; L],
     x: &'b mut [[f64; L]; 3],
     from: &'b [[f64; L]; 3],
     prev: &'b [[f64; L]; 3],
@@ -301,8 +375,8 @@ fn settle<S: Simd, const L: usize>(
         }
         // Where it ends is still within the certificate's reach (a lane not pushed: 1).
         let certs = &lists.certs;
-        let anchor = anchors::<S, L>(&certs.anchor, b.s);
-        let reach = load_at::<S, L>(&certs.reach, b.s);
+        let anchor = gather3::<S, L>(&certs.anchor, b.j);
+        let reach = gather::<S, L>(&certs.reach, b.j);
         let slack = o.sub(o.sub(reach, o.c(g.travel)), rv);
         let e = o.dif(&moved, &anchor);
         within = o.sel(push, o.sub(o.mul(slack, slack), o.dot(&e, &e)), within);
@@ -327,14 +401,14 @@ fn settle<S: Simd, const L: usize>(
     let hover = o.and(done, o.le(depth, o.c(0.0)));
     if o.any(hover) {
         let certs = &lists.certs;
-        let e = o.dif(&xv, &anchors::<S, L>(&certs.anchor, b.s));
-        let reach = load_at::<S, L>(&certs.reach, b.s);
+        let e = o.dif(&xv, &gather3::<S, L>(&certs.anchor, b.j));
+        let reach = gather::<S, L>(&certs.reach, b.j);
         let far = o.sub(o.sub(reach, o.c(g.travel)), o.sqrt(o.dot(&e, &e)));
         let least = o.min(o.min(h, far), front);
         let room = store::<S, L>(o.sel(hover, o.sub(least, rv), o.c(0.0)));
         for l in (0..L).filter(|&l| room[l] > 0.0) {
             let at = DVec3::new(b.x[0][l], b.x[1][l], b.x[2][l]);
-            lists.certs.set_hover(b.s + l, at, room[l], g.travel);
+            lists.certs.set_hover(b.j[l], at, room[l], g.travel);
         }
     }
     let (done, pushed) = (o.bits::<L>(done), o.bits::<L>(pushed));
@@ -343,7 +417,7 @@ fn settle<S: Simd, const L: usize>(
     for l in 0..L {
         settled[l] |= done[l];
         if pushed[l] {
-            lists.hint[b.s + l] = b.face[l];
+            lists.hint[b.j[l]] = b.face[l];
             made.contacts += 1;
             made.depth = made.depth.max(depth[l]);
         }
@@ -464,6 +538,18 @@ fn anchors<S: Simd, const L: usize>(field: &[Vec<f64>], s: usize) -> V3<S> {
         load_at::<S, L>(&field[1], s),
         load_at::<S, L>(&field[2], s),
     ]
+}
+
+/// Lanes `j[l]` of `field`, as a vector.
+#[inline(always)]
+fn gather<S: Simd, const L: usize>(field: &[f64], j: &[usize; L]) -> S::f64s {
+    load::<S, L>(std::array::from_fn(|l| field[j[l]]))
+}
+
+/// Lanes `j[l]` of a field kept per axis, as vectors.
+#[inline(always)]
+fn gather3<S: Simd, const L: usize>(field: &[Vec<f64>; 3], j: &[usize; L]) -> V3<S> {
+    std::array::from_fn(|k| gather::<S, L>(&field[k], j))
 }
 
 /// `bits` as a mask of `S`.

@@ -31,7 +31,7 @@ use weft_solver::{Contacts, ParticleRun};
 
 use super::MeshGeometry;
 use super::candidates::{ChunkLists, MeshFrame, Outcome};
-use super::certified::certified;
+use super::certified::{certified, face_test, screen};
 use crate::friction::push_lanes;
 
 /// Particles per block of the lane test: eight f64, one AVX-512 register or two AVX2 ones.
@@ -56,9 +56,10 @@ impl MeshFrame<'_> {
 
 /// Every free particle of `run` (thickness `r`) against the mesh of `frame` (for which
 /// [`MeshFrame::lists_settle`] holds), through the run's candidate lists `lists` (indexed
-/// from the run's start): the certified test (`certified`) a block at a time, then the lane
-/// test and `MeshFrame::resolve` for each particle it left open. Compiled for the run's kernel
-/// path (every path gives the same bits).
+/// from the run's start): the certified test's screen (`screen`) a block at a time, its face
+/// test (`face_test`) on the particles the screen sends it packed into full blocks, then the
+/// lane test and `MeshFrame::resolve` for each particle they left open. Compiled for the run's
+/// kernel path (every path gives the same bits).
 pub(crate) fn resolve_list_run(
     frame: &MeshFrame<'_>,
     lists: &mut ChunkLists,
@@ -108,6 +109,11 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
     }
     let full = n - n % L;
     let mut total = Contacts::default();
+    // The screen a block at a time; the lanes it sends to the face test are queued, and
+    // tested packed into full blocks after (what a lane does depends on that particle
+    // alone, so not on which block it is tested in).
+    let mut queue = std::mem::take(&mut lists.queue);
+    queue.clear();
     for s in (0..full).step_by(L) {
         let (mut x, mut prev, mut rr) = ([[0.0; L]; 3], [[0.0; L]; 3], [0.0; L]);
         for k in 0..3 {
@@ -116,21 +122,39 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
         }
         rr.copy_from_slice(&r[s..s + L]);
         let live: [bool; L] = std::array::from_fn(|l| run.w[s + l] != 0.0);
-        let done = certified::<S, L>(o, frame, lists, s, (&mut x, &prev), (&rr, live));
-        total = total.merge(done.contacts);
-        for l in (0..L).filter(|&l| live[l] && !done.settled[l]) {
-            let at = |v: &[[f64; L]; 3]| DVec3::new(v[0][l], v[1][l], v[2][l]);
-            let mut p = at(&x);
-            let out = frame.open(lists, s + l, at(&prev), &mut p, (rr[l], done.ring[l]));
-            total = total.merge(out.into());
-            for k in 0..3 {
-                x[k][l] = p[k];
+        let screened = screen::<S, L>(o, frame, lists, s, (&x, &prev), (&rr, live));
+        queue.extend((0..L).filter(|&l| screened.near[l]).map(|l| s + l));
+        for l in 0..L {
+            if live[l] && !screened.settled[l] && !screened.near[l] {
+                let j = s + l;
+                total = total.merge(open_one(frame, lists, run, j, (r[j], false)));
             }
         }
-        for k in 0..3 {
-            run.x[k][s..s + L].copy_from_slice(&x[k]);
+    }
+    for block in queue.chunks(L) {
+        // A short block's spare lanes repeat its first particle and take no part.
+        let j: [usize; L] = std::array::from_fn(|l| block.get(l).copied().unwrap_or(block[0]));
+        let near: [bool; L] = std::array::from_fn(|l| l < block.len());
+        let (mut x, mut prev, mut rr) = ([[0.0; L]; 3], [[0.0; L]; 3], [0.0; L]);
+        for l in 0..L {
+            for k in 0..3 {
+                x[k][l] = run.x[k][j[l]];
+                prev[k][l] = run.prev[k][j[l]];
+            }
+            rr[l] = r[j[l]];
+        }
+        let done = face_test::<S, L>(o, frame, lists, &j, (&mut x, &prev), (&rr, near));
+        total = total.merge(done.contacts);
+        for l in (0..L).filter(|&l| near[l]) {
+            for k in 0..3 {
+                run.x[k][j[l]] = x[k][l];
+            }
+            if !done.settled[l] {
+                total = total.merge(open_one(frame, lists, run, j[l], (rr[l], done.ring[l])));
+            }
         }
     }
+    lists.queue = queue;
     for j in full..n {
         if run.w[j] == 0.0 {
             continue;
@@ -143,6 +167,25 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
         }
     }
     total
+}
+
+/// `MeshFrame::open` for particle `j` of `run` (thickness `r`, among its face's ring where
+/// `ring`), moving it in place.
+#[inline(always)]
+fn open_one(
+    frame: &MeshFrame<'_>,
+    lists: &mut ChunkLists,
+    run: &mut ParticleRun<'_>,
+    j: usize,
+    (r, ring): (f64, bool),
+) -> Contacts {
+    let mut p = DVec3::new(run.x[0][j], run.x[1][j], run.x[2][j]);
+    let prev = DVec3::new(run.prev[0][j], run.prev[1][j], run.prev[2][j]);
+    let out = frame.open(lists, j, prev, &mut p, (r, ring));
+    for k in 0..3 {
+        run.x[k][j] = p[k];
+    }
+    out.into()
 }
 
 /// A run none of whose particles the mesh certifies (`MeshFrame::certifies`): the lane test
@@ -211,7 +254,7 @@ impl MeshFrame<'_> {
         }
         let mut at = [[x.x], [x.y], [x.z]];
         let before = [[prev.x], [prev.y], [prev.z]];
-        let done = certified::<Scalar, 1>(
+        let done = certified::<Scalar>(
             Ops(Scalar),
             self,
             lists,
