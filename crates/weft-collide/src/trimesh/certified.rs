@@ -184,7 +184,7 @@ pub(crate) fn screen<S: Simd, const L: usize>(
 /// Where each lane's path starts: the substep's start `prev` on its first projection, else
 /// where the last left particle `j[l]`.
 #[inline(always)]
-fn path_starts<const L: usize>(
+pub(crate) fn path_starts<const L: usize>(
     frame: &MeshFrame<'_>,
     lists: &ChunkLists,
     j: &[usize; L],

@@ -31,7 +31,7 @@ use weft_solver::{Contacts, ParticleRun};
 
 use super::MeshGeometry;
 use super::candidates::{ChunkLists, MeshFrame, Outcome};
-use super::certified::{certified, face_test, screen};
+use super::certified::{certified, face_test, path_starts, screen};
 use crate::friction::push_lanes;
 
 /// Particles per block of the lane test: eight f64, one AVX-512 register or two AVX2 ones.
@@ -127,7 +127,9 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
         for l in 0..L {
             if live[l] && !screened.settled[l] && !screened.near[l] {
                 let j = s + l;
-                total = total.merge(open_one(frame, lists, run, j, (r[j], false)));
+                total = total.merge(on_particle(run, j, |prev, p| {
+                    frame.open(lists, j, prev, p, (r[j], false)).into()
+                }));
             }
         }
     }
@@ -150,7 +152,11 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
                 run.x[k][j[l]] = x[k][l];
             }
             if !done.settled[l] {
-                total = total.merge(open_one(frame, lists, run, j[l], (rr[l], done.ring[l])));
+                total = total.merge(on_particle(run, j[l], |prev, p| {
+                    frame
+                        .open(lists, j[l], prev, p, (rr[l], done.ring[l]))
+                        .into()
+                }));
             }
         }
     }
@@ -159,33 +165,27 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
         if run.w[j] == 0.0 {
             continue;
         }
-        let mut p = DVec3::new(run.x[0][j], run.x[1][j], run.x[2][j]);
-        let before = DVec3::new(run.prev[0][j], run.prev[1][j], run.prev[2][j]);
-        total = total.merge(frame.resolve_listed(lists, j, before, &mut p, r[j]).into());
-        for k in 0..3 {
-            run.x[k][j] = p[k];
-        }
+        total = total.merge(on_particle(run, j, |prev, p| {
+            frame.resolve_listed(lists, j, prev, p, r[j]).into()
+        }));
     }
     total
 }
 
-/// `MeshFrame::open` for particle `j` of `run` (thickness `r`, among its face's ring where
-/// `ring`), moving it in place.
+/// `f` on particle `j` of `run`: its substep start, and its position, moved in place.
 #[inline(always)]
-fn open_one(
-    frame: &MeshFrame<'_>,
-    lists: &mut ChunkLists,
+fn on_particle(
     run: &mut ParticleRun<'_>,
     j: usize,
-    (r, ring): (f64, bool),
+    f: impl FnOnce(DVec3, &mut DVec3) -> Contacts,
 ) -> Contacts {
     let mut p = DVec3::new(run.x[0][j], run.x[1][j], run.x[2][j]);
     let prev = DVec3::new(run.prev[0][j], run.prev[1][j], run.prev[2][j]);
-    let out = frame.open(lists, j, prev, &mut p, (r, ring));
+    let made = f(prev, &mut p);
     for k in 0..3 {
         run.x[k][j] = p[k];
     }
-    out.into()
+    made
 }
 
 /// A run none of whose particles the mesh certifies (`MeshFrame::certifies`): the lane test
@@ -329,18 +329,12 @@ fn lanes<const L: usize>(
     (x, prev): (&mut [[f64; L]; 3], &[[f64; L]; 3]),
     (rr, live): (&[f64; L], [bool; L]),
 ) -> Contacts {
-    let mut from = *prev;
+    let from = path_starts::<L>(frame, lists, &std::array::from_fn(|l| s + l), prev);
     // Done: the list holds and is empty. Near: the list holds and is not, the path is short
     // and the particle was outside: the hint's test follows. Open: `resolve`.
     let (mut done, mut near, mut open) = ([false; L], [false; L], [false; L]);
     let mut stale = [false; L];
     for l in 0..L {
-        if !frame.fresh {
-            let f = lists.last[s + l];
-            for k in 0..3 {
-                from[k][l] = f[k];
-            }
-        }
         let lane = Lane::of(frame, lists, s + l, (x, &from, rr[l]), l);
         stale[l] = live[l] & !lane.valid;
         done[l] = live[l] & lane.valid & lane.empty & lane.outside;
