@@ -188,8 +188,8 @@ impl Collider {
                 expected: "a triangle mesh",
             });
         };
-        let mut now = mesh.rest.clone();
-        animation.vertices_at(0.0, &mesh.rest, &mut now);
+        let mut now = mesh.rest().to_vec();
+        animation.vertices_at(0.0, mesh.rest(), &mut now);
         if !now.iter().all(|v| v.is_finite()) {
             return Err(ShapeError::InvalidParameter {
                 name: "deforming mesh vertices at t = 0",
@@ -213,7 +213,7 @@ impl Collider {
     /// A triangle mesh's vertices at the end of the current substep, in the collider's frame,
     /// in the order of its `TriangleMesh` (for drawing a deforming mesh); `None` for others.
     pub fn mesh_vertices(&self) -> Option<&[DVec3]> {
-        self.mesh.as_ref().map(|m| &m.end[..])
+        self.mesh.as_ref().map(|m| m.vertices())
     }
 
     /// The triangle-mesh geometry, for the world's contacts.
@@ -298,9 +298,9 @@ impl Collider {
             if frame_end != end || !(start..end).contains(&t0) {
                 self.frame = (t0, frame_end);
                 let next = &mut self.next_vertices;
-                animation.vertices_at(frame_end, &mesh.rest, next);
+                animation.vertices_at(frame_end, mesh.rest(), next);
                 if !next.iter().all(|v| v.is_finite()) {
-                    next.copy_from_slice(&mesh.end); // a bad frame: hold the last good one
+                    next.copy_from_slice(mesh.vertices()); // a bad frame: hold the last good one
                 }
                 mesh.begin_frame(next);
             }
@@ -627,7 +627,7 @@ mod tests {
         };
         let desc = ColliderDesc::new(ShapeDesc::TriMesh(TriangleMesh::icosphere(0.5, 1)));
         let mut c = Collider::deforming(&desc, Arc::new(grow)).expect("deforming mesh");
-        let rest = c.mesh().expect("a mesh").rest.clone();
+        let rest = c.mesh().expect("a mesh").rest().to_vec();
         let (frames, substeps, dt) = (3, 4, 0.1);
         calls.store(0, Relaxed);
         for f in 0..frames {

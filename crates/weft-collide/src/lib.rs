@@ -1,13 +1,40 @@
 //! Weft's collisions: colliders (static, kinematic or deforming triangle meshes), kinematic
 //! bodies of round cones (animated characters, [`body`]), Coulomb friction and particle
 //! self-collision, plugged into the solver's substeps as a [`weft_solver::SubstepHook`]
-//! ([`CollisionWorld`]).
+//! ([`CollisionWorld`]). The crate uses the solver's public API only; its explicit-vector
+//! kernels build on `weft-simd`.
+//!
+//! The crate's modules:
+//!
+//! - `world`: the collision world, the solver's hook, and the contacts of a run of particles.
+//! - `collider`: a parry shape with a pose that follows a prescribed motion, and friction.
+//! - `shape`: collider shapes as descriptions in f64, and their parry shapes in f32.
+//! - `mesh`: triangle meshes, and the checks that make them safe to collide with.
+//! - `surface`: the answer of a closest-point query.
+//! - `convert`: the one seam between weft's types and parry's.
+//! - `analytic`: spheres, half-spaces, cuboids and capsules in closed form in f64.
+//! - `closed_run`: a still half-space or ball against a run of particles, a block at a time.
+//! - `reach`: which particles a collider can touch in one projection.
+//! - `trimesh`: particle–triangle-mesh contact for still, moving and deforming meshes.
+//! - `run_lists`: meshes' candidate lists kept per run of particles of the fused frame.
+//! - `chunk`: the fixed split of the particles into parallel tasks.
+//! - `friction`: Coulomb friction for position-based contacts.
+//! - `body`: kinematic bodies of round cones (an animated character's limbs).
+//! - `self_collision`: particle–particle self-collision (and between cloths) with friction.
+//! - `grid`: points sorted by grid cell, for close pairs and neighbour searches.
+//! - `obj`: a tiny Wavefront OBJ reader.
+//! - `tessellate`: colliders as triangle meshes for drawing.
+//! - `scenarios`: scenes as code, sized by parameter, for benches, examples and tests.
+//! - `error`: the crate's errors.
+//! - `analytic_vs_parry` (tests only): the closed-form queries against parry's answers.
+//! - `test_rand` (tests only): a deterministic pseudo-random source for the tests.
 #![warn(missing_docs)]
 
 mod analytic;
 #[cfg(test)]
 mod analytic_vs_parry;
 pub mod body;
+mod chunk;
 mod closed_run;
 mod collider;
 mod convert;

@@ -5,7 +5,7 @@
 
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use crate::trimesh::candidates::ChunkLists;
+use crate::trimesh::chunk_lists::ChunkLists;
 
 /// One run's lists: one [`ChunkLists`] per mesh with lists, indexed from the run's start.
 type Lists = Arc<Mutex<Vec<ChunkLists>>>;

@@ -2,9 +2,9 @@
 
 use glam::DVec3;
 
-use crate::domains::SimdPath;
 use crate::method::Method;
 use crate::particles::Particles;
+use weft_simd::SimdPath;
 
 /// Where in the step loop a hook is being called.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,9 +1,37 @@
 //! Weft's cloth solver.
 //!
 //! One particle store ([`Particles`], struct-of-arrays), one coloured constraint set and one
-//! substep loop ([`Solver::step_with`]) serve three methods ([`Method`]): XPBD, PBD and
-//! mass-spring. Cloths come from grid or triangle-mesh builders; collisions plug in through
-//! [`SubstepHook`]. The crate knows nothing of files, windows or rendering.
+//! substep loop ([`Solver::step_with`]) serve four methods ([`Method`]): XPBD, PBD, explicit
+//! mass-spring and implicit mass-spring. Cloths come from grid or triangle-mesh builders;
+//! collisions plug in through [`SubstepHook`]. The crate knows nothing of files, windows or
+//! rendering. The kernel paths and lane operations come from `weft-simd`.
+//!
+//! The crate's modules:
+//!
+//! - `particles`: the particle store, struct-of-arrays state shared by every method.
+//! - `cloth`: cloth geometry before it enters a solver: a triangle mesh with masses and pins.
+//! - `grid`: rectangular grid cloths: resolution, size, placement, mass and pins.
+//! - `topology`: unique edges and the wing vertices across each interior edge.
+//! - `params`: constraint families and their per-method parameters, with their range checks.
+//! - `material`: fabrics in physical units, and the parameters every method derives from them.
+//! - `presets`: fabric presets from published Kawabata (KES-F) measurements.
+//! - `spring_defaults`: spring constants scaled to the cloth, stable for the explicit springs.
+//! - `stability`: the explicit springs' highest mode and the largest stable substep.
+//! - `coloring`: greedy graph colouring of the constraints.
+//! - `constraints`: the constraint set, its shapes, blocks and lane kernels.
+//! - `domains`: domain decomposition of the distance constraints for parallel SIMD sweeps.
+//! - `method`: the four methods and the strategy each plugs into the step loop.
+//! - `methods`: one small strategy per method, and the `Strategy` trait.
+//! - `forces`: gravity, wind, aerodynamics and damping.
+//! - `motion`: prescribed rigid motions for kinematic pins (and colliders elsewhere).
+//! - `driver`: driven pins, placed by something outside the solver at every substep.
+//! - `chunk`: the task size of the per-particle parallel loops.
+//! - `solver`: the [`Solver`] and its step loop, fused and general.
+//! - `builder`: [`SolverBuilder`], which assembles cloths, constraints and pins into a solver.
+//! - `settings`: time stepping settings.
+//! - `hook`: the seam through which collisions act inside each substep.
+//! - `error`: the crate's errors.
+//! - `test_rand` (tests only): a seeded random source for unit tests.
 #![warn(missing_docs)]
 
 mod builder;
@@ -17,7 +45,6 @@ mod error;
 mod forces;
 mod grid;
 mod hook;
-pub mod lane_ops;
 mod material;
 mod method;
 mod methods;
@@ -36,7 +63,7 @@ mod topology;
 pub use builder::SolverBuilder;
 pub use cloth::{ClothMesh, Mass};
 pub use constraints::Residual;
-pub use domains::{DomainStats, SIMD_ENV, SimdPath, UnknownSimdPath};
+pub use domains::DomainStats;
 pub use driver::PinDriver;
 pub use error::{BuildError, MeshError, ParamError, SolverError};
 pub use forces::{Aero, Forces, Wind};
@@ -53,6 +80,7 @@ pub use solver::{Cloth, Solver, StepStats};
 pub use spring_defaults::{DEFAULT_SPRING_HW, DEFAULT_SPRING_SUBSTEP, stable_spring_defaults};
 pub use stability::StabilityBound;
 pub use topology::{EdgeWings, Topology};
+pub use weft_simd::{SIMD_ENV, SimdPath, UnknownSimdPath};
 
 /// Re-export of the math library, so users share our `DVec3`.
 pub use glam;

@@ -3,12 +3,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use glam::DVec3;
-
-use crate::constraints::{ConstraintSet, Rule};
-use crate::methods::{ImplicitMassSpring, MassSpring, Pbd, Xpbd};
-use crate::params::FamilyParams;
-use crate::particles::Particles;
+use crate::methods::{ImplicitMassSpring, MassSpring, Pbd, Strategy, Xpbd};
 
 /// A simulation method; all four share one particle store, constraint set and step loop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -89,33 +84,4 @@ impl FromStr for Method {
             .find(|m| m.name() == s || (s == "implicit" && *m == Method::ImplicitMassSpring))
             .ok_or_else(|| UnknownMethod(s.to_owned()))
     }
-}
-
-/// What distinguishes one method inside the shared substep loop.
-pub(crate) trait Strategy: Sync {
-    /// Adds internal (constraint) accelerations for substep `h` before integration, on top of
-    /// the external ones in `accel`; `force` is scratch.
-    fn add_internal_forces(
-        &self,
-        _constraints: &ConstraintSet,
-        _particles: &Particles,
-        _params: &[FamilyParams],
-        _h: f64,
-        _force: &mut [DVec3],
-        _accel: &mut [DVec3],
-    ) {
-    }
-
-    /// Whether [`Strategy::add_internal_forces`] adds anything (the mass-spring methods); without
-    /// internal forces the general loop computes the external accelerations inside its
-    /// integration pass.
-    fn has_internal_forces(&self) -> bool {
-        false
-    }
-
-    /// Starts a substep.
-    fn begin_substep(&self, _constraints: &mut ConstraintSet) {}
-
-    /// How constraints are projected with substep `h`, or `None` when they are not projected.
-    fn rule(&self, h: f64) -> Option<Rule>;
 }

@@ -2,9 +2,9 @@
 
 use glam::DVec3;
 
-use crate::domains::SimdPath;
 use crate::error::ParamError;
 use crate::method::Method;
+use weft_simd::SimdPath;
 
 /// Whether position `x` is finite with no coordinate beyond `bound` in magnitude (the
 /// divergence check, see [`Settings::divergence_bound`]). No branch: NaN fails `<=`, and an

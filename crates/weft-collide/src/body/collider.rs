@@ -10,8 +10,8 @@ use super::contact::{Plane, planes, project, sweep};
 use super::grid::PartGrid;
 use super::motion::MovingPart;
 use super::{BodyPart, KinematicBody};
+use crate::chunk::{CHUNK, moving_views};
 use crate::friction::Friction;
-use crate::world::{CHUNK, moving_views};
 
 /// Preferred edge of the broad phase's cells (m): a few limb radii.
 const CELL: f64 = 0.05;

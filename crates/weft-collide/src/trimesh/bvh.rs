@@ -3,24 +3,11 @@
 
 use glam::DVec3;
 
+use super::bvh_node::Node;
 use super::wide_bvh::WideBvh;
 
 /// Triangles per leaf at most.
 const LEAF: usize = 4;
-
-/// A node: its box and either two children (`count == 0`: nodes `first` and `first + 1`) or
-/// a leaf's primitives `first .. first + count`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Node {
-    /// Minimum corner.
-    pub lo: DVec3,
-    /// Maximum corner.
-    pub hi: DVec3,
-    /// First child, or first primitive of a leaf.
-    pub first: u32,
-    /// Primitives of a leaf; 0 for an inner node.
-    pub count: u32,
-}
 
 /// The hierarchy, root first; every child comes after its parent.
 #[derive(Clone, Debug, Default)]
@@ -101,7 +88,7 @@ impl Bvh {
             scratch: Vec::new(),
             scratch_motions: Vec::new(),
         };
-        bvh.wide = WideBvh::of(&bvh);
+        bvh.wide = WideBvh::of(&bvh.nodes);
         let stored: Vec<(DVec3, DVec3)> = order.iter().map(|&i| boxes[i as usize]).collect();
         bvh.refit(|i| stored[i]);
         (bvh, order)
@@ -136,7 +123,7 @@ impl Bvh {
             node.hi = hi;
         }
         let mut wide = std::mem::take(&mut self.wide);
-        wide.refit(self);
+        wide.refit(&self.nodes);
         self.wide = wide;
     }
 

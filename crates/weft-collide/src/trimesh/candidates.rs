@@ -18,31 +18,17 @@
 
 use glam::DVec3;
 
+use super::MeshPoint;
 use super::closest::Closest;
-use super::{MeshGeometry, MeshPoint};
 #[cfg(test)]
 #[path = "candidates_tests.rs"]
 mod tests;
 use super::bvh::box_distance_squared;
 use super::ccd::{Crossing, moving_crossing, segment_crossing};
-use super::certificate::Certificates;
+use super::chunk_lists::ChunkLists;
 use super::closest::closest_on_triangle;
+use super::frame::{GUARD, MeshFrame, Outcome, ROUNDS, RunParticle, SKIN};
 use super::riding::Riding;
-use crate::analytic::WorldPose;
-use crate::friction::Friction;
-use weft_solver::Contacts;
-
-/// Skin of a list, as a fraction of the particle's thickness r: lists are built with radius
-/// r (1 + SKIN) beyond the particle's own substep path.
-pub(crate) const SKIN: f64 = 0.5;
-
-/// Width of a riding list's guard and reach (`riding`) beyond the list's radius, as a
-/// fraction of the particle's thickness r.
-pub(crate) const GUARD: f64 = 1.0;
-
-/// Pushes per particle and projection (a push out of one face may land in another, in a
-/// concave corner).
-pub(crate) const ROUNDS: usize = 3;
 
 /// Triangles near enough to a contact to be checked again after its push, at most.
 const NEAR: usize = 16;
@@ -54,208 +40,7 @@ const SCAN_BLOCK: usize = 32;
 /// and that feature's pseudo-normal (or its opposite) that tells which side it is on.
 const SIDED: f64 = 0.5;
 
-/// The candidate lists of one mesh collider for one chunk of particles.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct ChunkLists {
-    /// Where each particle was when its list was built (collider frame).
-    pub(super) anchor: Vec<DVec3>,
-    /// The list holds every triangle within this distance of the anchor; NaN: no list.
-    pub(super) radius: Vec<f64>,
-    /// The surface's travel bound before the substep of the build.
-    pub(super) travel: Vec<f64>,
-    /// How far the nearest triangle lay from the anchor at the build, at most (infinite:
-    /// not known).
-    nearest: Vec<f64>,
-    /// Whether the anchor was inside the closed mesh.
-    pub(super) inside: Vec<bool>,
-    /// The particle's position after the last projection (collider frame, end pose).
-    pub(super) last: Vec<DVec3>,
-    /// The triangle each particle touched last (tested first: it tightens the search), or
-    /// `u32::MAX`.
-    pub(super) hint: Vec<u32>,
-    /// Each particle's list: `tris[start .. start + len]`.
-    pub(super) range: Vec<(u32, u32)>,
-    /// On a deforming mesh, the length of each list's guard (the unlisted triangles its
-    /// riding certificate bounds), stored after it: `tris[start + len ..][.. guard]`.
-    guard: Vec<u32>,
-    /// On a deforming mesh, each list's riding certificate.
-    riding: Vec<Riding>,
-    /// The last frame in which a riding certificate was made for a list of the chunk (0:
-    /// none): where that is not the current frame, no certificate of the chunk holds, and
-    /// none is read.
-    riding_frame: u64,
-    /// A build's guard, before it joins the arena.
-    scratch: Vec<u32>,
-    /// The lists, end to end; rebuilt lists are appended and the arena compacted when half
-    /// of it is stale.
-    pub(super) tris: Vec<u32>,
-    /// Entries in use.
-    live: usize,
-    /// The arena's spare buffer, for compaction.
-    spare: Vec<u32>,
-    /// Lists built so far.
-    pub builds: u64,
-    /// Each particle's certificate (`certified`).
-    pub(crate) certs: Certificates,
-    /// The block test's queue of particles for the face test (`list_run`), kept between
-    /// runs for its allocation.
-    pub(super) queue: Vec<usize>,
-}
-
-impl ChunkLists {
-    /// Lists for `n` particles, all to be built.
-    pub fn new(n: usize) -> Self {
-        Self {
-            anchor: vec![DVec3::ZERO; n],
-            radius: vec![f64::NAN; n],
-            travel: vec![0.0; n],
-            nearest: vec![f64::INFINITY; n],
-            inside: vec![false; n],
-            last: vec![DVec3::ZERO; n],
-            hint: vec![u32::MAX; n],
-            range: vec![(0, 0); n],
-            guard: vec![0; n],
-            riding: vec![Riding::NONE; n],
-            riding_frame: 0,
-            scratch: Vec::new(),
-            tris: Vec::new(),
-            live: 0,
-            spare: Vec::new(),
-            builds: 0,
-            certs: Certificates::new(n),
-            queue: Vec::new(),
-        }
-    }
-
-    /// Triangles listed (guards included), over all particles of the chunk.
-    pub fn entries(&self) -> usize {
-        self.live
-    }
-
-    /// [`Self::compact`] once half the arena (or more) is stale.
-    pub fn tidy(&mut self) {
-        if self.tris.len() > 2 * self.live + 64 {
-            self.compact();
-        }
-    }
-
-    /// Drops stale entries and puts the lists back in particle order (the contact loop then
-    /// reads the arena front to back).
-    pub fn compact(&mut self) {
-        if self.tris.len() == self.live {
-            return;
-        }
-        let mut fresh = std::mem::take(&mut self.spare);
-        fresh.clear();
-        for (r, &guard) in self.range.iter_mut().zip(&self.guard) {
-            let s = fresh.len() as u32;
-            fresh.extend_from_slice(&self.tris[r.0 as usize..(r.0 + r.1 + guard) as usize]);
-            *r = (s, r.1);
-        }
-        self.spare = std::mem::replace(&mut self.tris, fresh);
-    }
-}
-
-/// One mesh collider as seen by every particle in one projection.
-pub(crate) struct MeshFrame<'a> {
-    /// The surface.
-    pub geometry: &'a MeshGeometry,
-    /// Collider pose at the end of the substep.
-    pub pose: &'a WorldPose,
-    /// Collider pose at its start.
-    pub prev_pose: &'a WorldPose,
-    /// Both poses are the identity: positions are used as they are.
-    pub identity: bool,
-    /// The pose did not change over the substep.
-    pub still: bool,
-    /// First projection of the substep: the path starts at the previous position, and the
-    /// surface moves along it.
-    pub fresh: bool,
-    /// Coulomb friction of the collider.
-    pub friction: Friction,
-}
-
-#[cfg(test)]
-impl<'a> MeshFrame<'a> {
-    /// A mesh at rest at `pose`, seen in a substep's first projection.
-    pub(crate) fn still(g: &'a MeshGeometry, pose: &'a WorldPose, friction: Friction) -> Self {
-        Self {
-            geometry: g,
-            pose,
-            prev_pose: pose,
-            identity: true,
-            still: true,
-            fresh: true,
-            friction,
-        }
-    }
-}
-
-/// What one particle's contacts with one mesh did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct Outcome {
-    /// Pushes resolved.
-    pub contacts: usize,
-    /// Deepest overlap with the thickness shell (m).
-    pub depth: f64,
-    /// Crossings stopped.
-    pub swept: usize,
-}
-
-impl From<Outcome> for Contacts {
-    fn from(o: Outcome) -> Self {
-        Self {
-            contacts: o.contacts,
-            swept: o.swept,
-            depth: o.depth,
-        }
-    }
-}
-
-impl From<Contacts> for Outcome {
-    fn from(c: Contacts) -> Self {
-        Self {
-            contacts: c.contacts,
-            depth: c.depth,
-            swept: c.swept,
-        }
-    }
-}
-
 impl MeshFrame<'_> {
-    pub(super) fn to_local(&self, pose: &WorldPose, x: DVec3) -> DVec3 {
-        if self.identity {
-            x
-        } else {
-            pose.inverse_transform_point(x)
-        }
-    }
-
-    pub(super) fn to_world_vector(&self, v: DVec3) -> DVec3 {
-        if self.identity {
-            v
-        } else {
-            self.pose.rotation * v
-        }
-    }
-
-    /// How far the material point with barycentric weights `bary` on triangle `t` moved over
-    /// the substep, in world space; exactly zero for a still surface.
-    pub(super) fn surface_displacement(&self, t: usize, bary: [f64; 3]) -> DVec3 {
-        let g = self.geometry;
-        if self.still && !g.moving {
-            return DVec3::ZERO;
-        }
-        let tri = g.triangles[t];
-        let at = |v: &[DVec3]| (0..3).fold(DVec3::ZERO, |s, k| s + v[tri[k] as usize] * bary[k]);
-        let (end, start) = (at(&g.end), at(&g.start));
-        if self.identity {
-            end - start
-        } else {
-            self.pose.transform_point(end) - self.prev_pose.transform_point(start)
-        }
-    }
-
     /// Whether particle `j`'s list holds every triangle within `r` of `x` and of the path
     /// `from → x` (local): by its bound on the whole mesh's travel, or by its riding
     /// certificate.
@@ -456,14 +241,14 @@ impl MeshFrame<'_> {
     /// Particle `j` (thickness `r`, previous position `prev`, current `x`, world space):
     /// stops a crossing of the surface on the side it came from, then pushes it to distance r
     /// from the surface with Coulomb friction against the surface's motion.
-    pub fn resolve(
-        &self,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        r: f64,
-    ) -> Outcome {
+    pub fn resolve(&self, p: RunParticle<'_>) -> Outcome {
+        let RunParticle {
+            lists,
+            j,
+            prev,
+            x,
+            r,
+        } = p;
         let g = self.geometry;
         let mut out = Outcome::default();
         let (mut xl, from) = self.local_path(*x, prev, || lists.last[j]);

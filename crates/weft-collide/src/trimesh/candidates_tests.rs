@@ -2,6 +2,7 @@
 //! particle order with no stale entry. A particle's contact rounds: they stop early only where
 //! no triangle is within the thickness.
 
+use crate::trimesh::frame::RunParticle;
 use glam::{DQuat, DVec3};
 
 use super::{ChunkLists, MeshFrame, ROUNDS};
@@ -45,7 +46,7 @@ fn compaction_keeps_the_lists_in_particle_order() {
         for (j, xj) in x.iter_mut().enumerate() {
             let prev = *xj;
             *xj += rng.cube(0.006);
-            frame.resolve(&mut lists, j, prev, xj, r);
+            frame.resolve(RunParticle::new(&mut lists, j, prev, xj, r));
         }
         let before = lists_of(&lists);
         stale += lists.tris.len() - lists.live;
@@ -99,7 +100,7 @@ fn rounds_stop_early_only_clear_of_every_triangle() {
             let prev = *xj;
             // A small step: down towards the centre (gravity-like) and sideways.
             *xj += -*xj * 0.02 + rng.cube(0.004);
-            let out = frame.resolve(&mut lists, j, prev, xj, r);
+            let out = frame.resolve(RunParticle::new(&mut lists, j, prev, xj, r));
             pushed += usize::from(out.contacts > 0);
             if out.contacts < ROUNDS {
                 early += 1;

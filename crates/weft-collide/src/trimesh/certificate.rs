@@ -24,14 +24,9 @@ use glam::DVec3;
 
 use super::MeshGeometry;
 use super::bvh::box_distance_squared;
-use super::candidates::{ChunkLists, MeshFrame, Outcome, ROUNDS};
+use super::chunk_lists::{CLEAR, ChunkLists, NO_FACE};
 use super::closest::{Closest, Feature, closest_on_triangle};
-
-/// A certificate's face where no triangle lay within ψ: the particle is clear.
-pub(crate) const CLEAR: u32 = u32::MAX;
-
-/// A certificate's face where none could be made: the particle goes to the lists.
-pub(crate) const NO_FACE: u32 = u32::MAX - 1;
+use super::frame::{MeshFrame, Outcome, ROUNDS, RunParticle};
 
 /// How far a certificate's search reaches beyond the particle's thickness r, as a fraction of
 /// it (the certificate's skin; 1.0–5.0 were tried on the breathing ball, 2.0–2.5 fastest).
@@ -46,77 +41,6 @@ const CLEAR_REACH: f64 = 6.0;
 /// How far a particle with no certificate moves (a fraction of its thickness, with the
 /// surface's travel) before another is tried.
 const BACKOFF: f64 = 0.5;
-
-/// The certificates of one chunk (or run) of particles, per particle, in struct-of-arrays
-/// (the block test loads each field of a block's lanes as one vector).
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Certificates {
-    /// The anchors, per axis.
-    pub(super) anchor: [Vec<f64>; 3],
-    /// ψ plus the surface's travel bound before the substep of the build (NaN: none).
-    pub(super) reach: Vec<f64>,
-    /// The face, [`CLEAR`] or [`NO_FACE`].
-    pub(super) face: Vec<u32>,
-    /// For a clear certificate, the nearest triangle its search found ([`NO_FACE`]: none
-    /// within its reach): where the next certificate looks first.
-    pub(super) near: Vec<u32>,
-    /// A clear ball the block test found about a particle hovering over its face: its centre
-    /// per axis, then its radius less r plus the surface's travel bound when it was found
-    /// (NaN: none). No triangle was within r plus that radius of the centre.
-    pub(super) hover: [Vec<f64>; 4],
-    /// Certificates made so far.
-    pub builds: u64,
-}
-
-impl Certificates {
-    /// Certificates for `n` particles, none made.
-    pub fn new(n: usize) -> Self {
-        Self {
-            anchor: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
-            reach: vec![f64::NAN; n],
-            face: vec![NO_FACE; n],
-            near: vec![NO_FACE; n],
-            hover: [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![f64::NAN; n]],
-            builds: 0,
-        }
-    }
-
-    /// Particle `j`'s anchor.
-    #[inline]
-    pub(super) fn anchor_of(&self, j: usize) -> DVec3 {
-        DVec3::new(self.anchor[0][j], self.anchor[1][j], self.anchor[2][j])
-    }
-
-    /// Sets particle `j`'s certificate (and drops its hover ball): anchor, reach, face and,
-    /// for a clear one, the nearest triangle found.
-    fn set(&mut self, j: usize, anchor: DVec3, reach: f64, (face, near): (u32, u32)) {
-        for k in 0..3 {
-            self.anchor[k][j] = anchor[k];
-        }
-        self.reach[j] = reach;
-        self.face[j] = face;
-        self.near[j] = near;
-        self.hover[3][j] = f64::NAN;
-    }
-
-    /// Whether particle `j`'s certificate still covers a particle of thickness `r` at `x`
-    /// (the mesh's frame) with the surface's travel bound now `travel`: every triangle off
-    /// its face's ring (every triangle, if clear) at least r away.
-    #[inline]
-    pub(super) fn covers(&self, j: usize, x: DVec3, (r, travel): (f64, f64)) -> bool {
-        let slack = self.reach[j] - travel - r;
-        slack >= 0.0 && (x - self.anchor_of(j)).length_squared() <= slack * slack
-    }
-
-    /// Sets particle `j`'s hover ball: about `centre`, no triangle within r + `room` at the
-    /// surface's travel bound `travel`.
-    pub(super) fn set_hover(&mut self, j: usize, centre: DVec3, room: f64, travel: f64) {
-        for k in 0..3 {
-            self.hover[k][j] = centre[k];
-        }
-        self.hover[3][j] = room * (1.0 - 1e-9) + travel;
-    }
-}
 
 impl MeshFrame<'_> {
     /// Whether certificates are worth keeping for particles of thickness `r` on this mesh:
@@ -194,14 +118,14 @@ impl MeshFrame<'_> {
     /// `MeshFrame::resolve` makes them (the nearest within r pushed out, with friction, up
     /// to [`ROUNDS`] times). `None`, with `x` as it was, where the pushes carried it out of
     /// its certificate's reach (the lists follow).
-    pub(crate) fn resolve_ring(
-        &self,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        r: f64,
-    ) -> Option<Outcome> {
+    pub(crate) fn resolve_ring(&self, p: RunParticle<'_>) -> Option<Outcome> {
+        let RunParticle {
+            lists,
+            j,
+            prev,
+            x,
+            r,
+        } = p;
         let g = self.geometry;
         let face = lists.certs.face[j] as usize;
         let (mut xl, from) = self.local_path(*x, prev, || lists.last[j]);

@@ -38,13 +38,14 @@
 
 use glam::DVec3;
 use pulp::Simd;
+use weft_simd::{Ops, V3, load, load_at, load3, store};
 use weft_solver::Contacts;
-use weft_solver::lane_ops::{Ops, V3, load, load_at, load3, store};
 
 use super::MeshGeometry;
-use super::candidates::{ChunkLists, MeshFrame};
-use super::certificate::{CLEAR, Certificates, NO_FACE};
+use super::chunk_lists::ChunkLists;
+use super::chunk_lists::{CLEAR, Certificates, NO_FACE};
 use super::convexity::UNUSABLE;
+use super::frame::MeshFrame;
 use super::grid_lanes::push_vectors;
 
 /// Projections nearer than this (barycentric) to an edge of the face are left to the ring.

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::MeshGeometry;
 use super::closest::closest_on_triangle;
-use super::grid_run::FaceCert;
+use super::face_cert::FaceCert;
 
 /// Cells of a grid at most (a 16 MB offset table); coarser cells beyond.
 const MAX_CELLS: usize = 1 << 22;

@@ -10,8 +10,9 @@ use crate::analytic_vs_parry::Rng;
 use crate::friction::Friction;
 use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
-use crate::trimesh::candidates::{ChunkLists, MeshFrame, ROUNDS};
+use crate::trimesh::chunk_lists::ChunkLists;
 use crate::trimesh::closest::closest_on_triangle;
+use crate::trimesh::frame::{MeshFrame, ROUNDS, RunParticle};
 use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
 
@@ -187,7 +188,7 @@ fn grid_matches_lists(m: &TriangleMesh, seed: u64) {
             let (pa, pb) = (a[j], b[j]);
             a[j] += drift;
             b[j] += drift;
-            let oa = frame.resolve(&mut lists, j, pa, &mut a[j], r);
+            let oa = frame.resolve(RunParticle::new(&mut lists, j, pa, &mut a[j], r));
             let ob = frame.resolve_in_grid((&grid, &state), j, pb, &mut b[j], r);
             if ob.contacts < ROUNDS {
                 let d = (0..g.face_count())

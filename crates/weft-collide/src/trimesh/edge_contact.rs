@@ -27,9 +27,9 @@
 use glam::DVec3;
 
 use super::MeshPoint;
-use super::candidates::{ChunkLists, MeshFrame, Outcome};
 use super::closest::{Closest, Feature};
 use super::convexity::UNUSABLE;
+use super::frame::{MeshFrame, Outcome, RunParticle};
 use super::normals::NONE;
 
 /// How far inside the wedge's sides, and within the edge's ends (as fractions of the face's
@@ -61,14 +61,14 @@ impl MeshFrame<'_> {
     /// certificate holds with a face on a short path and which the block test left to the
     /// ring, by the edge of its face it lies over (see the module's notes), as
     /// [`MeshFrame::resolve_ring`] would; `None`, with `x` as it was, where it cannot.
-    pub(crate) fn edge_contact(
-        &self,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        r: f64,
-    ) -> Option<Outcome> {
+    pub(crate) fn edge_contact(&self, p: RunParticle<'_>) -> Option<Outcome> {
+        let RunParticle {
+            lists,
+            j,
+            prev,
+            x,
+            r,
+        } = p;
         let g = self.geometry;
         let f = lists.certs.face[j] as usize;
         if f >= g.face_count() || g.fronts.count[f] == UNUSABLE {
@@ -219,7 +219,8 @@ mod tests {
     use crate::analytic::WorldPose;
     use crate::friction::Friction;
     use crate::trimesh::MeshGeometry;
-    use crate::trimesh::candidates::{ChunkLists, MeshFrame};
+    use crate::trimesh::chunk_lists::ChunkLists;
+    use crate::trimesh::frame::{MeshFrame, RunParticle};
 
     /// Thickness (m).
     const R: f64 = 0.02;
@@ -289,9 +290,15 @@ mod tests {
             let x0 = over(d);
             let prev = x0 + DVec3::new(0.0, 0.2 * R, 0.0);
             let (mut x, mut by_resolve) = (x0, x0);
-            frame.resolve(&mut ChunkLists::new(1), 0, prev, &mut by_resolve, R);
+            frame.resolve(RunParticle::new(
+                &mut ChunkLists::new(1),
+                0,
+                prev,
+                &mut by_resolve,
+                R,
+            ));
             let mut lists = certified_at(f, x0);
-            let out = frame.edge_contact(&mut lists, 0, prev, &mut x, R);
+            let out = frame.edge_contact(RunParticle::new(&mut lists, 0, prev, &mut x, R));
             let case = format!("{d} r over the ridge, the flap {under} m under F");
             assert_eq!(out.is_some(), settles, "{case}");
             if settles {
@@ -330,7 +337,7 @@ mod tests {
             let x0 = DVec3::new(a.sin() * 0.5 * R, a.cos() * 0.5 * R, z);
             let mut x = x0;
             let mut lists = certified_at(f, x0);
-            let out = frame.edge_contact(&mut lists, 0, x0, &mut x, R);
+            let out = frame.edge_contact(RunParticle::new(&mut lists, 0, x0, &mut x, R));
             assert_eq!(out.is_some(), settles, "{degrees}° at z = {z}");
         }
     }
@@ -350,9 +357,15 @@ mod tests {
             assert!(g.fronts.count[f] > 0, "the fin in front of F");
             let frame = MeshFrame::still(&g, &pose, Friction::NONE);
             let (mut x, mut by_resolve) = (x0, x0);
-            frame.resolve(&mut ChunkLists::new(1), 0, x0, &mut by_resolve, R);
+            frame.resolve(RunParticle::new(
+                &mut ChunkLists::new(1),
+                0,
+                x0,
+                &mut by_resolve,
+                R,
+            ));
             let mut lists = certified_at(f, x0);
-            let out = frame.edge_contact(&mut lists, 0, x0, &mut x, R);
+            let out = frame.edge_contact(RunParticle::new(&mut lists, 0, x0, &mut x, R));
             assert_eq!(out.is_some(), settles, "fin's tip {tip} above");
             if settles {
                 assert!(

@@ -11,8 +11,8 @@
 use glam::DVec3;
 use pulp::Simd;
 use rayon::prelude::*;
-use weft_solver::SimdPath;
-use weft_solver::lane_ops::{LaneKernel, Ops, V3, load3, on_path, store, store3};
+use weft_simd::SimdPath;
+use weft_simd::{LaneKernel, Ops, V3, load3, on_path, store, store3};
 
 use super::Planes;
 use super::normals::face_normal;

@@ -5,14 +5,16 @@
 use std::sync::atomic::{AtomicU8, AtomicU32, AtomicU64, Ordering::Relaxed};
 
 use glam::DVec3;
-use pulp::Scalar;
-use weft_solver::lane_ops::Ops;
+use pulp::{Scalar, Simd};
+use weft_simd::{Ops, V3, load, store};
+use weft_solver::Contacts;
 
 use super::MeshPoint;
-use super::candidates::{MeshFrame, Outcome, ROUNDS};
 use super::closest::{Feature, closest_on_triangle};
 use super::contact_grid::{ContactGrid, Side};
-use super::grid_run::{Placement, Settled, first_test};
+use super::face_cert::{FaceCert, Placement, Settled};
+use super::frame::{MeshFrame, Outcome, ROUNDS};
+use super::grid_lanes::{Lanes, Verdict, gather, local, settle, world};
 use super::normals::NONE;
 
 /// Triangles a particle's contact walks across from the one it touched last, at most.
@@ -461,5 +463,105 @@ impl GridParticles {
                 )
             })
             .collect()
+    }
+}
+
+/// A block after its first test: positions in the world's frame and the mesh's, path starts
+/// (mesh's frame) and what the test did per lane.
+pub(crate) struct Tested<const L: usize> {
+    /// Positions in the world's frame (moved where pushed).
+    pub world: [[f64; L]; 3],
+    /// Positions in the mesh's frame.
+    pub local: [[f64; L]; 3],
+    /// Path starts in the mesh's frame.
+    pub from: [[f64; L]; 3],
+    /// What the test did per lane.
+    pub verdict: Verdict<L>,
+}
+
+impl<const L: usize> Tested<L> {
+    /// Lane `l`'s position in the world's frame.
+    #[inline(always)]
+    pub fn world_at(&self, l: usize) -> DVec3 {
+        DVec3::new(self.world[0][l], self.world[1][l], self.world[2][l])
+    }
+
+    /// Lane `l`'s position in the mesh's frame.
+    #[inline(always)]
+    pub fn local_at(&self, l: usize) -> DVec3 {
+        DVec3::new(self.local[0][l], self.local[1][l], self.local[2][l])
+    }
+
+    /// Lane `l`'s path start in the mesh's frame.
+    #[inline(always)]
+    pub fn path_start(&self, l: usize) -> DVec3 {
+        DVec3::new(self.from[0][l], self.from[1][l], self.from[2][l])
+    }
+}
+
+/// The first test of particles `i0 .. i0 + L` (global indices, `L` the f64 lanes of `S`) at
+/// world positions `wx`, at `wp` at the substep's start, thickness `r`, taking part where
+/// `live`, against the triangles they touched last, with the mesh of `frame` still over the
+/// substep ([`settle`]). A block whose every live path lies in its clear ball reads no
+/// triangle. The block path and the one-particle path test alike through this.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn first_test<S: Simd, const L: usize>(
+    o: Ops<S>,
+    frame: &MeshFrame<'_>,
+    (certs, state): (&[FaceCert], &GridParticles),
+    place: &Placement,
+    (wx, wp): (&V3<S>, &V3<S>),
+    r: S::f64s,
+    live: S::m64s,
+    i0: usize,
+) -> Tested<L> {
+    debug_assert_eq!(L, S::F64_LANES);
+    let x = local(o, place, wx);
+    let prev = local(o, place, wp);
+    let from = if frame.fresh {
+        prev
+    } else {
+        let last: [DVec3; L] = std::array::from_fn(|l| state.last(i0 + l));
+        std::array::from_fn(|k| load::<S, L>(last.map(|p| p[k])))
+    };
+    let balls: [(DVec3, f64); L] = std::array::from_fn(|l| state.ball(i0 + l));
+    let t: [usize; L] = std::array::from_fn(|l| state.hint(i0 + l) as usize);
+    let mut b = Lanes::<S> {
+        x,
+        from,
+        prev,
+        r,
+        live,
+        anchor: std::array::from_fn(|k| load::<S, L>(balls.map(|(c, _)| c[k]))),
+        ball: load::<S, L>(balls.map(|(_, radius)| radius)),
+    };
+    let in_ball = b.in_ball(o);
+    let (verdict, moved) = if o.any(o.and(live, o.not(in_ball))) {
+        let f = gather::<S, L>(certs, t);
+        let (verdict, push) = settle::<S, L>(o, &mut b, in_ball, &f, frame.friction);
+        let moved = if o.any(push) {
+            world(o, place, wx, &x, &b.x, push)
+        } else {
+            *wx
+        };
+        (verdict, moved)
+    } else {
+        // Nothing within r of any path: no triangle to read.
+        let settled = o
+            .bits::<L>(live)
+            .map(|l| if l { Settled::Done } else { Settled::Open });
+        let verdict = Verdict {
+            settled,
+            new_ball: [f64::NAN; L],
+            contacts: Contacts::default(),
+        };
+        (verdict, *wx)
+    };
+    Tested {
+        world: moved.map(store::<S, L>),
+        local: b.x.map(store::<S, L>),
+        from: b.from.map(store::<S, L>),
+        verdict,
     }
 }

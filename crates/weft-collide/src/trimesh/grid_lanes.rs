@@ -12,10 +12,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use pulp::Simd;
+use weft_simd::{Ops, V3, load, store};
 use weft_solver::Contacts;
-use weft_solver::lane_ops::{Ops, V3, load, store};
 
-use super::grid_run::{A, CLEAR, FIELDS, FaceCert, INSIDE, N, Placement, Settled, U, V};
+use super::face_cert::{A, CLEAR, FIELDS, FaceCert, INSIDE, N, Placement, Settled, U, V};
 use crate::friction::Friction;
 
 /// The lanes of a block, in the mesh's frame, and the triangles they touched last.

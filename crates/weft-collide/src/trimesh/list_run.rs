@@ -26,12 +26,13 @@
 
 use glam::DVec3;
 use pulp::{Scalar, Simd};
-use weft_solver::lane_ops::{LaneKernel, Ops, on_path};
+use weft_simd::{LaneKernel, Ops, on_path};
 use weft_solver::{Contacts, ParticleRun};
 
 use super::MeshGeometry;
-use super::candidates::{ChunkLists, MeshFrame, Outcome};
 use super::certified::{certified, face_test, path_starts, screen};
+use super::chunk_lists::ChunkLists;
+use super::frame::{MeshFrame, Outcome, RunParticle};
 use crate::friction::push_lanes;
 
 /// Particles per block of the lane test: eight f64, one AVX-512 register or two AVX2 ones.
@@ -128,7 +129,9 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
             if live[l] && !screened.settled[l] && !screened.near[l] {
                 let j = s + l;
                 total = total.merge(on_particle(run, j, |prev, p| {
-                    frame.open(lists, j, prev, p, (r[j], false)).into()
+                    frame
+                        .open(RunParticle::new(lists, j, prev, p, r[j]), false)
+                        .into()
                 }));
             }
         }
@@ -154,7 +157,7 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
             if !done.settled[l] {
                 total = total.merge(on_particle(run, j[l], |prev, p| {
                     frame
-                        .open(lists, j[l], prev, p, (rr[l], done.ring[l]))
+                        .open(RunParticle::new(lists, j[l], prev, p, rr[l]), done.ring[l])
                         .into()
                 }));
             }
@@ -166,7 +169,9 @@ fn run_blocks<S: Simd, const L: usize>(o: Ops<S>, b: Blocks<'_, '_, '_, '_>) -> 
             continue;
         }
         total = total.merge(on_particle(run, j, |prev, p| {
-            frame.resolve_listed(lists, j, prev, p, r[j]).into()
+            frame
+                .resolve_listed(RunParticle::new(lists, j, prev, p, r[j]))
+                .into()
         }));
     }
     total
@@ -241,16 +246,16 @@ impl MeshFrame<'_> {
     /// run of one: the certified test and the lane test where [`Self::lists_settle`] holds,
     /// else `resolve`. Every particle of a mesh with lists takes this path or a block of the
     /// same tests, so its bits do not depend on which.
-    pub(crate) fn resolve_listed(
-        &self,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        r: f64,
-    ) -> Outcome {
+    pub(crate) fn resolve_listed(&self, p: RunParticle<'_>) -> Outcome {
+        let RunParticle {
+            lists,
+            j,
+            prev,
+            x,
+            r,
+        } = p;
         if !self.lists_settle() {
-            return self.resolve(lists, j, prev, x, r);
+            return self.resolve(RunParticle::new(lists, j, prev, x, r));
         }
         let mut at = [[x.x], [x.y], [x.z]];
         let before = [[prev.x], [prev.y], [prev.z]];
@@ -266,32 +271,32 @@ impl MeshFrame<'_> {
         if done.settled[0] {
             return done.contacts.into();
         }
-        let out = self.open(lists, j, prev, x, (r, done.ring[0]));
+        let out = self.open(RunParticle::new(lists, j, prev, x, r), done.ring[0]);
         Contacts::from(out).merge(done.contacts).into()
     }
 
     /// Particle `j` left open by the certified test: among its face's ring where its
     /// certificate allows (`ring`), else through the lists; a new certificate where it has
     /// come to rest on another face.
-    fn open(
-        &self,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        (r, ring): (f64, bool),
-    ) -> Outcome {
+    fn open(&self, p: RunParticle<'_>, ring: bool) -> Outcome {
+        let RunParticle {
+            lists,
+            j,
+            prev,
+            x,
+            r,
+        } = p;
         // Over a convex edge of its face by that edge, else among the face's ring, else
         // through the lists.
         let settled = if ring {
-            (self.edge_contact(lists, j, prev, x, r))
-                .or_else(|| self.resolve_ring(lists, j, prev, x, r))
+            (self.edge_contact(RunParticle::new(lists, j, prev, x, r)))
+                .or_else(|| self.resolve_ring(RunParticle::new(lists, j, prev, x, r)))
         } else {
             None
         };
         let out = match settled {
             Some(out) => out,
-            None => self.listed(lists, j, prev, x, r),
+            None => self.listed(RunParticle::new(lists, j, prev, x, r)),
         };
         // As a run none of whose particles the mesh certifies would (`lane_blocks`).
         if self.certifies(r) {
@@ -302,14 +307,14 @@ impl MeshFrame<'_> {
 
     /// Particle `j` through its lists: the lane test as a run of one, then `resolve` where it
     /// leaves it open.
-    fn listed(
-        &self,
-        lists: &mut ChunkLists,
-        j: usize,
-        prev: DVec3,
-        x: &mut DVec3,
-        r: f64,
-    ) -> Outcome {
+    fn listed(&self, p: RunParticle<'_>) -> Outcome {
+        let RunParticle {
+            lists,
+            j,
+            prev,
+            x,
+            r,
+        } = p;
         let mut at = [[x.x], [x.y], [x.z]];
         let before = [[prev.x], [prev.y], [prev.z]];
         let total = lanes::<1>(self, lists, j, (&mut at, &before), (&[r], [true]));
@@ -371,7 +376,7 @@ fn lanes<const L: usize>(
         } else if open[l] {
             let mut p = DVec3::new(x[0][l], x[1][l], x[2][l]);
             let before = DVec3::new(prev[0][l], prev[1][l], prev[2][l]);
-            let out = frame.resolve(lists, j, before, &mut p, rr[l]);
+            let out = frame.resolve(RunParticle::new(lists, j, before, &mut p, rr[l]));
             for k in 0..3 {
                 x[k][l] = p[k];
             }

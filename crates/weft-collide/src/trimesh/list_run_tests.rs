@@ -11,7 +11,8 @@ use crate::analytic_vs_parry::Rng;
 use crate::friction::Friction;
 use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
-use crate::trimesh::candidates::{ChunkLists, MeshFrame};
+use crate::trimesh::chunk_lists::ChunkLists;
+use crate::trimesh::frame::{MeshFrame, RunParticle};
 use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
 use crate::trimesh::{certified, edge_contact};
@@ -158,7 +159,7 @@ fn run_matches(m: &TriangleMesh, case: (u64, bool, bool), path: SimdPath) {
         let mut expected = Contacts::default();
         for j in 0..n {
             if w[j] != 0.0 {
-                let o = frame.resolve_listed(&mut one, j, prev[j], &mut a[j], R);
+                let o = frame.resolve_listed(RunParticle::new(&mut one, j, prev[j], &mut a[j], R));
                 expected = expected.merge(o.into());
             }
         }
@@ -223,9 +224,9 @@ fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) 
         let mut contacts = 0;
         for j in (0..n).filter(|j| j % 11 != 0) {
             contacts += frame
-                .resolve_listed(&mut with_test, j, prev[j], &mut a[j], R)
+                .resolve_listed(RunParticle::new(&mut with_test, j, prev[j], &mut a[j], R))
                 .contacts;
-            frame.resolve(&mut alone, j, prev[j], &mut b[j], R);
+            frame.resolve(RunParticle::new(&mut alone, j, prev[j], &mut b[j], R));
             worst = worst.max((a[j] - b[j]).length());
             tested += 1;
         }
@@ -322,8 +323,8 @@ fn a_push_beyond_the_certificate_is_left_to_the_ring() {
     let (mut with_test, mut alone) = (ChunkLists::new(1), ChunkLists::new(1));
     let prev = DVec3::new(0.1, 0.5 * R, 0.05);
     let (mut a, mut b) = (prev, prev);
-    frame.resolve_listed(&mut with_test, 0, prev, &mut a, R);
-    frame.resolve(&mut alone, 0, prev, &mut b, R);
+    frame.resolve_listed(RunParticle::new(&mut with_test, 0, prev, &mut a, R));
+    frame.resolve(RunParticle::new(&mut alone, 0, prev, &mut b, R));
     assert_eq!(
         with_test.certs.face[0] as usize,
         g.nearest(prev, 1.0).expect("near").triangle
@@ -365,9 +366,9 @@ fn a_surface_travelling_towards_a_certified_particle_lapses_its_certificate() {
             a -= DVec3::Y * 1e-4;
             b -= DVec3::Y * 1e-4;
             certified::SETTLED.with(|c| c.set([0; 3]));
-            frame.resolve_listed(&mut with_test, 0, prev, &mut a, R);
+            frame.resolve_listed(RunParticle::new(&mut with_test, 0, prev, &mut a, R));
             certified += certified::SETTLED.with(|c| c.get()).iter().sum::<usize>();
-            frame.resolve(&mut alone, 0, prev, &mut b, R);
+            frame.resolve(RunParticle::new(&mut alone, 0, prev, &mut b, R));
             assert!(
                 (a - b).length() <= 1e-12,
                 "frame {frame_no}, substep {sub}: {a} against {b}"

@@ -1,20 +1,49 @@
-//! Particle–triangle-mesh contact in closed form and in f64: the closest point on a triangle
-//! (`closest`), pseudo-normals that tell inside from outside (`normals`), a flat BVH that is
-//! refitted when the mesh deforms (`bvh`), continuous collision against still and moving
-//! triangles (`ccd`), per-particle candidate lists kept with a skin (`candidates`) and the
-//! vertex animations that drive deforming meshes (`deforming`).
+//! Particle–triangle-mesh contact in closed form and in f64, for still, moving and deforming
+//! meshes. This file holds the mesh as contact reads it (`MeshGeometry`: faces, their f32
+//! `Planes`, a deforming mesh's frame); its modules hold the rest:
+//!
+//! - `closest`: the closest point of a triangle to a point (Ericson).
+//! - `normals`: the mesh's topology and pseudo-normals that tell inside from outside.
+//! - `bvh_node`: a node of the binary bounding-volume hierarchy.
+//! - `bvh`: a flat BVH in f64, built once and refitted when the mesh deforms.
+//! - `wide_bvh`: the BVH's four-wide f32 copy for nearest-first searches.
+//! - `ccd`: continuous collision of a moving point with a still or moving triangle.
+//! - `deforming`: what drives a deforming mesh (vertex animations, keyframes).
+//! - `face_update`: a moving mesh's face normals every substep and planes every frame.
+//! - `convexity`: each face's one-ring, and the ring triangles that may come in front of it.
+//! - `frame`: one mesh as every particle sees it in one projection (`MeshFrame`).
+//! - `chunk_lists`: what a mesh keeps per particle of a chunk: lists and certificates.
+//! - `candidates`: per-particle candidate lists kept with a skin, and contacts through them.
+//! - `riding`: a list's certificate that rides with a deforming surface.
+//! - `certificate`: a particle's certificate: a face, how far the other triangles lie.
+//! - `certified`: the block test certificates allow, in explicit vectors.
+//! - `edge_contact`: contacts over a convex edge of a certificate's face.
+//! - `list_run`: a run of particles against their candidate lists, a block at a time.
+//! - `contact_grid`: a still mesh's uniform grid of cell lists, sides and clearances.
+//! - `face_cert`: what the grid's first test reads of one triangle, and what it decides.
+//! - `grid_lanes`: that first test over `L` lanes in explicit vectors.
+//! - `grid_run`: a run of particles' first test on a still mesh's grid, a block at a time.
+//! - `grid_contacts`: contacts through the grid, and the little each particle keeps.
+//! - `open_side_tests` (tests only): an open surface keeps a particle on its side.
+//! - `queries_vs_brute_force` (tests only): the BVH queries against brute force.
+//! - `vs_parry` (tests only): the mesh queries against brute force and parry.
+//! - `test_particles` (tests only): particles about a mesh for the block paths' tests.
 
 pub(crate) mod bvh;
+pub(crate) mod bvh_node;
 pub(crate) mod candidates;
 pub(crate) mod ccd;
 pub(crate) mod certificate;
 pub(crate) mod certified;
+pub(crate) mod chunk_lists;
 pub(crate) mod closest;
 pub(crate) mod contact_grid;
 pub(crate) mod convexity;
 pub(crate) mod deforming;
 pub(crate) mod edge_contact;
+pub(crate) mod face_cert;
 pub(crate) mod face_update;
+pub(crate) mod frame;
 pub(crate) mod grid_contacts;
 pub(crate) mod grid_lanes;
 pub(crate) mod grid_run;
@@ -120,39 +149,39 @@ pub(crate) struct MeshPoint {
 #[derive(Clone, Debug)]
 pub(crate) struct MeshGeometry {
     /// Triangles in BVH storage order.
-    pub triangles: Vec<[u32; 3]>,
+    triangles: Vec<[u32; 3]>,
     /// Rest vertices (m), as given.
-    pub rest: Vec<DVec3>,
+    rest: Vec<DVec3>,
     /// Vertices at the start of the substep.
-    pub start: Vec<DVec3>,
+    start: Vec<DVec3>,
     /// Vertices at the end of the substep: the current surface.
-    pub end: Vec<DVec3>,
+    end: Vec<DVec3>,
     /// The faces' unit normals at the end of the substep, in storage order (their corners
     /// are `end`'s: [`Self::face`]).
-    pub normals: Vec<DVec3>,
+    normals: Vec<DVec3>,
     /// Their bounding planes, apart (a scan reads only these for most triangles).
-    pub planes: Vec<Planes>,
+    planes: Vec<Planes>,
     /// The f32 rounding bound of [`Planes::distance_squared_bound`] near the mesh (m).
-    pub margin: f32,
+    margin: f32,
     /// The largest vertex coordinate, in absolute value (m).
-    pub extent: f64,
+    extent: f64,
     /// Adjacency and closedness.
-    pub topology: Topology,
+    topology: Topology,
     /// Each face's one-ring.
-    pub rings: Rings,
+    rings: Rings,
     /// Per face, the ring triangles that may come in front of its plane over the current
     /// frame (over the mesh's life while it is still).
-    pub fronts: Fronts,
+    fronts: Fronts,
     /// How far the farthest-moving vertex moves over the current frame (m).
-    pub frame_reach: f64,
+    frame_reach: f64,
     /// Boxes of the triangles over the substep (start and end).
-    pub bvh: Bvh,
+    bvh: Bvh,
     /// A bound on how far any vertex moved, summed over the substeps so far (m).
-    pub travel: f64,
+    travel: f64,
     /// The bound before the current substep.
-    pub travel_before: f64,
+    travel_before: f64,
     /// Whether the vertices moved in the current substep.
-    pub moving: bool,
+    moving: bool,
     /// A deforming mesh's frame: its vertices at the frame's start and end, between which
     /// they move linearly over the frame's substeps (empty until the first frame).
     frame: (Vec<DVec3>, Vec<DVec3>),
@@ -163,12 +192,22 @@ pub(crate) struct MeshGeometry {
     /// planes are the frame end's, so every bound on them is this much less.
     slack: f64,
     /// The frame begun last, counted from 1 (0: none yet).
-    pub frame_id: u64,
+    frame_id: u64,
     /// Where in that frame the current substep starts and ends (fractions, 0 to 1).
-    pub frame_span: (f64, f64),
+    frame_span: (f64, f64),
 }
 
 impl MeshGeometry {
+    /// The rest vertices (m), as given.
+    pub fn rest(&self) -> &[DVec3] {
+        &self.rest
+    }
+
+    /// The vertices at the end of the substep: the current surface (m).
+    pub fn vertices(&self) -> &[DVec3] {
+        &self.end
+    }
+
     /// Builds the geometry of `vertices` and `triangles` (already validated).
     pub fn new(vertices: &[DVec3], triangles: &[[u32; 3]]) -> Self {
         let boxes: Vec<(DVec3, DVec3)> = triangles

@@ -8,9 +8,10 @@ use crate::analytic_vs_parry::Rng;
 use crate::friction::Friction;
 use crate::mesh::TriangleMesh;
 use crate::trimesh::MeshGeometry;
-use crate::trimesh::candidates::{ChunkLists, MeshFrame};
 use crate::trimesh::ccd::segment_crossing;
+use crate::trimesh::chunk_lists::ChunkLists;
 use crate::trimesh::contact_grid::ContactGrid;
+use crate::trimesh::frame::{MeshFrame, RunParticle};
 use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::test_particles::under;
 use crate::trimesh::vs_parry::bumpy_sheet;
@@ -45,7 +46,9 @@ fn crossed(m: &TriangleMesh, path: Path, seed: u64, depth: f64, side: f64) -> us
     let mut step = |from: &[DVec3], mut x: Vec<DVec3>| -> Vec<DVec3> {
         for j in 0..N {
             match path {
-                Path::Lists => frame.resolve(&mut lists, j, from[j], &mut x[j], R),
+                Path::Lists => {
+                    frame.resolve(RunParticle::new(&mut lists, j, from[j], &mut x[j], R))
+                }
                 Path::Grid => frame.resolve_in_grid((&grid, &state), j, from[j], &mut x[j], R),
             };
         }

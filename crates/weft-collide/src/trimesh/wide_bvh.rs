@@ -1,11 +1,11 @@
-//! A four-wide copy of a [`Bvh`] for nearest-first searches: each node holds its four
-//! children's boxes in f32, rounded outwards, axis by axis, so one pass of four-lane
+//! A four-wide copy of a binary hierarchy ([`super::bvh`]) for nearest-first searches: each
+//! node holds its four children's boxes in f32, rounded outwards, axis by axis, so one pass of four-lane
 //! arithmetic bounds the distance to all four; the binary tree stays the authority (it is
 //! built and refitted, and this copy follows it).
 
 use glam::{DVec3, Vec4};
 
-use super::bvh::Bvh;
+use super::bvh_node::Node;
 
 /// Children of a node: four boxes per node, a third of the binary tree's nodes to visit.
 const WIDTH: usize = 4;
@@ -97,31 +97,31 @@ impl WideBvh {
     /// The four-wide copy of `bvh`'s shape: each node takes up to four of the binary tree's
     /// nodes below it, opening the inner one with most primitives first. Its boxes are set by
     /// [`Self::refit`] (`Bvh::build` refits at once).
-    pub fn of(bvh: &Bvh) -> Self {
+    pub fn of(nodes: &[Node]) -> Self {
         let mut wide = Self::default();
-        if bvh.nodes.is_empty() {
+        if nodes.is_empty() {
             return wide;
         }
-        wide.push(bvh, 0);
+        wide.push(nodes, 0);
         wide
     }
 
     /// Adds the node covering binary node `n` (and, below it, its subtree); returns its index.
-    fn push(&mut self, bvh: &Bvh, n: usize) -> u32 {
-        let node = bvh.nodes[n];
+    fn push(&mut self, nodes: &[Node], n: usize) -> u32 {
+        let node = nodes[n];
         let mut children: Vec<usize> = if node.count > 0 {
             vec![n]
         } else {
             vec![node.first as usize, node.first as usize + 1]
         };
-        let size = |c: usize| Self::primitives(bvh, c);
+        let size = |c: usize| Self::primitives(nodes, c);
         while children.len() < WIDTH {
             // The inner child with most primitives, the first of equals.
             let open = (0..children.len())
-                .filter(|&k| bvh.nodes[children[k]].count == 0)
+                .filter(|&k| nodes[children[k]].count == 0)
                 .max_by(|&a, &b| size(children[a]).cmp(&size(children[b])).then(b.cmp(&a)));
             let Some(k) = open else { break };
-            let first = bvh.nodes[children[k]].first as usize;
+            let first = nodes[children[k]].first as usize;
             children.splice(k..=k, [first, first + 1]);
         }
         let index = self.nodes.len();
@@ -133,13 +133,13 @@ impl WideBvh {
         });
         self.source.push([u32::MAX; WIDTH]);
         for (k, &c) in children.iter().enumerate() {
-            let child = bvh.nodes[c];
+            let child = nodes[c];
             self.source[index][k] = c as u32;
             if child.count > 0 {
                 self.nodes[index].at[k] = child.first;
                 self.nodes[index].count[k] = child.count;
             } else {
-                let below = self.push(bvh, c);
+                let below = self.push(nodes, c);
                 self.nodes[index].at[k] = below;
                 self.nodes[index].count[k] = 0;
             }
@@ -148,25 +148,25 @@ impl WideBvh {
     }
 
     /// Primitives below binary node `n`.
-    fn primitives(bvh: &Bvh, n: usize) -> usize {
-        let node = bvh.nodes[n];
+    fn primitives(nodes: &[Node], n: usize) -> usize {
+        let node = nodes[n];
         if node.count > 0 {
             node.count as usize
         } else {
-            Self::primitives(bvh, node.first as usize)
-                + Self::primitives(bvh, node.first as usize + 1)
+            Self::primitives(nodes, node.first as usize)
+                + Self::primitives(nodes, node.first as usize + 1)
         }
     }
 
     /// Copies the binary tree's boxes (after its own refit), rounded outwards.
-    pub fn refit(&mut self, bvh: &Bvh) {
+    pub fn refit(&mut self, nodes: &[Node]) {
         for (node, source) in self.nodes.iter_mut().zip(&self.source) {
             // Per axis and child, each side's f64 bound (a child with no source keeps its
             // box: the f64 infinities round to themselves).
             let mut lo = [[0.0f64; WIDTH]; 3];
             let mut hi = [[0.0f64; WIDTH]; 3];
             for (k, &s) in source.iter().enumerate() {
-                let b = bvh.nodes.get(s as usize);
+                let b = nodes.get(s as usize);
                 for a in 0..3 {
                     lo[a][k] = b.map_or(f64::from(node.lo[a][k]), |b| b.lo[a]);
                     hi[a][k] = b.map_or(f64::from(node.hi[a][k]), |b| b.hi[a]);
@@ -358,7 +358,7 @@ impl WideBvh {
 mod tests {
     use super::*;
     use crate::test_rand::rand;
-    use crate::trimesh::bvh::box_distance_squared;
+    use crate::trimesh::bvh::{Bvh, box_distance_squared};
 
     /// Random small boxes in a 2 m cube, off the f32 grid.
     fn boxes(n: usize, s: &mut u64) -> Vec<(DVec3, DVec3)> {

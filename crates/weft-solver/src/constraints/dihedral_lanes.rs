@@ -23,8 +23,8 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use pulp::Simd;
 
 use super::lanes::Coefs;
-use super::quad_sweep::Quads;
-use crate::lane_ops::{Ops, V3, load, store};
+use super::lanes::Quads;
+use weft_simd::{Ops, V3, load, store};
 
 /// tan(3π/8).
 const TAN_3PI_8: f64 = 2.414_213_562_373_095;

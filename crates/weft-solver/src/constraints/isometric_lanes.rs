@@ -10,8 +10,8 @@
 use pulp::{Scalar, Simd};
 
 use super::lanes::Coefs;
-use super::quad_sweep::Quads;
-use crate::lane_ops::{load, store};
+use super::lanes::Quads;
+use weft_simd::{load, store};
 
 /// Projects `L` independent isometric-bending constraints in place, `L` being the f64 lanes
 /// of `S`: the vector constraint C = v = Σᵢ kᵢ xᵢ, one row per axis with the same gradient

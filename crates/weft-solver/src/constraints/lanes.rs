@@ -19,6 +19,10 @@ use crate::params::FamilyParams;
 /// Constraints per SIMD chunk (8 × f32: one AVX2 register, two SSE2 or NEON ones).
 pub(crate) const LANES: usize = 8;
 
+/// Positions of the four particles of `L` constraints, `[particle][axis][lane]`, in the
+/// order `[wing_a, wing_b, edge_0, edge_1]` of [`Dihedral`] and [`Isometric`].
+pub(crate) type Quads<const L: usize> = [[[f64; L]; 3]; 4];
+
 /// Per-group coefficients of the unified multiplier step (see [`project`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Coef {

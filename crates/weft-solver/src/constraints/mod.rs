@@ -1,4 +1,22 @@
 //! The constraint set: every cloth's constraints, coloured, in one block per shape.
+//!
+//! The module's parts:
+//!
+//! - `distance`: the distance constraint C = |p₀ − p₁| − d.
+//! - `dihedral`: dihedral bending, C = θ − θ₀ across an interior edge.
+//! - `isometric`: isometric bending, C = |Σᵢ kᵢ xᵢ| over an interior edge's four vertices.
+//! - `tether`: long-range attachment, active only when stretched.
+//! - `seam`: a seam whose rest length ramps to zero over a closing time, then holds.
+//! - `block`: a coloured struct-of-arrays block of one shape and its projection.
+//! - `linear`: springs linearised at the current state, for implicit mass-spring.
+//! - `lanes`: the distance projection over `L` lanes at once.
+//! - `dihedral_lanes`: the dihedral projection over `L` lanes in explicit vectors.
+//! - `isometric_lanes`: the isometric projection over `L` lanes in explicit vectors.
+//! - `quad_lanes`: the four-particle shapes' lane kernels as one interface, with their frame
+//!   constants.
+//! - `quad_sweep`: the symmetric Gauss–Seidel sweep of a four-particle block through its lane
+//!   kernel.
+//! - `parts`: contiguous particle ranges that let one colour be projected in parallel.
 
 mod block;
 mod dihedral;
@@ -9,6 +27,7 @@ mod isometric_lanes;
 pub(crate) mod lanes;
 mod linear;
 mod parts;
+mod quad_lanes;
 mod quad_sweep;
 mod seam;
 mod tether;
@@ -23,10 +42,10 @@ pub use tether::Tether;
 
 use glam::DVec3;
 
-pub(crate) use quad_sweep::FrameConstants;
+pub(crate) use quad_lanes::FrameConstants;
 
-use crate::domains::SimdPath;
 use crate::params::FamilyParams;
+use weft_simd::SimdPath;
 
 /// A constraint function C(p) over `N` particles with its gradient.
 pub trait Shape<const N: usize>: Copy + Send + Sync {

@@ -10,12 +10,10 @@ use glam::DVec3;
 use multiversion::multiversion;
 
 use super::layout::Chunk;
-use super::simd::SimdPath;
-use super::sweep::sweep;
-use crate::constraints::lanes::Coef;
 use crate::forces::Forces;
 use crate::hook::{Contacts, ParticleContacts, ParticleRun};
 use crate::settings::within_bound;
+use weft_simd::SimdPath;
 
 /// Distance constraints as struct-of-arrays; rest lengths and multipliers in f32, the lane
 /// type of the domain sweep (see `sweep`).
@@ -299,11 +297,6 @@ impl Domain {
             path: self.path,
         };
         contacts.resolve_run(run, fresh)
-    }
-
-    /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
-    pub fn project(&mut self, coef: &[Coef], mode: Mode) {
-        sweep(self, coef, mode);
     }
 }
 

@@ -20,12 +20,11 @@
 //! [`order`] (colouring and chunking of a domain's constraints), [`layout`] (how a chunk's
 //! lanes reach their particles), [`sweep`] (the Gauss–Seidel sweep over a domain's chunks),
 //! [`tree`] (the fork–join tree and the links between domains) and [`team`] (the threads that
-//! stay together for a fused frame).
+//! stay together for a fused frame); `tests` (test builds only) holds their unit tests.
 
 mod domain;
 mod layout;
 mod order;
-mod simd;
 mod sweep;
 mod team;
 #[cfg(test)]
@@ -40,11 +39,11 @@ use rayon::prelude::*;
 use crate::constraints::lanes::{Coef, LANES};
 use crate::constraints::{Block, Distance, Rule};
 use crate::params::FamilyParams;
+use weft_simd::SimdPath;
 
 pub(crate) use domain::{AosChunk, Domain, Finish, Integration, Mode, Start};
 use layout::Layout;
 use order::Interior;
-pub use simd::{SIMD_ENV, SimdPath, UnknownSimdPath};
 use tree::{Job, LinkSet, fork, tree_node};
 
 /// How a solver's distance constraints are laid out for the parallel SIMD solve.

@@ -11,12 +11,19 @@ use multiversion::multiversion;
 
 use super::domain::{Domain, Mode, Pairs, Rebased};
 use super::layout::{ALL_LIVE, Chunk, Layout, layout_of, load_ends, store_ends, window_fits};
-use super::simd::SimdPath;
 use crate::constraints::lanes::{self, Coef, Coefs, Ends, LANES};
+use weft_simd::SimdPath;
+
+impl Domain {
+    /// One Gauss–Seidel sweep over the interior constraints, colour by colour.
+    pub fn project(&mut self, coef: &[Coef], mode: Mode) {
+        sweep(self, coef, mode);
+    }
+}
 
 /// [`Domain::project`] on the domain's kernel path (see [`SimdPath`]; every path does the same
 /// IEEE operations, so results depend neither on the CPU nor on the path).
-pub(super) fn sweep(dom: &mut Domain, coef: &[Coef], mode: Mode) {
+fn sweep(dom: &mut Domain, coef: &[Coef], mode: Mode) {
     match dom.path {
         SimdPath::Avx512 => sweep_avx512(dom, coef, mode),
         SimdPath::Avx2 => sweep_avx2(dom, coef, mode),

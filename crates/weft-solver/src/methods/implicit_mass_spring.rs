@@ -16,8 +16,8 @@
 
 use glam::DVec3;
 
+use super::Strategy;
 use crate::constraints::{ConstraintSet, Rule, Springs};
-use crate::method::Strategy;
 use crate::params::FamilyParams;
 use crate::particles::Particles;
 

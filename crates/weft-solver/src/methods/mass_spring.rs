@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
+use super::Strategy;
 use crate::constraints::{ConstraintSet, Rule};
-use crate::method::Strategy;
 use crate::params::FamilyParams;
 use crate::particles::Particles;
 

@@ -3,9 +3,11 @@
 mod implicit_mass_spring;
 mod mass_spring;
 mod pbd;
+mod strategy;
 mod xpbd;
 
 pub(crate) use implicit_mass_spring::ImplicitMassSpring;
 pub(crate) use mass_spring::MassSpring;
 pub(crate) use pbd::Pbd;
+pub(crate) use strategy::Strategy;
 pub(crate) use xpbd::Xpbd;

@@ -1,7 +1,7 @@
 //! PBD: projection scaled by a stiffness in [0, 1], whose effect depends on iterations and h.
 
+use super::Strategy;
 use crate::constraints::Rule;
-use crate::method::Strategy;
 
 /// Position Based Dynamics (Müller et al. 2007), with k applied to every projection.
 pub(crate) struct Pbd;

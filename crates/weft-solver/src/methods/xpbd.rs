@@ -1,7 +1,7 @@
 //! XPBD: multipliers reset every substep, projection with compliance α̃ = α/h².
 
+use super::Strategy;
 use crate::constraints::{ConstraintSet, Rule};
-use crate::method::Strategy;
 
 /// Extended Position Based Dynamics (Macklin, Müller, Chentanez 2016).
 pub(crate) struct Xpbd;

@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, Residual};
-use crate::domains::{DomainStats, Domains, SimdPath};
+use crate::domains::{DomainStats, Domains};
 use crate::driver::PinDriver;
 use crate::error::{ParamError, SolverError};
 use crate::forces::Forces;
@@ -20,6 +20,7 @@ use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
 use crate::settings::{Settings, within_bound};
 use crate::stability::{StabilityBound, bound};
+use weft_simd::SimdPath;
 
 /// A cloth inside a solver: its particle range and its mesh in global particle indices.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,5 +1,5 @@
 //! Which instruction set the constraint kernel runs on: picked from the CPU, or forced by
-//! [`crate::Settings::simd`] or the `WEFT_SIMD` environment variable (read once).
+//! the solver's `Settings::simd` or the `WEFT_SIMD` environment variable (read once).
 //!
 //! Every path runs the same IEEE operations in the same order on the same lanes, so the path
 //! changes the speed, never the result (`tests/integration/determinism.rs` checks each path this CPU has).
@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 
 use thiserror::Error;
 
-/// The environment variable that forces a kernel path when [`crate::Settings::simd`] is `None`.
+/// The environment variable that forces a kernel path when the solver's `Settings::simd` is `None`.
 pub const SIMD_ENV: &str = "WEFT_SIMD";
 
 /// A kernel path: the instruction set the domain sweep and integration are compiled for.

@@ -5,7 +5,7 @@
 
 use pulp::{Scalar128b, Simd, WithSimd};
 
-use crate::domains::SimdPath;
+use crate::path::SimdPath;
 
 /// A 3-vector of lanes, one vector per axis.
 pub type V3<S> = [<S as Simd>::f64s; 3];

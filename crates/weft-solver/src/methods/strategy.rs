@@ -1,0 +1,36 @@
+//! The strategy a method plugs into the shared substep loop.
+
+use glam::DVec3;
+
+use crate::constraints::{ConstraintSet, Rule};
+use crate::params::FamilyParams;
+use crate::particles::Particles;
+
+/// What distinguishes one method inside the shared substep loop.
+pub(crate) trait Strategy: Sync {
+    /// Adds internal (constraint) accelerations for substep `h` before integration, on top of
+    /// the external ones in `accel`; `force` is scratch.
+    fn add_internal_forces(
+        &self,
+        _constraints: &ConstraintSet,
+        _particles: &Particles,
+        _params: &[FamilyParams],
+        _h: f64,
+        _force: &mut [DVec3],
+        _accel: &mut [DVec3],
+    ) {
+    }
+
+    /// Whether [`Strategy::add_internal_forces`] adds anything (the mass-spring methods); without
+    /// internal forces the general loop computes the external accelerations inside its
+    /// integration pass.
+    fn has_internal_forces(&self) -> bool {
+        false
+    }
+
+    /// Starts a substep.
+    fn begin_substep(&self, _constraints: &mut ConstraintSet) {}
+
+    /// How constraints are projected with substep `h`, or `None` when they are not projected.
+    fn rule(&self, h: f64) -> Option<Rule>;
+}
