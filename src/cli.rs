@@ -87,8 +87,8 @@ pub struct ExportArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Logged frames to export: `A..B` (B excluded), `A..=B`, `A..` or `..B` (default: all).
-    #[arg(long, value_name = "RANGE", value_parser = crate::export::select::FrameRange::parse)]
-    pub frames: Option<crate::export::select::FrameRange>,
+    #[arg(long, value_name = "RANGE", value_parser = FrameRange::parse)]
+    pub frames: Option<FrameRange>,
     /// Export every N-th of those frames, starting with the first.
     #[arg(long, default_value_t = 1, value_name = "N",
           value_parser = clap::value_parser!(u64).range(1..))]
@@ -374,4 +374,37 @@ pub struct RenderArgs {
     /// Memory and file-size limits.
     #[command(flatten)]
     pub limits: LimitArgs,
+}
+
+/// A range of frame numbers: `A..B` (B excluded), `A..=B`, `A..`, `..B`, `..=B` or `..`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameRange {
+    /// First frame.
+    pub start: u64,
+    /// Frame after the last (`None`: to the end).
+    pub end: Option<u64>,
+}
+
+impl FrameRange {
+    /// Parses `A..B`, `A..=B`, `A..`, `..B`, `..=B` or `..`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let bad = || format!("expected a frame range such as 0..100, 10..=20 or 50.., got {s:?}");
+        let (a, b) = s.trim().split_once("..").ok_or_else(bad)?;
+        let number = |t: &str| t.trim().parse::<u64>().map_err(|_| bad());
+        let start = if a.trim().is_empty() { 0 } else { number(a)? };
+        let end = match b.strip_prefix('=') {
+            Some(last) => Some(number(last)?.checked_add(1).ok_or_else(bad)?),
+            None if b.trim().is_empty() => None,
+            None => Some(number(b)?),
+        };
+        if end.is_some_and(|e| e <= start) {
+            return Err(format!("the frame range {s:?} is empty"));
+        }
+        Ok(Self { start, end })
+    }
+
+    /// Whether `frame` lies in the range.
+    pub fn contains(&self, frame: u64) -> bool {
+        frame >= self.start && self.end.is_none_or(|e| frame < e)
+    }
 }

@@ -6,7 +6,7 @@ use weft_collide::KinematicBody;
 use weft_scene::Scene;
 
 use crate::body::{PartPose, mesh, part_name};
-use crate::export::log::{ColliderTrack, logged_pose};
+use crate::export::collider_track::{ColliderTrack, logged_pose};
 
 /// One track per body part of `scene`'s character (none without one).
 pub fn tracks(

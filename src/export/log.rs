@@ -10,10 +10,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, bail};
 use foxglove::Decode;
 use foxglove::messages::{PointCloud, SceneUpdate};
-use glam::Vec3;
 use weft_scene::Scene;
-use weft_solver::glam::{DQuat, DVec3};
 
+use super::collider_track::{ColliderTrack, logged_pose};
 use crate::record::collider_state::{self, ColliderState};
 
 /// The export was stopped by SIGINT or SIGTERM.
@@ -38,18 +37,6 @@ pub struct ClothTrack {
     pub triangles: Vec<[u32; 3]>,
     /// Positions per exported frame, as logged (float32).
     pub positions: Vec<Vec<[f32; 3]>>,
-}
-
-/// One collider over the exported frames.
-pub struct ColliderTrack {
-    /// The collider's name.
-    pub name: String,
-    /// Its shape as triangles, in its own frame.
-    pub vertices: Vec<Vec3>,
-    /// Triangles of `vertices`.
-    pub triangles: Vec<[u32; 3]>,
-    /// World pose (position, rotation) per exported frame.
-    pub poses: Vec<(DVec3, DQuat)>,
 }
 
 /// Everything an export writes.
@@ -90,16 +77,6 @@ pub fn logged_frames(bytes: &[u8], stop: &AtomicBool) -> anyhow::Result<BTreeMap
 
 fn rgba(c: foxglove::messages::Color) -> [f32; 4] {
     [c.r as f32, c.g as f32, c.b as f32, c.a as f32]
-}
-
-/// A collider's pose as `/colliders/state` writes it.
-fn pose_of(v: &serde_json::Value) -> Option<(DVec3, DQuat)> {
-    let n = |a: &serde_json::Value, i: usize| a.get(i)?.as_f64();
-    let (p, r) = (&v["position"], &v["rotation"]);
-    Some((
-        DVec3::new(n(p, 0)?, n(p, 1)?, n(p, 2)?),
-        DQuat::from_xyzw(n(r, 0)?, n(r, 1)?, n(r, 2)?, n(r, 3)?),
-    ))
 }
 
 /// Reads the tracks of the frames `wanted` (log time → frame number, in order) for `scene`.
@@ -257,38 +234,5 @@ pub fn read_tracks(
         times,
         cloths,
         colliders,
-    })
-}
-
-/// Collider `name`'s pose at exported frame `k` as `/colliders/state` logged it.
-pub fn logged_pose(
-    states: &[Option<serde_json::Value>],
-    k: usize,
-    frames: &[u64],
-    name: &str,
-) -> anyhow::Result<(DVec3, DQuat)> {
-    let state = states[k].as_ref().with_context(|| {
-        format!(
-            "{} has no message at frame {}",
-            collider_state::TOPIC,
-            frames[k]
-        )
-    })?;
-    let entry = state["colliders"]
-        .as_array()
-        .and_then(|cs| cs.iter().find(|c| c["name"] == name))
-        .with_context(|| {
-            format!(
-                "{} at frame {} does not list collider {name}",
-                collider_state::TOPIC,
-                frames[k],
-            )
-        })?;
-    pose_of(entry).with_context(|| {
-        format!(
-            "{} at frame {}: collider {name} has no position or rotation",
-            collider_state::TOPIC,
-            frames[k],
-        )
     })
 }

@@ -6,6 +6,7 @@
 //! export between two messages or frames: files finished stay, the one in progress goes.
 
 pub mod body;
+pub mod collider_track;
 pub mod estimate;
 pub mod glb;
 pub mod log;
