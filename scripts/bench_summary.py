@@ -4,8 +4,9 @@
 Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.8) and
 `<criterion>/substeps_error.json` (written by crates/weft-scene/benches/substeps.rs), and prints:
 
-- step time per frame of XPBD / PBD / mass-spring at 32²…256² particles, projections per
-  second, and the scaling exponent p of cost ∝ particles^p (least-squares fit in log-log);
+- step time per frame of XPBD / PBD / explicit and implicit mass-spring at 32²…256² particles,
+  projections per second, and the scaling exponent p of cost ∝ particles^p (least-squares fit
+  in log-log);
 - the reference workload at N = 64/128/256 on 1 and 2 threads;
 - substeps × iterations at equal cost with the constraint error reached after 1 s;
 - collisions (sphere, triangle mesh, self) with and without, and their exponents;
@@ -18,38 +19,58 @@ Figures are criterion's median point estimates. The page starts with where they 
 the date, the commit (`git describe`), the CPU (`/proc/cpuinfo`'s model name) and the widest
 vector path the CPU offers, or the one forced with WEFT_SIMD. Usage:
     python3 scripts/bench_summary.py [CRITERION_DIR] [--out docs/benchmarks.md] [--note TEXT]
+                                     [--readme README.md]
+    python3 scripts/bench_summary.py --from docs/benchmarks.md --readme README.md
 --note adds a line to the header (e.g. the machine's load average during the run). CRITERION_DIR
 defaults to $CRITERION_HOME, else $CARGO_TARGET_DIR/criterion, else
 target/criterion. Without --out the page goes to standard output.
+
+--readme FILE rewrites the block between `<!-- speed-table:start -->` and
+`<!-- speed-table:end -->` in FILE: one table of the figures a user cares about (step time per
+method at 128², the reference workload on 1 and 2 threads, colliders, triangle-mesh contact, the
+dressed characters, MCAP logging) and one line naming the date, commit, CPU and kernel path. It
+is derived from the benchmarks page alone: the page just generated, or with --from PAGE an
+already generated page (criterion's output is then not read), so the README's table can be
+regenerated without running the benches again.
 """
 import contextlib
 import datetime
 import subprocess
+import io
 import json
 import math
 import os
+import re
 import sys
 from pathlib import Path
 
 
 def parse_args(argv):
-    """(criterion directory or None, output path or None, note or None) from the command line."""
-    root, out, note = None, None, None
+    """The command line as a dict: root (criterion directory), out, note, readme, page (--from)."""
+    opts = {"root": None, "out": None, "note": None, "readme": None, "page": None}
+    flags = {"--out": ("out", "a file"), "--note": ("note", "a text"),
+             "--readme": ("readme", "a file"), "--from": ("page", "a benchmarks page")}
     it = iter(argv)
     for a in it:
-        if a == "--out":
-            out = next(it, None)
-            if out is None:
-                sys.exit("bench_summary: --out needs a file")
-        elif a == "--note":
-            note = next(it, None)
-            if note is None:
-                sys.exit("bench_summary: --note needs a text")
-        elif root is None:
-            root = a
+        if a in flags:
+            key, what = flags[a]
+            opts[key] = next(it, None)
+            if opts[key] is None:
+                sys.exit(f"bench_summary: {a} needs {what}")
+        elif opts["root"] is None and not a.startswith("--"):
+            opts["root"] = a
         else:
             sys.exit(f"bench_summary: unexpected argument {a!r}")
-    return root, out, note
+    if opts["readme"] is not None and opts["page"] is None and opts["out"] is None:
+        sys.exit("bench_summary: --readme needs --out (the page the table is derived from) "
+                 "or --from")
+    if opts["page"] is not None:
+        if opts["readme"] is None:
+            sys.exit("bench_summary: --from needs --readme (it only rewrites the README's table)")
+        if opts["root"] or opts["out"] or opts["note"]:
+            sys.exit("bench_summary: --from reads a generated page; it takes no CRITERION_DIR, "
+                     "--out or --note")
+    return opts
 
 
 def criterion_dir(arg):
@@ -118,7 +139,7 @@ def methods(r):
     print(f"| method | {head} | Mproj/s at 128² | exponent p (cost ∝ particles^p) |")
     print("|---" * (len(SIZES) + 3) + "|")
     any_row = False
-    for m in ["xpbd", "pbd", "mass-spring"]:
+    for m in ["xpbd", "pbd", "mass-spring", "implicit-mass-spring"]:
         t = [ms(r, f"step/{m}/{n * n}") for n in SIZES]
         if all(x is None for x in t):
             continue
@@ -282,7 +303,7 @@ def dressed(r):
 
 def not_benches():
     print("## Figures that are not from a bench\n")
-    print("Two kinds of figure quoted in the README and the notes do not come from criterion and "
+    print("Two kinds of figure quoted in the performance notes do not come from criterion and "
           "are not on this page:\n")
     print("- Weft against Taichi and the C grid kernel: `scripts/compare_peers.sh` (medians of "
           "whole runs of each solver, interleaved); its dated runs are in "
@@ -356,20 +377,33 @@ def header(root, count, note):
 
 
 def main():
-    arg, out, note = parse_args(sys.argv[1:])
-    root = criterion_dir(arg)
+    opts = parse_args(sys.argv[1:])
+    if opts["page"] is not None:
+        try:
+            page = Path(opts["page"]).read_text()
+        except OSError as e:
+            print(f"bench_summary: cannot read {opts['page']}: {e}", file=sys.stderr)
+            return 1
+        return update_readme(opts["readme"], page, opts["page"])
+    root = criterion_dir(opts["root"])
     r = load(root)
     if not r:
         print(f"no criterion results under {root}: run `cargo bench` first", file=sys.stderr)
         return 1
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        write_page(r, root, opts["note"])
+    page = buf.getvalue()
+    out = opts["out"]
     if out:
         tmp = Path(out).with_suffix(".md.tmp")
-        with open(tmp, "w") as f, contextlib.redirect_stdout(f):
-            write_page(r, root, note)
+        tmp.write_text(page)
         tmp.replace(out)
         print(f"wrote {out}", file=sys.stderr)
     else:
-        write_page(r, root, note)
+        sys.stdout.write(page)
+    if opts["readme"]:
+        return update_readme(opts["readme"], page, out)
     return 0
 
 
@@ -385,6 +419,162 @@ def write_page(r, root, note):
     dressed(r)
     logging(r)
     not_benches()
+
+
+# --- The README's Speed table, read back from a generated benchmarks page. ---
+
+START, END = "<!-- speed-table:start -->", "<!-- speed-table:end -->"
+
+
+def page_sections(page):
+    """(sections, bullets): sections maps each heading (without '## ') to its tables, each a
+    list of rows (lists of cells), header row first, separator row left out; bullets maps the
+    names of the page's header bullets (`- date: …`, `- commit: …`, …) to their values."""
+    sections, bullets, current = {}, {}, None
+    table = None
+    for line in page.splitlines():
+        if line.startswith("## "):
+            current = line[3:].strip()
+            sections[current] = []
+            table = None
+        elif line.startswith("|") and current is not None:
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if all(re.fullmatch(r":?-+:?", c) for c in cells):
+                continue
+            if table is None:
+                table = []
+                sections[current].append(table)
+            table.append(cells)
+        else:
+            table = None
+            m = re.match(r"- ([A-Za-z ]+): (.*)$", line)
+            if current is None and m:
+                bullets[m.group(1)] = m.group(2).strip()
+    return sections, bullets
+
+
+def cell(sections, heading, row, column, table=None):
+    """The cell of the page under the `## heading...` section (a prefix), in the table whose
+    first header cell contains `table` (or the first table), the row whose leading cells are
+    `row` (a string or a tuple) and the column whose header contains `column`; None when
+    missing or '–'."""
+    row = (row,) if isinstance(row, str) else tuple(row)
+    for name, tables in sections.items():
+        if not name.startswith(heading):
+            continue
+        for t in tables:
+            if table is not None and table not in t[0][0]:
+                continue
+            cols = [i for i, h in enumerate(t[0]) if column in h]
+            if not cols:
+                continue
+            for r in t[1:]:
+                if tuple(r[:len(row)]) == row and cols[0] < len(r):
+                    v = r[cols[0]]
+                    return None if v in ("", "–", "-") else v
+    return None
+
+
+STEP = "Step time per frame"
+REFERENCE = "Reference workload"
+COLLISIONS = "Collisions: step time"
+MESH = "Triangle-mesh contact"
+DRESSED = "A dressed character"
+LOGGING = "MCAP logging"
+
+# (what, scene or workload, threads, where in the page: (heading, row, column, table)).
+SPEED_ROWS = [
+    *[(f"step, {label}", scene, "all", (STEP, m, "128² ms", None))
+      for m, label, scene in [
+          ("xpbd", "XPBD", "`reference.toml` at 128² (16,384 particles)"),
+          ("pbd", "PBD", "the same"),
+          ("mass-spring", "explicit mass-spring", "the same"),
+          ("implicit-mass-spring", "implicit mass-spring", "the same")]],
+    ("step, XPBD", "the same", "1", (REFERENCE, "1", "N=128", None)),
+    ("step, XPBD", "the same", "2", (REFERENCE, "2", "N=128", None)),
+    ("with a sphere and the ground", "128² cloth draped over a sphere", "all",
+     (COLLISIONS, ("sphere", "with ms"), "128²", None)),
+    ("with self-collision", "128² curtain folding onto itself", "all",
+     (COLLISIONS, ("self-collision", "with ms"), "128²", None)),
+    ("with a triangle mesh, landing", "128² cloth on a 20,480-triangle sphere mesh", "all",
+     (MESH, "mesh, Weft's f64 path", "landing", "128² cloth")),
+    ("with a triangle mesh, draped", "the same, at rest on it", "all",
+     (MESH, "mesh, Weft's f64 path", "draped", "128² cloth")),
+    ("with a moving triangle mesh", "90² cloth on a breathing 5,120-triangle ball", "all",
+     (MESH, "animation and refit once a frame, faces and swept contact every substep", "draped",
+      "90² cloth")),
+    ("dressed character", "`character.toml`: the walker in its T-shirt", "all",
+     (DRESSED, "solve + body contact + self-collision", "ms/frame", "the walker in its T-shirt")),
+    ("skinned glTF character", "`glb_character.toml`: a cape on a jumping body", "all",
+     (DRESSED, "solve + skinned-body contact + self-collision", "ms/frame", "the BCN glTF")),
+    ("`weft run`, no log", "`hanging.toml` at 128²", "all", (LOGGING, None, "no log", None)),
+    ("`weft run --out`, MCAP log", "the same", "all", (LOGGING, None, "with MCAP", None)),
+]
+
+
+def speed_block(page, source):
+    """The README's Speed block (between the markers, markers excluded) from a page's text, and
+    the rows the page lacks."""
+    sections, bullets = page_sections(page)
+    missing = []
+    lines = ["| what | scene | threads | ms per frame |", "|---|---|---|---|"]
+    scene_above, shown_above = None, False
+    for what, scene, threads, (heading, row, column, table) in SPEED_ROWS:
+        # "the same" names the row above's scene; spelt out when that row was left out.
+        if scene == "the same":
+            scene = scene if shown_above else scene_above
+        elif scene.startswith("the same,"):
+            scene = scene if shown_above else scene_above + scene[len("the same"):]
+        else:
+            scene_above = scene
+        if row is None:
+            # A one-row table: the first data row.
+            v = None
+            for name, tables in sections.items():
+                if name.startswith(heading) and tables and len(tables[0]) > 1:
+                    cols = [i for i, h in enumerate(tables[0][0]) if column in h]
+                    if cols:
+                        v = tables[0][1][cols[0]]
+                        v = None if v in ("", "–", "-") else v
+        else:
+            v = cell(sections, heading, row, column, table)
+        shown_above = v is not None
+        if v is None:
+            missing.append(what if threads == "all" else f"{what}, {threads} thread(s)")
+            continue
+        lines.append(f"| {what} | {scene} | {threads} | {v} |")
+    cpu = bullets.get("CPU", "unknown CPU")
+    lines.append("")
+    lines.append(f"Measured {bullets.get('date', 'on an unknown date')} at commit "
+                 f"{bullets.get('commit', 'unknown')} on {cpu}, kernel path "
+                 f"{bullets.get('kernel path', 'unknown')}; criterion medians, threads \"all\" "
+                 f"meaning every logical CPU. Generated from [{source}]({source}) by "
+                 f"`python3 scripts/bench_summary.py --from {source} --readme README.md`; every "
+                 f"benchmark and how it was run are on that page.")
+    return "\n".join(lines), missing
+
+
+def update_readme(readme, page, source):
+    """Rewrites the Speed block of `readme` from the page's text; 1 when the markers are missing."""
+    path = Path(readme)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        print(f"bench_summary: cannot read {readme}: {e}", file=sys.stderr)
+        return 1
+    a, b = text.find(START), text.find(END)
+    if a < 0 or b < a:
+        print(f"bench_summary: {readme} has no {START} … {END} block", file=sys.stderr)
+        return 1
+    block, missing = speed_block(page, source)
+    for m in missing:
+        print(f"bench_summary: {source} has no figure for {m}: row left out", file=sys.stderr)
+    new = text[:a + len(START)] + "\n" + block + "\n" + text[b:]
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(new)
+    tmp.replace(path)
+    print(f"rewrote the speed table of {readme}", file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":

@@ -194,7 +194,7 @@ fn tidy(message: &str) -> String {
                 expected.join(", ")
             )
         }
-        None => format!("unknown key `{field}` (see the scene key reference in README.md)"),
+        None => format!("unknown key `{field}` (see the scene key reference in docs/scenes.md)"),
     }
 }
 
