@@ -107,7 +107,7 @@ pub struct ExportArgs {
 /// `weft recover`.
 #[derive(Debug, Args)]
 pub struct RecoverArgs {
-    /// The damaged log (e.g. `run.partial.mcap`, left by a killed run).
+    /// The damaged log (e.g. `run.partial-4242-0.mcap`, left by a killed run).
     pub log: PathBuf,
     /// Where to write the recovered log.
     #[arg(long)]

@@ -1,8 +1,11 @@
 //! Output files that never destroy an input or each other: a command's outputs are checked
 //! against its inputs and against one another (same path once canonicalised, or the same file
-//! by device and inode), and each is written to `<stem>.partial.<ext>` beside its target, held under
-//! an exclusive lock, and renamed into place only when finished. A file under its final name
-//! is therefore always whole; a failed write leaves none.
+//! by device and inode), and each is written to a temporary file beside its target,
+//! `<stem>.partial-<pid>-<n>.<ext>`, created exclusively (it never replaces a file, an input's
+//! or another writer's, whatever the names given on the command line) and held under an
+//! exclusive lock, then renamed into place only when finished. A file under its final name is
+//! therefore always whole; a failed write leaves none; a killed run leaves its temporary file,
+//! which `weft recover` reads, and which a later writer never empties.
 
 use std::fs::{File, OpenOptions};
 use std::io::Write;
@@ -124,7 +127,7 @@ pub fn refuse_clashes(inputs: &[Named<'_>], outputs: &[Named<'_>]) -> anyhow::Re
     Ok(())
 }
 
-/// An output being written: [`partial_path`], locked, renamed to `target` by
+/// An output being written: a temporary file of its own beside `target`, locked, renamed to it by
 /// [`Output::commit`]; removed if dropped unfinished. A target that exists and is not a regular
 /// file (a device such as `/dev/null`, a FIFO) is written directly.
 #[derive(Debug)]
@@ -136,22 +139,105 @@ pub struct Output {
     committed: bool,
 }
 
-/// Where `target` is written until finished: `.partial` before its extension (`run.mcap` →
-/// `run.partial.mcap`, so the file keeps its type), or after a name with none.
-pub fn partial_path(target: &Path) -> PathBuf {
+/// The marker of a temporary file's name: `<stem>.partial-<pid>-<n>.<ext>`.
+const PARTIAL: &str = ".partial";
+
+/// The `n`-th name this process may write `target` under until it is finished:
+/// `<stem>.partial-<pid>-<n>.<ext>` (`run.mcap` → `run.partial-4242-0.mcap`, so the file keeps
+/// its type), or `<name>.partial-<pid>-<n>` for a name with no extension.
+fn partial_candidate(target: &Path, n: u32) -> PathBuf {
+    let tag = format!("{PARTIAL}-{}-{n}", std::process::id());
     match (target.file_stem(), target.extension()) {
         (Some(stem), Some(ext)) => {
             let mut name = stem.to_owned();
-            name.push(".partial.");
+            name.push(&tag);
+            name.push(".");
             name.push(ext);
             target.with_file_name(name)
         }
         _ => {
             let mut name = target.as_os_str().to_owned();
-            name.push(".partial");
+            name.push(&tag);
             PathBuf::from(name)
         }
     }
+}
+
+/// The final name a temporary file's name stands for (`run.partial-4242-0.mcap` → `run.mcap`,
+/// and an older `run.partial.mcap` → `run.mcap`), or `None` for a name that is not one.
+pub fn target_of_partial(name: &str) -> Option<String> {
+    let at = name.rfind(PARTIAL)?;
+    let rest = &name[at + PARTIAL.len()..];
+    let (tag, ext) = match rest.find('.') {
+        Some(dot) => (&rest[..dot], &rest[dot..]),
+        None => (rest, ""),
+    };
+    let numbered = tag.strip_prefix('-').is_some_and(|t| {
+        let mut parts = t.split('-');
+        let digits = |p: Option<&str>| {
+            p.is_some_and(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+        };
+        digits(parts.next()) && digits(parts.next()) && parts.next().is_none()
+    });
+    (tag.is_empty() || numbered).then(|| format!("{}{ext}", &name[..at]))
+}
+
+/// The temporary files beside `target` that stand for it (any writer's, finished or not).
+fn partials_of(target: &Path) -> Vec<PathBuf> {
+    let (Some(dir), Some(name)) = (target.parent(), target.file_name()) else {
+        return Vec::new();
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let name = name.to_string_lossy();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            let n = e.file_name();
+            target_of_partial(&n.to_string_lossy()).is_some_and(|t| t == name)
+        })
+        .map(|e| dir.join(e.file_name()))
+        .collect();
+    found.sort();
+    found
+}
+
+/// Whether another open file holds `path` locked (a weft writing it now); a file that cannot
+/// be opened is taken as not held.
+fn held_by_another(path: &Path) -> bool {
+    let Ok(file) = File::open(path) else {
+        return false;
+    };
+    matches!(try_lock(&file), Ok(false))
+}
+
+/// Creates this process's temporary file for `target`, exclusively (`O_EXCL`): the first
+/// free name of [`partial_candidate`]'s, so no existing file is ever opened for writing.
+fn create_exclusive(target: &Path) -> anyhow::Result<(PathBuf, File)> {
+    for n in 0..1000 {
+        let partial = partial_candidate(target, n);
+        match OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&partial)
+        {
+            Ok(file) => return Ok((partial, file)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => {
+                return Err(e).with_context(|| format!("cannot write {}", target.display()));
+            }
+        }
+    }
+    bail!(
+        "cannot write {}: no free temporary name beside it",
+        target.display()
+    )
 }
 
 impl Output {
@@ -174,24 +260,34 @@ impl Output {
         if target.is_dir() {
             bail!("cannot write {}: it is a directory", target.display());
         }
-        let partial = partial_path(target);
-        let file = OpenOptions::new()
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&partial)
-            .with_context(|| format!("cannot write {}", target.display()))?;
+        // A target held locked is another writer's file (its temporary file, named as ours).
+        if target.is_file() && held_by_another(target) {
+            bail!(
+                "another weft is writing {} (it holds it locked): refusing to replace it; choose \
+                 another path",
+                target.display()
+            );
+        }
+        let (partial, file) = create_exclusive(target)?;
         if !try_lock(&file).with_context(|| format!("cannot lock {}", partial.display()))? {
+            let _ = std::fs::remove_file(&partial);
+            bail!("cannot lock {}", partial.display());
+        }
+        // Another writer of the same target (its temporary file held locked) is refused; a
+        // killed run's temporary file is left as it is, for `weft recover`.
+        if let Some(other) = partials_of(target)
+            .into_iter()
+            .find(|p| *p != partial && held_by_another(p))
+        {
+            drop(file);
+            let _ = std::fs::remove_file(&partial);
             bail!(
                 "another weft is writing {} (it holds {} locked); wait for it or choose another \
                  path",
                 target.display(),
-                partial.display()
+                other.display()
             );
         }
-        // Only now, under the lock, is a stale partial (a killed run's) emptied.
-        file.set_len(0)
-            .with_context(|| format!("cannot write {}", partial.display()))?;
         if let Ok(mut list) = PARTIALS.lock() {
             list.push(partial.clone());
         }
@@ -360,14 +456,75 @@ mod tests {
         );
         first.commit().expect("commit");
         assert_eq!(std::fs::read(&target).expect("read"), b"whole");
-        assert!(!partial_path(&target).exists());
+        assert!(partials_of(&target).is_empty());
         let mut dropped = Output::create(&target).expect("a new writer after commit");
         dropped.write_all(b"half").expect("write");
         drop(dropped);
         assert_eq!(std::fs::read(&target).expect("read"), b"whole", "kept");
         assert!(
-            !partial_path(&target).exists(),
+            partials_of(&target).is_empty(),
             "an unfinished partial goes"
+        );
+    }
+
+    #[test]
+    fn temporary_names_map_back_to_their_target_and_nothing_else_does() {
+        let target = Path::new("/tmp/x/run.mcap");
+        for n in [0, 7, 999] {
+            let p = partial_candidate(target, n);
+            let name = p.file_name().expect("name").to_string_lossy().into_owned();
+            assert_eq!(
+                target_of_partial(&name).as_deref(),
+                Some("run.mcap"),
+                "{name}"
+            );
+        }
+        assert_eq!(
+            target_of_partial("run.partial.mcap").as_deref(),
+            Some("run.mcap")
+        );
+        assert_eq!(
+            target_of_partial("log.partial-12-3").as_deref(),
+            Some("log")
+        );
+        for not in [
+            "run.mcap",
+            "run.partially.mcap",
+            "run.partial-x-1.mcap",
+            "run.partial-1.mcap",
+        ] {
+            assert_eq!(target_of_partial(not), None, "{not}");
+        }
+    }
+
+    #[test]
+    fn a_killed_run_s_partial_is_kept_and_another_writer_s_is_never_replaced() {
+        let d = dir("names");
+        let target = d.join("a.mcap");
+        // A killed run's temporary file (no lock held): a new writer leaves it whole.
+        let stale = d.join("a.partial-999999-0.mcap");
+        std::fs::write(&stale, b"killed run").expect("write");
+        let mut out = Output::create(&target).expect("writer beside a stale partial");
+        assert_ne!(out.partial(), stale.as_path());
+        out.write_all(b"new").expect("write");
+        out.commit().expect("commit");
+        assert_eq!(std::fs::read(&stale).expect("read"), b"killed run", "kept");
+        assert_eq!(std::fs::read(&target).expect("read"), b"new");
+        // An output named as a running writer's temporary file is refused, and so is an
+        // output named as the old fixed partial while that name is an input: it is never
+        // opened for writing (a new writer's file is its own).
+        let first = Output::create(&d.join("b.mcap")).expect("first");
+        let err = Output::create(first.partial()).expect_err("another writer's file");
+        assert!(err.to_string().contains("another weft"), "{err}");
+        let input = d.join("c.partial.mcap");
+        std::fs::write(&input, b"input").expect("write");
+        let mut out = Output::create(&d.join("c.mcap")).expect("writer");
+        out.write_all(b"output").expect("write");
+        out.commit().expect("commit");
+        assert_eq!(
+            std::fs::read(&input).expect("read"),
+            b"input",
+            "input untouched"
         );
     }
 }

@@ -312,7 +312,7 @@ pub fn refuse_overwriting_inputs(
 
 /// Whether `render` writes a file called `file` (or its partial) into its directory.
 fn written_by_render(file: &str, name: &str) -> bool {
-    let whole = file.replacen(".partial.", ".", 1);
+    let whole = crate::output::target_of_partial(file).unwrap_or_else(|| file.to_owned());
     let frame = whole
         .strip_prefix("frame_")
         .and_then(|f| f.strip_suffix(".png"))

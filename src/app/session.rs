@@ -295,6 +295,7 @@ mod tests {
         let path = std::env::temp_dir().join(format!("weft-session-{}.mcap", std::process::id()));
         let _ = std::fs::remove_file(&path);
         let out = crate::output::Output::create(&path).expect("temp file");
+        let partial = out.partial().to_path_buf();
         s.log = Some(SessionLog::new(out, &s.sim, 0, 0).expect("log"));
         let e = s.switch_scene(SceneSource::Default).expect_err("refused");
         assert!(format!("{e}").contains("recorded"), "{e}");
@@ -307,7 +308,7 @@ mod tests {
         s.finish(false).expect("finishes");
         assert!(s.log.is_none());
         assert!(path.exists(), "the finished log is renamed into place");
-        assert!(!crate::output::partial_path(&path).exists());
+        assert!(!partial.exists(), "the temporary file is the finished log");
         let _ = std::fs::remove_file(path);
     }
 }

@@ -392,7 +392,7 @@ fn ctrl_c_in_the_viewer_leaves_a_finished_log() {
     let (status, out) = wait_exit(&mut viewer, Duration::from_secs(60), "SIGINT");
     assert_eq!(status.code(), Some(130), "{out}");
     assert!(
-        !log.with_file_name("session.partial.mcap").exists(),
+        !common::partial(&log).exists(),
         "the finished log is renamed into place"
     );
     let bytes = std::fs::read(&log).expect("log exists");

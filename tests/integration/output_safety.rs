@@ -76,12 +76,12 @@ fn a_log_appears_only_when_finished_and_a_second_writer_is_refused() {
     let scene = write(&dir, "s.toml", &big(64));
     let target = dir.join("a.mcap");
     let first = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
-    let part = partial(&target);
     assert!(
         partial_grows_past(&target, 0, Duration::from_secs(30)),
         "the first run never started writing {}",
-        part.display()
+        target.display()
     );
+    let part = partial(&target);
     assert!(
         !target.exists(),
         "a log under its final name before it is finished"

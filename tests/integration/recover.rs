@@ -39,8 +39,8 @@ fn killed_log(dir: &std::path::Path) -> std::path::PathBuf {
     let scene = write(dir, "s.toml", &big(48));
     let target = dir.join("run.mcap");
     let child = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
-    let part = partial(&target);
     let grew = partial_grows_past(&target, 3 << 20, Duration::from_secs(60));
+    let part = partial(&target);
     signal(child.id(), "KILL");
     let (_, _) = exits_within(child, Duration::from_secs(10));
     assert!(grew, "the log never grew past 3 MiB");

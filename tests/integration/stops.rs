@@ -30,10 +30,9 @@ fn stop_inside_a_long_frame(sig: &str) {
         ],
         &target,
     );
-    let part = partial(&target);
     // The log's frame 0 is written as soon as the run starts: from then on frames are long.
     assert!(
-        wait_for(Duration::from_secs(60), || part.exists()),
+        wait_for(Duration::from_secs(60), || partial(&target).exists()),
         "the run never started"
     );
     std::thread::sleep(Duration::from_millis(300));

@@ -114,8 +114,8 @@ fn record_refuses_a_log_another_weft_is_writing() {
     let scene = write(&dir, "s.toml", &big(64));
     let target = dir.join("a.mcap");
     let first = spawn_logging(&["run", &scene, "--frames", "100000000"], &target);
-    let part = partial(&target);
     let started = partial_grows_past(&target, 0, Duration::from_secs(30));
+    let part = partial(&target);
     let out = without_display(&["view", "--record", &target.to_string_lossy()]);
     signal(first.id(), "INT");
     let (run, _) = exits_within(first, Duration::from_secs(20));

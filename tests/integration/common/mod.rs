@@ -218,11 +218,36 @@ pub fn exits_within(child: Child, limit: Duration) -> (Output, Duration) {
     }
 }
 
-/// The partial file a run writes before renaming it to `target` (`a.mcap` → `a.partial.mcap`).
+/// The temporary file a run writes before renaming it to `target` (`a.mcap` →
+/// `a.partial-<pid>-<n>.mcap`), the newest if there are several; a path that does not exist
+/// when there is none.
 pub fn partial(target: &Path) -> PathBuf {
-    let stem = target.file_stem().expect("stem").to_string_lossy();
-    let ext = target.extension().expect("extension").to_string_lossy();
-    target.with_file_name(format!("{stem}.partial.{ext}"))
+    let stem = target
+        .file_stem()
+        .expect("stem")
+        .to_string_lossy()
+        .into_owned();
+    let ext = target
+        .extension()
+        .expect("extension")
+        .to_string_lossy()
+        .into_owned();
+    let prefix = format!("{stem}.partial-");
+    let suffix = format!(".{ext}");
+    let dir = target.parent().expect("a directory");
+    let newest = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.starts_with(&prefix) && n.ends_with(&suffix)
+        })
+        .max_by_key(|e| e.metadata().and_then(|m| m.modified()).ok());
+    newest.map_or_else(
+        || target.with_file_name(format!("{stem}.partial-none.{ext}")),
+        |e| e.path(),
+    )
 }
 
 /// A bigger scene: a `n`×`n` cloth, so a frame takes a while and a log grows chunk by chunk.
@@ -245,9 +270,8 @@ pub fn spawn_logging(args: &[&str], target: &Path) -> Child {
 
 /// Waits at most `limit` for the partial log of `target` to hold more than `bytes` bytes.
 pub fn partial_grows_past(target: &Path, bytes: u64, limit: Duration) -> bool {
-    let part = partial(target);
     wait_for(limit, || {
-        std::fs::metadata(&part).is_ok_and(|m| m.len() > bytes)
+        std::fs::metadata(partial(target)).is_ok_and(|m| m.len() > bytes)
     })
 }
 
