@@ -1,6 +1,5 @@
-//! A run of particles through the certified test and the lane test against the same particles
-//! one at a time, and either test against `MeshFrame::resolve` alone, on deforming and still
-//! meshes.
+//! A run of particles through the certified test against the same particles one at a time,
+//! and that test against `MeshFrame::resolve` alone, on deforming and still meshes.
 
 use glam::{DQuat, DVec3};
 use weft_solver::{Contacts, SimdPath};
@@ -16,13 +15,6 @@ use crate::trimesh::frame::{MeshFrame, RunParticle};
 use crate::trimesh::test_particles::{about, assert_same_bits, axes, over_runs};
 use crate::trimesh::vs_parry::{bumpy_sheet, bumpy_sphere};
 use crate::trimesh::{certified, edge_contact};
-
-thread_local! {
-    /// Lanes the lane test settled itself (clear, or pushed out of their face) on this thread.
-    pub(super) static SETTLED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-    /// Lanes whose other listed triangles the flat test cleared (`below`) on this thread.
-    pub(super) static FLAT: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
 
 /// Thickness of every particle (m).
 const R: f64 = 0.02;
@@ -52,7 +44,7 @@ fn shape(rest: &[DVec3], t: f64, deforming: bool) -> Vec<DVec3> {
 ///
 ///
 /// Without `certify`, the mesh certifies no particle (as a fast limb's mesh would not), and
-/// the lane test takes every particle.
+/// `resolve` takes every particle.
 fn passes(
     m: &TriangleMesh,
     case: (u64, bool, bool),
@@ -193,10 +185,6 @@ fn a_run_moves_each_particle_as_the_one_particle_path_does_bit_for_bit() {
 struct Settled {
     /// Particle-passes tested.
     tested: usize,
-    /// Lanes the lane test settled.
-    lanes: usize,
-    /// Lanes whose other listed triangles the lane test's flat test cleared.
-    flat: usize,
     /// Lanes the certified test settled: clear, pushed out of their face, in a hover ball.
     certified: [usize; 3],
     /// (lane, front triangle) distances the certified test worked out.
@@ -205,17 +193,15 @@ struct Settled {
     edges: usize,
 }
 
-/// From the same positions in every pass, `resolve_listed` (the certified test, or without
-/// certificates the lane test, first) and `resolve` alone leave each particle within
-/// 10⁻¹² m of each other (rounding apart: the tests push along the face's plane, `resolve`
-/// through the closest point). Returns what each test settled.
+/// From the same positions in every pass, `resolve_listed` (the certified test first, where the
+/// mesh certifies) and `resolve` alone leave each particle within 10⁻¹² m of each other
+/// (rounding apart: the certified test pushes along the face's plane, `resolve` through the
+/// closest point). Returns what each test settled.
 fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) -> Settled {
     let n = 1003;
     let (mut with_test, mut alone) = (ChunkLists::new(n), ChunkLists::new(n));
     let mut worst = 0.0f64;
     let mut tested = 0;
-    SETTLED.with(|c| c.set(0));
-    FLAT.with(|c| c.set(0));
     certified::SETTLED.with(|c| c.set([0; 3]));
     certified::FRONT_DISTANCES.with(|c| c.set(0));
     edge_contact::EDGES.with(|c| c.set(0));
@@ -235,30 +221,24 @@ fn lanes_agree(m: &TriangleMesh, case: (u64, bool, bool), resting: Option<f64>) 
     assert!(worst <= 1e-12, "{case:?}: {worst:e} m apart");
     Settled {
         tested,
-        lanes: SETTLED.with(|c| c.get()),
-        flat: FLAT.with(|c| c.get()),
         certified: certified::SETTLED.with(|c| c.get()),
         fronts: certified::FRONT_DISTANCES.with(|c| c.get()),
         edges: edge_contact::EDGES.with(|c| c.get()),
     }
 }
 
-/// Without certificates, the lane test settles a good share of the particles itself; on a
-/// convex mesh every neighbour of a touched face lies below its plane, so its flat test
-/// clears most of what it settles.
+/// Without certificates every particle goes through `resolve` itself: the same bits, and the
+/// certified test settles nothing.
 #[test]
-fn the_lane_test_moves_particles_as_resolve_does() {
+fn without_certificates_a_run_moves_particles_as_resolve_does() {
     for (m, seed, deforming) in [
         (bumpy_sphere(), 51, true),
         (bumpy_sheet(), 53, false),
         (TriangleMesh::icosphere(0.5, 4), 52, true),
     ] {
         let s = lanes_agree(&m, (seed, deforming, false), None);
-        assert!(s.lanes * 4 > s.tested, "{s:?}");
+        assert!(s.tested > 1000, "{s:?}");
         assert_eq!(s.certified, [0; 3], "no certificates");
-        if seed == 52 {
-            assert!(s.flat * 2 > s.lanes, "{s:?}");
-        }
     }
 }
 
