@@ -202,7 +202,7 @@ fn partials_of(target: &Path) -> Vec<PathBuf> {
             let n = e.file_name();
             target_of_partial(&n.to_string_lossy()).is_some_and(|t| t == name)
         })
-        .map(|e| dir.join(e.file_name()))
+        .map(|e| target.with_file_name(e.file_name()))
         .collect();
     found.sort();
     found
@@ -277,7 +277,7 @@ impl Output {
         // killed run's temporary file is left as it is, for `weft recover`.
         if let Some(other) = partials_of(target)
             .into_iter()
-            .find(|p| *p != partial && held_by_another(p))
+            .find(|p| p.file_name() != partial.file_name() && held_by_another(p))
         {
             drop(file);
             let _ = std::fs::remove_file(&partial);

@@ -116,3 +116,34 @@ fn outputs_named_like_temporary_files_land_where_they_were_asked() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
+
+#[test]
+fn outputs_named_without_a_directory_are_written_in_the_working_directory() {
+    let dir = temp_dir("relative-out");
+    write(&dir, "s.toml", SMALL);
+    let out = weft()
+        .current_dir(&dir)
+        .args(["run", "s.toml", "--frames", "3", "--out", "run.mcap"])
+        .args(["--dump-final", "final.json"])
+        .output()
+        .expect("weft runs");
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(
+        std::fs::read(dir.join("run.mcap"))
+            .expect("log")
+            .starts_with(MAGIC)
+    );
+    assert!(dir.join("final.json").exists(), "the dump is written");
+    let out = weft()
+        .current_dir(&dir)
+        .args(["recover", "run.mcap", "--out", "again.mcap"])
+        .output()
+        .expect("weft runs");
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(
+        dir.join("again.mcap").exists(),
+        "the recovered log is written"
+    );
+}
