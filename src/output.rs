@@ -510,9 +510,9 @@ mod tests {
         out.commit().expect("commit");
         assert_eq!(std::fs::read(&stale).expect("read"), b"killed run", "kept");
         assert_eq!(std::fs::read(&target).expect("read"), b"new");
-        // An output named as a running writer's temporary file is refused, and so is an
-        // output named as the old fixed partial while that name is an input: it is never
-        // opened for writing (a new writer's file is its own).
+        // An output named as a running writer's temporary file is refused; a file named as
+        // the old fixed partial (an input, say) is never opened for writing: a new writer's
+        // temporary file is its own.
         let first = Output::create(&d.join("b.mcap")).expect("first");
         let err = Output::create(first.partial()).expect_err("another writer's file");
         assert!(err.to_string().contains("another weft"), "{err}");

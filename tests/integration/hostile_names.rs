@@ -6,9 +6,6 @@ use crate::common;
 
 use common::*;
 
-/// The MCAP file magic.
-const MAGIC: &[u8] = b"\x89MCAP0\r\n";
-
 #[test]
 fn recover_and_replay_leave_an_input_named_like_a_temporary_file() {
     let dir = temp_dir("hostile-recover");
@@ -35,8 +32,7 @@ fn recover_and_replay_leave_an_input_named_like_a_temporary_file() {
             from.display()
         );
         if out.status.success() {
-            let fixed = std::fs::read(dir.join(to)).expect("recovered log");
-            assert!(fixed.starts_with(MAGIC), "{to} is not MCAP");
+            read_log(&dir.join(to));
         }
     }
     assert!(dir.join("run.mcap").exists(), "a whole log recovers");
@@ -54,11 +50,7 @@ fn recover_and_replay_leave_an_input_named_like_a_temporary_file() {
         bytes,
         "replay kept it"
     );
-    assert!(
-        std::fs::read(&replayed)
-            .expect("replay's log")
-            .starts_with(MAGIC)
-    );
+    read_log(&replayed);
 }
 
 #[test]
@@ -80,34 +72,23 @@ fn outputs_named_like_temporary_files_land_where_they_were_asked() {
     ]);
     let (o, e) = texts(&out);
     assert!(out.status.success(), "{o}{e}");
-    assert!(
-        std::fs::read(&log).expect("log").starts_with(MAGIC),
-        "the log is MCAP"
-    );
+    assert_eq!(read_log(&log).metadata["weft.status"]["status"], "complete");
     let text = std::fs::read_to_string(&dump).expect("dump");
     assert!(
         serde_json::from_str::<serde_json::Value>(&text).is_ok(),
         "the dump is JSON: {text:.80}"
     );
     // The scene named as the log's temporary file once was.
-    let named = write(&dir, "t.partial.toml", SMALL);
-    let target = dir.join("t.toml");
-    let out = run(&[
-        "run",
-        &named,
-        "--frames",
-        "5",
-        "--out",
-        &target.to_string_lossy(),
-    ]);
-    let (o, e) = texts(&out);
-    assert!(out.status.success(), "{o}{e}");
+    let target = logged_run(&dir, "t.partial.toml", SMALL, 5, "t.toml");
     assert_eq!(
-        std::fs::read_to_string(&named).expect("scene"),
+        std::fs::read_to_string(dir.join("t.partial.toml")).expect("scene"),
         SMALL,
         "scene kept"
     );
-    assert!(std::fs::read(&target).expect("log").starts_with(MAGIC));
+    assert_eq!(
+        read_log(&target).metadata["weft.status"]["status"],
+        "complete"
+    );
     let leftovers: Vec<String> = std::fs::read_dir(&dir)
         .expect("dir")
         .filter_map(|e| e.ok())
@@ -129,10 +110,9 @@ fn outputs_named_without_a_directory_are_written_in_the_working_directory() {
         .expect("weft runs");
     let (o, e) = texts(&out);
     assert!(out.status.success(), "{o}{e}");
-    assert!(
-        std::fs::read(dir.join("run.mcap"))
-            .expect("log")
-            .starts_with(MAGIC)
+    assert_eq!(
+        read_log(&dir.join("run.mcap")).metadata["weft.status"]["status"],
+        "complete"
     );
     assert!(dir.join("final.json").exists(), "the dump is written");
     let out = weft()
@@ -142,8 +122,8 @@ fn outputs_named_without_a_directory_are_written_in_the_working_directory() {
         .expect("weft runs");
     let (o, e) = texts(&out);
     assert!(out.status.success(), "{o}{e}");
-    assert!(
-        dir.join("again.mcap").exists(),
-        "the recovered log is written"
+    assert_eq!(
+        read_log(&dir.join("again.mcap")).metadata["weft.status"]["status"],
+        "recovered"
     );
 }
