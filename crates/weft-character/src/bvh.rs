@@ -89,6 +89,11 @@ pub struct Bvh {
     pub channels: Vec<Vec<Channel>>,
 }
 
+/// Deepest joint nesting a BVH file may have below its root. Motion-capture skeletons are
+/// under 30 levels deep; the limit keeps a file from driving the parser's recursion into a
+/// stack overflow.
+pub const MAX_JOINT_DEPTH: usize = 256;
+
 /// Parses BVH text.
 pub fn parse_bvh(text: &str, options: &BvhOptions) -> Result<Bvh, BvhError> {
     if !(options.scale.is_finite() && options.scale > 0.0) {
@@ -98,7 +103,7 @@ pub fn parse_bvh(text: &str, options: &BvhOptions) -> Result<Bvh, BvhError> {
     lex.expect_word("HIERARCHY", "`HIERARCHY`")?;
     lex.expect_word("ROOT", "`ROOT`")?;
     let mut h = Hierarchy::default();
-    h.joint(&mut lex, None, options.scale)?;
+    h.joint(&mut lex, None, 0, options.scale)?;
     lex.expect_word("MOTION", "`MOTION` after the root joint's closing `}`")?;
     let (frames, frame_time) = motion_header(&mut lex)?;
     let poses = frame_lines(&mut lex, &h.channels, frames, options.scale)?;
@@ -120,14 +125,22 @@ struct Hierarchy {
 }
 
 impl Hierarchy {
-    /// Reads `name { OFFSET … CHANNELS … children }` after ROOT or JOINT.
+    /// Reads `name { OFFSET … CHANNELS … children }` after ROOT or JOINT, `depth` levels below
+    /// the root (the recursion is bounded by [`MAX_JOINT_DEPTH`], not by the file).
     fn joint(
         &mut self,
         lex: &mut Lexer,
         parent: Option<usize>,
+        depth: usize,
         scale: f64,
     ) -> Result<(), BvhError> {
         let (line, name) = lex.name()?;
+        if depth > MAX_JOINT_DEPTH {
+            return Err(BvhError::TooDeep {
+                line,
+                limit: MAX_JOINT_DEPTH,
+            });
+        }
         if self.joints.iter().any(|j| j.name == name) {
             return Err(BvhError::DuplicateJoint { line, name });
         }
@@ -149,7 +162,7 @@ impl Hierarchy {
             match word {
                 "OFFSET" => offset = Some(lex.vec3()? * scale),
                 "CHANNELS" => channels = Some(read_channels(lex, at)?),
-                "JOINT" => self.joint(lex, Some(index), scale)?,
+                "JOINT" => self.joint(lex, Some(index), depth + 1, scale)?,
                 "End" => self.end_site(lex, index, scale)?,
                 "}" => break,
                 "MOTION" | "ROOT" => return Err(BvhError::MissingBrace { line, joint: name }),
@@ -266,7 +279,8 @@ fn frame_lines(
     scale: f64,
 ) -> Result<Vec<Pose>, BvhError> {
     let expected: usize = channels.iter().map(Vec::len).sum();
-    let mut poses = Vec::with_capacity(frames);
+    // A frame takes a line: the text, not the `Frames:` it declares, bounds the allocation.
+    let mut poses = Vec::with_capacity(frames.min(lex.lines_left()));
     let mut values = Vec::with_capacity(expected);
     while poses.len() < frames {
         let Some((line, text)) = lex.next_line() else {
@@ -371,6 +385,11 @@ impl<'a> Lexer<'a> {
     /// The tokens left on the current line.
     fn rest_of_line(&mut self) -> Vec<&'a str> {
         self.tokens.drain(..).collect()
+    }
+
+    /// Lines not yet read (the current line's remaining tokens aside).
+    fn lines_left(&self) -> usize {
+        self.lines.len() - self.next_line
     }
 
     /// The next whole line after the current one.

@@ -167,6 +167,14 @@ pub enum BvhError {
         /// Frames announced.
         expected: usize,
     },
+    /// Joints nested deeper than [`MAX_JOINT_DEPTH`](crate::bvh::MAX_JOINT_DEPTH).
+    #[error("line {line}: joints are nested more than {limit} levels deep below the root")]
+    TooDeep {
+        /// Line of the joint past the limit.
+        line: usize,
+        /// The limit.
+        limit: usize,
+    },
     /// Text after the last announced frame.
     #[error("line {line}: text after the {frames} frames that `Frames:` announces")]
     ExtraData {

@@ -12,7 +12,7 @@ use glam::DVec2;
 use thiserror::Error;
 use weft_solver::{ClothMesh, MeshError};
 
-pub use sew::build_garment;
+pub use sew::{MAX_COORDINATE, MAX_CORNERS, MAX_GARMENT_VERTICES, MIN_EDGE_LENGTH, build_garment};
 pub use spec::{GarmentSpec, PanelSpec, SeamSide, SeamSpec};
 
 /// A garment ready for a solver: one mesh of all panels (unsewn) and the seams to close.

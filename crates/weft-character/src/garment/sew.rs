@@ -12,6 +12,16 @@ use super::{Garment, GarmentError, PanelMesh};
 /// Most vertices a garment may have (guards against a tiny `edge_length`).
 pub const MAX_GARMENT_VERTICES: usize = 2_000_000;
 
+/// Shortest `edge_length` (m): a tenth of a millimetre, finer than a yarn.
+pub const MIN_EDGE_LENGTH: f64 = 1e-4;
+
+/// Largest outline coordinate (m): no sewing pattern spans more than a few metres.
+pub const MAX_COORDINATE: f64 = 100.0;
+
+/// Most corners a panel's outline may have (its self-crossing test is quadratic in them;
+/// real pattern pieces have tens).
+pub const MAX_CORNERS: usize = 10_000;
+
 /// Triangulates, places and merges the panels of `spec`, and pairs its seams' vertices.
 pub fn build_garment(spec: &GarmentSpec) -> Result<Garment, GarmentError> {
     let top = |key: &'static str, message: String| GarmentError::Key {
@@ -25,6 +35,12 @@ pub fn build_garment(spec: &GarmentSpec) -> Result<Garment, GarmentError> {
         return Err(top(
             "edge_length",
             format!("must be a positive length in metres, got {h}"),
+        ));
+    }
+    if h < MIN_EDGE_LENGTH {
+        return Err(top(
+            "edge_length",
+            format!("{h} m is below the shortest edge a garment may have, {MIN_EDGE_LENGTH} m"),
         ));
     }
     let density = spec.area_density;
@@ -41,6 +57,19 @@ pub fn build_garment(spec: &GarmentSpec) -> Result<Garment, GarmentError> {
         ));
     }
     let outlines = check_panels(spec)?;
+    // Counted before anything the count would size is allocated.
+    let vertices = estimated_vertices(&outlines, h);
+    if vertices > MAX_GARMENT_VERTICES as f64 {
+        let area: f64 = outlines.iter().map(|o| polygon_area(o)).sum();
+        return Err(top(
+            "edge_length",
+            format!(
+                "{h} m over the panels' {area:.3} m² gives about {vertices:.2e} vertices, more \
+                 than the {MAX_GARMENT_VERTICES} a garment may have; use at least {:.2e} m",
+                h * (vertices / MAX_GARMENT_VERTICES as f64).sqrt()
+            ),
+        ));
+    }
     let pieces = seam_aware_pieces(spec, &outlines, h)?;
 
     let mut positions = Vec::new();
@@ -167,12 +196,37 @@ fn check_panels(spec: &GarmentSpec) -> Result<Vec<Vec<DVec2>>, GarmentError> {
                 "needs at least 3 corners".into(),
             ));
         }
+        if outline.len() > MAX_CORNERS {
+            return Err(panel_error(
+                spec,
+                i,
+                "outline",
+                format!(
+                    "has {} corners, more than the {MAX_CORNERS} a panel may have",
+                    outline.len()
+                ),
+            ));
+        }
         if let Some(k) = outline.iter().position(|p| !p.is_finite()) {
             return Err(panel_error(
                 spec,
                 i,
                 "outline",
                 format!("corner {k} is not finite"),
+            ));
+        }
+        if let Some(k) = outline
+            .iter()
+            .position(|p| p.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(panel_error(
+                spec,
+                i,
+                "outline",
+                format!(
+                    "corner {k} lies {:.3e} m out, beyond the {MAX_COORDINATE} m a panel may span",
+                    outline[k].abs().max_element()
+                ),
             ));
         }
         if let Some(k) = edge_lengths(&outline).iter().position(|&l| l <= 0.0) {
@@ -191,8 +245,13 @@ fn check_panels(spec: &GarmentSpec) -> Result<Vec<Vec<DVec2>>, GarmentError> {
                 format!("the outline crosses itself (edges {i1} and {i2})"),
             ));
         }
-        if !panel.position.iter().all(|v| v.is_finite()) {
-            return Err(panel_error(spec, i, "position", "must be finite".into()));
+        if !panel.position.iter().all(|v| v.abs() <= MAX_COORDINATE) {
+            return Err(panel_error(
+                spec,
+                i,
+                "position",
+                format!("must be finite and within {MAX_COORDINATE} m of the origin"),
+            ));
         }
         if !panel.rotation.iter().all(|v| v.is_finite()) {
             return Err(panel_error(spec, i, "rotation", "must be finite".into()));
@@ -273,6 +332,19 @@ fn seam_aware_pieces(
         }
     }
     Ok(pieces)
+}
+
+/// Vertices that triangulating `outlines` to edge length `h` makes, about: each panel's area
+/// over an equilateral triangle's, and its boundary samples (in floating point, so no count
+/// can overflow).
+fn estimated_vertices(outlines: &[Vec<DVec2>], h: f64) -> f64 {
+    outlines
+        .iter()
+        .map(|o| {
+            let boundary: f64 = edge_lengths(o).iter().map(|l| (l / h).ceil()).sum();
+            polygon_area(o) / (3f64.sqrt() / 4.0 * h * h) + boundary
+        })
+        .sum()
 }
 
 /// R = R_z R_y R_x from degrees about x, y, z.

@@ -305,3 +305,42 @@ fn file_errors_name_the_file_and_the_line() {
     assert_eq!(read_bvh(&good, &cm()).expect("good file").skeleton.len(), 4);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A chain of `depth` joints below the root, each with one rotation channel, one frame.
+fn chain(depth: usize) -> String {
+    let mut text = String::from("HIERARCHY\nROOT J0\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n");
+    for k in 1..=depth {
+        text += &format!("JOINT J{k}\n{{\nOFFSET 0 1 0\nCHANNELS 1 Xrotation\n");
+    }
+    text += &"}\n".repeat(depth + 1);
+    text += &format!(
+        "MOTION\nFrames: 1\nFrame Time: 0.1\n{}\n",
+        "0 ".repeat(depth + 1)
+    );
+    text
+}
+
+#[test]
+fn declared_frame_counts_and_nesting_cannot_exhaust_memory_or_the_stack() {
+    // A count the file cannot hold is an error, not an allocation of that many frames.
+    for frames in ["4000000000", "18446744073709551615"] {
+        assert_eq!(
+            error_of(&edit("Frames: 2", &format!("Frames: {frames}"))),
+            BvhError::MissingFrames {
+                line: 25,
+                found: 2,
+                expected: frames.parse().expect("a count")
+            }
+        );
+    }
+    let deep = parse_bvh(&chain(200), &cm()).expect("200 levels read");
+    assert_eq!(deep.skeleton.len(), 201);
+    let limit = weft_character::bvh::MAX_JOINT_DEPTH;
+    assert_eq!(
+        error_of(&chain(20_000)),
+        BvhError::TooDeep {
+            line: 2 + 4 * (limit + 1),
+            limit
+        }
+    );
+}

@@ -239,7 +239,7 @@ fn bad_garments_name_their_key_and_line() {
     let e = error_of(&tube().replace("edge_length = 0.03", "edge_length = -0.03"));
     assert_eq!(key_line(&e), ("edge_length", Some(1)));
     let e = error_of(&tube().replace("edge_length = 0.03", "edge_length = 1e-5"));
-    assert_eq!(key_line(&e).0, "outline");
+    assert_eq!(key_line(&e), ("edge_length", Some(1)));
     let e = error_of(&tube().replace("name = \"back\"", "name = \"front\""));
     assert_eq!(key_line(&e), ("name", Some(10)));
     for (text, line) in [
@@ -280,4 +280,43 @@ fn garment_files_name_the_file() {
     let spec = read_garment(&path).expect("good garment");
     assert_eq!(spec.panels.len(), 2);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The tube with its front panel's third corner at `corner` and edge length `h`.
+fn hostile(corner: &str, h: &str) -> String {
+    tube()
+        .replacen("[0.2, 0.5]", corner, 1)
+        .replace("edge_length = 0.03", &format!("edge_length = {h}"))
+}
+
+#[test]
+fn outlines_and_edge_lengths_beyond_physical_limits_are_refused_before_allocating() {
+    // Each of these hung, aborted on a huge allocation or panicked on "capacity overflow".
+    for (corner, h, key) in [
+        ("[1e308, 0.8]", "0.03", "outline"),
+        ("[1e11, 0.8]", "0.03", "outline"),
+        ("[-1e6, 0.8]", "1e-300", "edge_length"),
+        ("[0.2, 0.5]", "1e-9", "edge_length"),
+        ("[0.2, 0.5]", "1e-8", "edge_length"),
+        // Inside every limit on its own, but 99 m × 0.5 m at 1 mm is 1e8 vertices.
+        ("[99.0, 0.5]", "1e-3", "edge_length"),
+    ] {
+        let text = hostile(corner, h);
+        let e = error_of(&text);
+        let line = if key == "edge_length" { 1 } else { 6 };
+        assert_eq!(key_line(&e), (key, Some(line)), "{corner} {h}: {e}");
+    }
+    let e = error_of(&hostile("[1e11, 0.8]", "0.03")).to_string();
+    assert!(e.contains("corner 2") && e.contains("100 m"), "{e}");
+    let e = error_of(&hostile("[0.2, 0.5]", "1e-8")).to_string();
+    assert!(e.contains("shortest edge"), "{e}");
+    let e = error_of(&hostile("[99.0, 0.5]", "1e-3")).to_string();
+    assert!(e.contains("vertices") && e.contains("2000000"), "{e}");
+    // The largest panel the limits allow still builds at a sensible edge length.
+    let big = build(&hostile("[0.2, 3.0]", "0.05").replacen("[-0.2, 0.5]", "[-0.2, 3.0]", 1));
+    assert!(
+        big.mesh.positions.len() > 200,
+        "{}",
+        big.mesh.positions.len()
+    );
 }
