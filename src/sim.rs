@@ -57,10 +57,14 @@ impl Simulation {
         })
     }
 
-    /// Lets every solver poll `stop` once per substep (see `Solver::set_stop`).
+    /// Lets every solver poll `stop` once per substep (see `Solver::set_stop`), and its
+    /// collision world inside its longest work.
     pub fn set_stop(&mut self, stop: Arc<AtomicBool>) {
         for g in &mut self.groups {
             g.solver.set_stop(Arc::clone(&stop));
+            if let Some(w) = &mut g.world {
+                w.set_stop(Arc::clone(&stop));
+            }
         }
     }
 

@@ -124,3 +124,36 @@ fn a_scene_file_that_is_a_device_is_refused() {
         "{e}"
     );
 }
+
+#[test]
+fn sigint_while_self_collision_lists_a_thick_cloth_stops_within_a_second() {
+    // A 512² sheet 10 m thick: every particle lies within reach of every other, so the first
+    // list build tests 3·10¹⁰ pairs (all exempt, so it takes no memory): minutes of work
+    // inside the first substep, where the solver's own per-substep poll cannot see a stop.
+    let dir = temp_dir("thick-self-collision");
+    let scene = write(
+        &dir,
+        "s.toml",
+        "[cloth.c]\nresolution = [512, 512]\nthickness = 10.0\n\n[self_collision]\n",
+    );
+    let target = dir.join("a.mcap");
+    let child = spawn_logging(
+        &["run", &scene, "--frames", "5", "--max-memory", "4T"],
+        &target,
+    );
+    // Frame 0 in the log: the run is stepping (a stop before would end it at once).
+    assert!(
+        partial_grows_past(&target, 100_000, Duration::from_secs(120)),
+        "the run never started"
+    );
+    std::thread::sleep(Duration::from_millis(500));
+    signal(child.id(), "INT");
+    let (out, took) = exits_within(child, Duration::from_secs(120));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(took < PROMPT, "took {took:?} to stop: {err}");
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert_eq!(
+        read_log(&target).metadata["weft.status"]["status"],
+        "interrupted"
+    );
+}

@@ -2,7 +2,7 @@
 //! every point near each of a batch of queries, both walking the cells in key order with one
 //! forward-only cursor per neighbour column.
 
-use std::ops::Range;
+use std::ops::{ControlFlow, Range};
 
 use glam::DVec3;
 use multiversion::multiversion;
@@ -82,13 +82,14 @@ impl CellGrid {
             for &j in near {
                 f(i, j);
             }
+            ControlFlow::Continue(())
         });
     }
 
     /// [`CellGrid::for_each_pair_in`] one point at a time: calls `f(i, near)` for each point
-    /// `i` of `run` with a partner, `near` being its partners that come after it in key
-    /// order (so that each pair comes once). Only partners whose tags are more than `apart`
-    /// from i's count (the grid must be tagged). `row` is scratch.
+    /// `i` of `run`, `near` being its partners that come after it in key order (so that each
+    /// pair comes once; often none), until `f` breaks. Only partners whose tags are
+    /// more than `apart` from i's count (the grid must be tagged). `row` is scratch.
     ///
     /// With `radius` ≤ spacing two such points lie in the same or neighbouring cells. Walking
     /// the cells in key order, the cells of a neighbour column (x + dx, y + dy, z − 1..=z + 1)
@@ -105,7 +106,7 @@ impl CellGrid {
         radius: f64,
         apart: f64,
         row: &mut Vec<u32>,
-        mut f: impl FnMut(u32, &[u32]),
+        mut f: impl FnMut(u32, &[u32]) -> ControlFlow<()>,
     ) {
         assert!(
             radius <= self.spacing,
@@ -151,8 +152,8 @@ impl CellGrid {
             for x in s..e {
                 row.clear();
                 near.within(x - s + 1, (pos[x], tags[x]), (r2, apart2), row);
-                if !row.is_empty() {
-                    f(cells[x].1, row);
+                if f(cells[x].1, row).is_break() {
+                    return;
                 }
             }
             s = e;

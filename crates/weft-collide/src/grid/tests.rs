@@ -25,6 +25,7 @@ fn tagged_pairs_are_the_close_pairs_whose_tags_are_apart() {
         let mut row = Vec::new();
         grid.for_each_row_in(run, radius, apart, &mut row, |i, near| {
             found.extend(near.iter().map(|&j| (i.min(j), i.max(j))));
+            std::ops::ControlFlow::Continue(())
         });
     }
     found.sort_unstable();

@@ -2,6 +2,9 @@
 //! added for re-anchored members since, with the anchors they were listed at; built from a
 //! [`CellGrid`] and filtered down when the skin thins.
 
+use std::ops::ControlFlow;
+use std::sync::atomic::Ordering;
+
 use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
@@ -127,6 +130,8 @@ impl SelfCollision {
         let runs = self.list.grid.cell_runs(4 * rayon::current_num_threads());
         self.list.pairs.resize_with(runs.len(), PairList::default);
         let grid = &self.list.grid;
+        let stop = self.stop.as_deref();
+        let stopping = || stop.is_some_and(|f| f.load(Ordering::Relaxed));
         self.list
             .pairs
             .par_iter_mut()
@@ -140,8 +145,20 @@ impl SelfCollision {
                     for &j in near {
                         list.push(i.min(j), i.max(j), 0.5 * (ti + thickness[j as usize]));
                     }
+                    // A list of a huge thickness takes seconds: a stop cuts it short.
+                    if stopping() {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    }
                 });
             });
+        if stopping() {
+            // The frame is being abandoned: no list, so the next check builds one anew.
+            self.list.pairs.iter_mut().for_each(PairList::clear);
+            self.list.built_for = None;
+            return;
+        }
         self.skin.built(self.members.len(), self.pair_count());
     }
 

@@ -46,6 +46,9 @@ mod skin;
 mod tests;
 mod times;
 
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
 use glam::DVec3;
 use weft_solver::Solver;
 
@@ -165,6 +168,8 @@ pub(crate) struct SelfCollision {
     sweep: Sweep,
     /// Rebuilds, partial updates and time spent so far.
     tally: Tally,
+    /// Raised to abandon the frame in progress (see [`SelfCollision::set_stop`]).
+    stop: Option<Arc<AtomicBool>>,
 }
 
 impl SelfCollision {
@@ -218,7 +223,14 @@ impl SelfCollision {
             moved: Movers::default(),
             sweep: Sweep::new(n),
             tally: Tally::default(),
+            stop: None,
         })
+    }
+
+    /// A flag polled while the list is built: once raised, a build stops within a
+    /// particle's partners and leaves no list (the frame in progress is being abandoned).
+    pub(crate) fn set_stop(&mut self, flag: Arc<AtomicBool>) {
+        self.stop = Some(flag);
     }
 
     /// The distance pair `(a, b)` must keep, or `None` if it is exempt (see

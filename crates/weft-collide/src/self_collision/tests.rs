@@ -475,3 +475,29 @@ fn exempt_pairs_are_those_of_one_cloth_within_a_fold_length_at_rest() {
                 || rest[a as usize].distance(rest[b as usize]) > fold)
     );
 }
+
+#[test]
+fn a_raised_stop_cuts_a_list_build_short_and_leaves_no_list() {
+    // Two coincident sheets 10 m thick: every pair of the two cloths is a candidate.
+    let n = 16;
+    let solver = sheets(2, n, (0.3, 0.3));
+    let count = solver.particles().len();
+    let t = vec![10.0; count];
+    let params = SelfCollisionParams {
+        adaptive_margin: false,
+        ..SelfCollisionParams::default()
+    };
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let mut sc = SelfCollision::new(&solver, &[0, 1], params).expect("self-collision");
+    sc.set_stop(std::sync::Arc::clone(&flag));
+    let mut x = solver.particles().positions.clone();
+    sc.refresh(&mut x, &t, None);
+    assert_eq!((sc.pair_count(), sc.list.built_for), (0, None));
+    flag.store(false, std::sync::atomic::Ordering::Relaxed);
+    sc.refresh(&mut x, &t, None);
+    assert_eq!(
+        sc.pair_count(),
+        (n * n) * (n * n),
+        "every pair of the two cloths"
+    );
+}

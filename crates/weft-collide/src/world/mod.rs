@@ -11,6 +11,7 @@
 
 use std::ops::Range;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
@@ -87,6 +88,8 @@ pub struct CollisionWorld {
     /// Triangle meshes go through parry's f32 queries, as before the f64 mesh path (kept
     /// for comparisons).
     parry_meshes: bool,
+    /// The flag the self-collision's list build polls (see [`CollisionWorld::set_stop`]).
+    stop: Option<Arc<AtomicBool>>,
 }
 
 /// Rounds of re-query per particle and collider (a push out of one face of a mesh may land in
@@ -111,6 +114,7 @@ impl CollisionWorld {
             run_lists: RunLists::default(),
             mesh_grids: Vec::new(),
             parry_meshes: false,
+            stop: None,
         };
         world.sync_thickness(solver);
         world
@@ -251,8 +255,23 @@ impl CollisionWorld {
         cloths: &[usize],
         params: SelfCollisionParams,
     ) -> Result<(), CollideError> {
-        self.self_collision = Some(SelfCollision::new(solver, cloths, params)?);
+        let mut sc = SelfCollision::new(solver, cloths, params)?;
+        if let Some(flag) = &self.stop {
+            sc.set_stop(Arc::clone(flag));
+        }
+        self.self_collision = Some(sc);
         Ok(())
+    }
+
+    /// A flag polled inside the work that can take seconds in one substep (building the
+    /// self-collision's candidate list for a large thickness): once raised, that work stops
+    /// at once, leaving the frame in progress to be abandoned (as [`Solver::set_stop`]
+    /// does at the next substep).
+    pub fn set_stop(&mut self, flag: Arc<AtomicBool>) {
+        if let Some(sc) = &mut self.self_collision {
+            sc.set_stop(Arc::clone(&flag));
+        }
+        self.stop = Some(flag);
     }
 
     /// Turns self-collision off.
