@@ -31,6 +31,15 @@ impl LimitArgs {
     }
 }
 
+/// This process's peak resident memory so far (`VmHWM` in /proc/self/status), in bytes
+/// (`None` where there is no such file).
+pub fn peak_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
 /// `MemAvailable` from /proc/meminfo, in bytes (`None` where there is no such file).
 pub fn available_memory() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;

@@ -162,6 +162,10 @@ fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
                 scene.colliders.len(),
                 methods.join(", ")
             )?;
+            say!(
+                "  memory: about {} once running",
+                weft_scene::human(scene.estimated_bytes())
+            )?;
             for g in &groups {
                 for i in 0..g.solver.cloths().len() {
                     if let Some(v) = stability::verdict(&g.solver, i) {

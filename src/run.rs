@@ -185,6 +185,13 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
         last.residual_max,
         last.kinetic_energy,
     )?;
+    if let Some(peak) = crate::limits::peak_memory() {
+        say!(
+            "memory: peak {}, estimated {}",
+            weft_scene::human(peak),
+            weft_scene::human(sim.scene.estimated_bytes())
+        )?;
+    }
     if let Some(p) = plan.out {
         let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
         say!("wrote {} ({size} bytes)", p.display())?;

@@ -80,15 +80,9 @@ fn slug(s: &str) -> String {
     out.trim_matches('-').chars().take(60).collect()
 }
 
-/// The memory `scene` needs once built (the estimate the scene loader checks).
-fn scene_bytes(scene: &weft_scene::Scene) -> u64 {
-    let particles: u64 = scene.cloths.iter().map(|c| c.mesh.len() as u64).sum();
-    weft_scene::estimate_bytes(particles, scene.self_collision.is_some())
-}
-
 /// Refuses a queue whose runs, `jobs` at a time, could need more memory together than the
 /// limit allows (each alone was checked when it was loaded): the `jobs` largest estimates
-/// are what may be built at once.
+/// are what may be built at once, in one process (whose own base is counted once).
 fn refuse_concurrent_memory(
     needs: &[u64],
     jobs: usize,
@@ -100,10 +94,11 @@ fn refuse_concurrent_memory(
     let mut sorted = needs.to_vec();
     sorted.sort_unstable_by(|a, b| b.cmp(a));
     let at_once = jobs.min(sorted.len());
+    let base = weft_scene::BASE_BYTES;
     let need: u64 = sorted
         .iter()
         .take(at_once)
-        .fold(0u64, |a, b| a.saturating_add(*b));
+        .fold(base, |a, b| a.saturating_add(b.saturating_sub(base)));
     if need > *cap {
         bail!(
             "{at_once} runs at a time may need about {} together, more than the {} allowed \
@@ -225,7 +220,7 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         let mut needs = Vec::with_capacity(mine.len());
         for r in &mine {
             match weft_scene::load_with(&scene_path, &r.overrides, &limits) {
-                Ok(s) => needs.push(scene_bytes(&s)),
+                Ok(s) => needs.push(s.estimated_bytes()),
                 Err(e) => bail!("run {} ({} {}):\n{e}", r.index, r.series, r.label),
             }
         }

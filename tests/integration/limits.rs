@@ -197,7 +197,8 @@ fn a_huge_sweep_asks_for_yes_and_jobs_and_shards_are_checked_first() {
 #[test]
 fn the_memory_limit_covers_the_runs_that_run_at_once() {
     let dir = temp_dir("queue-memory");
-    // 128² = 16384 particles: about 19 MiB each once built, 38 MiB for two at once.
+    // 128² = 16384 particles: about 19 MiB each once built, beside the process's 32 MiB:
+    // 51 MiB for one run, 71 MiB for two at once.
     write(&dir, "mid.toml", &big(128));
     let exp = write(
         &dir,
@@ -214,7 +215,7 @@ fn the_memory_limit_covers_the_runs_that_run_at_once() {
             o.clone(),
             "--no-mcap".into(),
             "--max-memory".into(),
-            "30M".into(),
+            "60M".into(),
             "--jobs".into(),
             jobs.into(),
         ]
@@ -224,7 +225,7 @@ fn the_memory_limit_covers_the_runs_that_run_at_once() {
     let (so, e) = texts(&out);
     assert_eq!(out.status.code(), Some(1), "{so}{e}");
     assert!(
-        e.contains("2 runs at a time") && e.contains("--jobs") && e.contains("30 MiB"),
+        e.contains("2 runs at a time") && e.contains("--jobs") && e.contains("60 MiB"),
         "{e}"
     );
     assert!(
@@ -235,4 +236,83 @@ fn the_memory_limit_covers_the_runs_that_run_at_once() {
     let out = run(&one.iter().map(String::as_str).collect::<Vec<_>>());
     let (so, e) = texts(&out);
     assert!(out.status.success(), "one at a time fits: {so}{e}");
+}
+
+/// A size as `human` prints it ("154 MiB", "2.1 GiB"), in bytes.
+fn parse_human(s: &str) -> f64 {
+    let (n, unit) = s.trim().split_once(' ').expect("number and unit");
+    let n: f64 = n.parse().expect("a number");
+    n * match unit {
+        "MiB" => (1u64 << 20) as f64,
+        "GiB" => (1u64 << 30) as f64,
+        other => panic!("unit {other}"),
+    }
+}
+
+/// Runs `scene` for 5 frames with a log (and `extra` arguments); its peak memory and the
+/// estimate it printed.
+fn peak_and_estimate(scene: &str, extra: &[&str], dir: &std::path::Path) -> (f64, f64) {
+    let log = dir.join("a.mcap");
+    let mut args = vec![
+        "run",
+        scene,
+        "--frames",
+        "5",
+        "--out",
+        log.to_str().expect("utf-8 path"),
+    ];
+    args.extend_from_slice(extra);
+    let out = run(&args);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{scene}: {e}");
+    let line = o
+        .lines()
+        .find_map(|l| l.strip_prefix("memory: peak "))
+        .unwrap_or_else(|| panic!("{scene}: no memory line in {o}"));
+    let (peak, estimate) = line.split_once(", estimated ").expect("peak, estimate");
+    (parse_human(peak), parse_human(estimate))
+}
+
+#[test]
+fn peak_memory_stays_within_the_estimate_on_every_shipped_scene_and_thick_cloths() {
+    let dir = temp_dir("peak-memory");
+    let mut scenes: Vec<String> = std::fs::read_dir("assets/scenes")
+        .expect("scenes")
+        .map(|e| e.expect("entry").path().to_string_lossy().into_owned())
+        .filter(|p| p.ends_with(".toml"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 10, "{scenes:?}");
+    // Self-collision lists that hold most pairs of particles: the estimate counts them.
+    let sheet = |name: &str, n: usize, y: f64, t: f64| {
+        format!(
+            "[cloth.{name}]\nresolution = [{n}, {n}]\norientation = \"horizontal\"\n\
+             center = [0.0, {y}, 0.0]\nthickness = {t}\n\n"
+        )
+    };
+    let two = sheet("a", 48, 1.001, 10.0) + &sheet("b", 48, 1.0, 10.0) + "[self_collision]\n";
+    scenes.push(write(&dir, "two.toml", &two));
+    scenes.push(write(
+        &dir,
+        "thick.toml",
+        &(sheet("a", 96, 1.0, 0.5) + "[self_collision]\n"),
+    ));
+    for scene in &scenes {
+        // `explode.toml` shows mass-spring blowing up; with enough substeps it runs on.
+        let extra: &[&str] = if scene.ends_with("explode.toml") {
+            &["--set", "sim.substeps=60"]
+        } else {
+            &[]
+        };
+        let (peak, estimate) = peak_and_estimate(scene, extra, &dir);
+        println!(
+            "{scene}: peak {:.0} MiB, estimate {:.0} MiB",
+            peak / 1048576.0,
+            estimate / 1048576.0
+        );
+        assert!(
+            peak <= 1.5 * estimate,
+            "{scene}: peak {peak} > 1.5 × {estimate}"
+        );
+    }
 }

@@ -1,7 +1,7 @@
 //! Limits a load enforces before it reads or allocates: the largest file read, and the memory
 //! the scene may need once built, estimated from its particle count before any cloth exists.
 
-use crate::scene::DEFAULT_MAX_FILE_BYTES;
+use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, SelfCollisionSpec};
 use crate::schema::SceneFile;
 
 /// What a load may read and allocate.
@@ -30,33 +30,130 @@ impl Default for Limits {
 /// EPYC, AVX-512 path); rounded up for scenes with more constraints.
 pub const BYTES_PER_PARTICLE: u64 = 1200;
 
-/// Extra bytes per particle with self-collision on (the spatial grid and contact lists):
-/// measured 240 on a 512² grid, rounded up.
+/// Extra bytes per self-collision member (its cell in the grid, anchors, tags, the contact
+/// sweep's corrections): measured 240 on a 512² grid, rounded up. The candidate pairs are
+/// counted apart ([`BYTES_PER_PAIR`]).
 pub const PER_PARTICLE_SELF_COLLISION: u64 = 400;
 
-/// Particles of every grid cloth in `file`, read from the resolutions alone (a mesh cloth's
-/// file is capped by [`Limits::max_file_bytes`] instead).
-pub(crate) fn grid_particles(file: &SceneFile) -> Vec<(String, u64)> {
+/// Bytes a candidate pair of self-collision costs at most: its entry in the list (two `u32`
+/// indices and an `f64` target, 16 bytes, with the room a growing list keeps) and, while it
+/// touches, the sweep's two 32-byte corrections. Measured: 84 bytes a listed pair at the
+/// peak of two coincident 48² sheets 10 m thick, where every listed pair touches.
+pub const BYTES_PER_PAIR: u64 = 96;
+
+/// The process before any scene: the binary, the allocator's arenas, the threads' stacks and
+/// the log's compressor (a run of a 20 × 20 cloth peaks at 12–25 MiB).
+pub const BASE_BYTES: u64 = 32 << 20;
+
+/// The largest skin (as a fraction of the thickness) an adaptive self-collision list keeps
+/// while it is dense; it grows thicker only while the list is sparse.
+const DENSE_MARGIN: f64 = 1.0;
+
+/// A self-collision member cloth as the estimate sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Member {
+    /// Its particles.
+    pub particles: u64,
+    /// Its rest area (m²).
+    pub area: f64,
+    /// Its collision thickness (m).
+    pub thickness: f64,
+}
+
+/// A bound on the candidate pairs self-collision lists for `members` with search margin
+/// `margin` (the starting one when `adaptive`). A particle's partners lie within
+/// R = t (1 + m) of it (t the largest thickness); layers the contacts keep t apart fit
+/// 2R/t + 1 deep into that ball, each holding at most π R² / a particles (a the smallest area
+/// per particle); and no particle has more partners than the other members.
+pub fn self_collision_pairs(members: &[Member], margin: f64, adaptive: bool) -> u64 {
+    let total: u64 = members.iter().map(|m| m.particles).sum();
+    let t = members.iter().map(|m| m.thickness).fold(0.0, f64::max);
+    if total < 2 || t <= 0.0 {
+        return 0;
+    }
+    let margin = if adaptive {
+        margin.max(DENSE_MARGIN)
+    } else {
+        margin
+    };
+    let reach = t * (1.0 + margin);
+    let per_particle = members
+        .iter()
+        .filter(|m| m.particles > 0)
+        .map(|m| m.area / m.particles as f64)
+        .fold(f64::INFINITY, f64::min);
+    let layers = 2.0 * reach / t + 1.0;
+    let partners =
+        (layers * std::f64::consts::PI * reach * reach / per_particle).min((total - 1) as f64);
+    // Each pair is listed once.
+    (total as f64 * partners / 2.0).ceil() as u64
+}
+
+/// The memory a scene of `particles` needs once built and running: the process, the
+/// particles, and with self-collision its `members` and their candidate `pairs` (see
+/// [`self_collision_pairs`]).
+pub fn estimate_bytes(particles: u64, members: u64, pairs: u64) -> u64 {
+    BASE_BYTES
+        .saturating_add(particles.saturating_mul(BYTES_PER_PARTICLE))
+        .saturating_add(members.saturating_mul(PER_PARTICLE_SELF_COLLISION))
+        .saturating_add(pairs.saturating_mul(BYTES_PER_PAIR))
+}
+
+/// Every grid cloth of `file` as the estimate sees it, read from its keys alone (a mesh or
+/// garment cloth's file is capped by [`Limits::max_file_bytes`] instead), and whether
+/// self-collision takes it in.
+pub(crate) fn grid_members(file: &SceneFile) -> Vec<(String, Member, bool)> {
+    let chosen = (file.self_collision.as_ref())
+        .filter(|s| s.enabled)
+        .map(|s| s.cloths.clone());
     file.cloth
         .iter()
-        .filter(|(_, s)| s.mesh.is_none())
+        .filter(|(_, s)| s.mesh.is_none() && s.garment.is_none())
         .map(|(name, s)| {
             let [nx, ny] = s.resolution.unwrap_or([20, 20]);
-            let n = (nx.clamp(0, 4096) as u64) * (ny.clamp(0, 4096) as u64);
-            (name.clone(), n)
+            let particles = (nx.clamp(0, 4096) as u64) * (ny.clamp(0, 4096) as u64);
+            let [w, h] = s.size.unwrap_or([1.0, 1.0]);
+            let member = Member {
+                particles,
+                area: (w * h).abs(),
+                thickness: s.thickness.unwrap_or(0.005).abs(),
+            };
+            let collides = match &chosen {
+                None => false,
+                Some(None) => true,
+                Some(Some(names)) => names.contains(name),
+            };
+            (name.clone(), member, collides)
         })
         .collect()
 }
 
-/// The memory `particles` need once built.
-pub fn estimate_bytes(particles: u64, self_collision: bool) -> u64 {
-    let per = BYTES_PER_PARTICLE
-        + if self_collision {
-            PER_PARTICLE_SELF_COLLISION
-        } else {
-            0
-        };
-    particles.saturating_mul(per)
+/// The self-collision members of a built scene of `cloths` and a bound on their candidate
+/// pairs (see [`self_collision_pairs`]); zeros without self-collision `sc`.
+pub(crate) fn built_pairs(cloths: &[ClothSpec], sc: Option<&SelfCollisionSpec>) -> (u64, u64) {
+    let Some(sc) = sc else {
+        return (0, 0);
+    };
+    let members: Vec<Member> = cloths
+        .iter()
+        .filter(|c| sc.cloths.contains(&c.name))
+        .map(|c| Member {
+            particles: c.mesh.len() as u64,
+            area: c.mesh.area(),
+            thickness: c.thickness,
+        })
+        .collect();
+    let count = members.iter().map(|m| m.particles).sum();
+    let pairs = self_collision_pairs(&members, sc.search_margin, sc.adaptive_search_margin);
+    (count, pairs)
+}
+
+/// The memory a built scene of `cloths`, with self-collision `sc`, needs (mesh cloths and
+/// garments included; see [`estimate_bytes`]).
+pub(crate) fn built_bytes(cloths: &[ClothSpec], sc: Option<&SelfCollisionSpec>) -> u64 {
+    let particles: u64 = cloths.iter().map(|c| c.mesh.len() as u64).sum();
+    let (members, pairs) = built_pairs(cloths, sc);
+    estimate_bytes(particles, members, pairs)
 }
 
 /// `bytes` for people: "3.2 GiB".

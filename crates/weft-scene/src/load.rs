@@ -6,7 +6,10 @@ use std::path::Path;
 use toml_edit::DocumentMut;
 
 use crate::error::{Origin, SceneError, SceneErrors};
-use crate::limits::{Limits, estimate_bytes, grid_particles, human};
+use crate::limits::{
+    BYTES_PER_PAIR, Limits, Member, built_bytes, estimate_bytes, grid_members, human,
+    self_collision_pairs,
+};
 use crate::overrides::{self, Override};
 use crate::resolve::{Checker, resolve};
 use crate::scene::{CappedDirFiles, Files, Scene, read_regular};
@@ -105,11 +108,39 @@ pub fn from_text_with(
         }
     })?;
     if let Some((cap, origin)) = &limits.max_memory {
-        let grids = grid_particles(&file);
-        let total: u64 = grids.iter().map(|(_, n)| n).sum();
-        let need = estimate_bytes(total, file.self_collision.is_some());
+        let grids = grid_members(&file);
+        let total: u64 = grids.iter().map(|(_, m, _)| m.particles).sum();
+        let members: Vec<Member> = (grids.iter()).filter(|g| g.2).map(|g| g.1).collect();
+        let (margin, adaptive) = (file.self_collision.as_ref()).map_or((0.0, false), |s| {
+            (s.search_margin, s.adaptive_search_margin)
+        });
+        let pairs = self_collision_pairs(&members, margin, adaptive);
+        let count = members.iter().map(|m| m.particles).sum();
+        let need = estimate_bytes(total, count, pairs);
+        let thickest =
+            (grids.iter().filter(|g| g.2)).max_by(|a, b| a.1.thickness.total_cmp(&b.1.thickness));
+        let by_pairs = pairs.saturating_mul(BYTES_PER_PAIR) > need / 2;
         if need > *cap
-            && let Some((largest, _)) = grids.iter().max_by_key(|(_, n)| *n)
+            && by_pairs
+            && let Some((name, m, _)) = thickest
+        {
+            return Err(src
+                .error(
+                    &format!("cloth.{name}.thickness"),
+                    format!(
+                        "self-collision at this thickness ({} m) may list {pairs} pairs of \
+                         particles, and the scene needs about {} once built, more than the {} \
+                         allowed ({origin}); lower the thickness, or raise the limit with \
+                         --max-memory",
+                        m.thickness,
+                        human(need),
+                        human(*cap)
+                    ),
+                )
+                .into());
+        }
+        if need > *cap
+            && let Some((largest, _, _)) = grids.iter().max_by_key(|(_, m, _)| m.particles)
         {
             return Err(src
                 .error(
@@ -133,7 +164,7 @@ pub fn from_text_with(
     if let Some((cap, origin)) = &limits.max_memory {
         // Exact now, mesh cloths included.
         let total: u64 = parts.cloths.iter().map(|c| c.mesh.len() as u64).sum();
-        let need = estimate_bytes(total, parts.self_collision.is_some());
+        let need = built_bytes(&parts.cloths, parts.self_collision.as_ref());
         if need > *cap {
             return Err(src
                 .error(

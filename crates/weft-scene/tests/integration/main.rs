@@ -10,6 +10,7 @@ mod friction;
 mod fuzz;
 mod glb_character;
 mod material_key;
+mod memory_estimate;
 mod mesh_drape;
 mod self_fold;
 mod shipped_scenes;
