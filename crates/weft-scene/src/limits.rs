@@ -1,7 +1,7 @@
 //! Limits a load enforces before it reads or allocates: the largest file read, and the memory
 //! the scene may need once built, estimated from its particle count before any cloth exists.
 
-use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, SelfCollisionSpec};
+use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, Scene, SelfCollisionSpec};
 use crate::schema::SceneFile;
 
 /// What a load may read and allocate.
@@ -154,6 +154,18 @@ pub(crate) fn built_bytes(cloths: &[ClothSpec], sc: Option<&SelfCollisionSpec>) 
     let particles: u64 = cloths.iter().map(|c| c.mesh.len() as u64).sum();
     let (members, pairs) = built_pairs(cloths, sc);
     estimate_bytes(particles, members, pairs)
+}
+
+impl Scene {
+    /// The memory the scene needs once built and running (the estimate its load checked).
+    pub fn estimated_bytes(&self) -> u64 {
+        built_bytes(&self.cloths, self.self_collision.as_ref())
+    }
+
+    /// The most candidate pairs its self-collision can list (0 without self-collision).
+    pub fn self_collision_pair_bound(&self) -> u64 {
+        built_pairs(&self.cloths, self.self_collision.as_ref()).1
+    }
 }
 
 /// `bytes` for people: "3.2 GiB".

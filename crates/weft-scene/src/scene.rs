@@ -266,16 +266,6 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// The memory the scene needs once built and running (the estimate its load checked).
-    pub fn estimated_bytes(&self) -> u64 {
-        crate::limits::built_bytes(&self.cloths, self.self_collision.as_ref())
-    }
-
-    /// The most candidate pairs its self-collision can list (0 without self-collision).
-    pub fn self_collision_pair_bound(&self) -> u64 {
-        crate::limits::built_pairs(&self.cloths, self.self_collision.as_ref()).1
-    }
-
     /// The methods used, in cloth order, each once: a scene yields one solver per method.
     pub fn methods(&self) -> Vec<Method> {
         let mut out = Vec::new();
