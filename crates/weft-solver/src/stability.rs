@@ -25,20 +25,20 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::constraints::{
-    Block, ConstraintSet, Dihedral, Distance, Isometric, Seam, Shape, Tether,
-};
+use crate::constraints::{Block, ConstraintSet, Isometric, Seam, Shape, Tether};
 use crate::params::FamilyParams;
 
-/// How fast a cloth's springs can ring and how much their dampers can bite.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How fast a cloth's springs can ring and how much their dampers can bite (all zero: no
+/// springs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StabilityBound {
     /// Upper bound on the highest angular frequency ω of the springs linearised at rest (rad/s).
     pub omega: f64,
     /// Upper bound on the highest damping rate γ of the spring dampers (1/s).
     pub gamma: f64,
     /// The highest mode itself, ω, estimated by power iteration on M^{-1/2} K M^{-1/2}
-    /// (a Rayleigh quotient: a lower bound on ω that converges to it); ≤ `omega`.
+    /// (a Rayleigh quotient: a lower bound on ω that converges to it); ≤ `omega`. Estimated
+    /// for an explicit method only; otherwise `omega`.
     pub mode_omega: f64,
     /// That mode's damping rate (its Rayleigh quotient of M^{-1/2} D M^{-1/2}).
     pub mode_gamma: f64,
@@ -140,32 +140,53 @@ impl Rows {
     }
 }
 
-/// Adds (a_k K + a_c D) z restricted by √w, i.e. M^{-1/2} (k or c) ∇C ∇Cᵀ M^{-1/2} z, of
-/// every enabled constraint of `block` into `out_k` (stiffness) and `out_c` (damping).
-#[allow(clippy::too_many_arguments)]
-fn product<const N: usize, S: Shape<N>>(
-    block: &Block<N, S>,
-    x: &[DVec3],
-    sw: &[f64],
-    params: &[FamilyParams],
-    grad: impl Fn(&S, &[DVec3; N]) -> Option<[DVec3; N]>,
-    z: &[DVec3],
-    out_k: &mut [DVec3],
-    out_c: &mut [DVec3],
-) {
-    for (idx, p, gr) in enabled_gradients(block, x, params, grad) {
-        let s: f64 = (0..N)
-            .map(|j| gr[j].dot(z[idx[j] as usize]) * sw[idx[j] as usize])
-            .sum();
-        for k in 0..N {
-            let i = idx[k] as usize;
-            out_k[i] += gr[k] * (p.spring_stiffness * s * sw[i]);
-            out_c[i] += gr[k] * (p.spring_damping * s * sw[i]);
+/// The terms of M^{-1/2} K M^{-1/2} and M^{-1/2} D M^{-1/2} for constraints of `N`
+/// particles, each evaluated once: the particles, aⱼ = ∇ⱼC √wⱼ, and the spring's k and c.
+/// A power iteration then costs a pass over them, not a gradient per constraint per pass.
+#[derive(Default)]
+struct Terms<const N: usize> {
+    idx: Vec<[u32; N]>,
+    a: Vec<[DVec3; N]>,
+    kc: Vec<[f64; 2]>,
+}
+
+impl<const N: usize> Terms<N> {
+    /// The terms of every enabled constraint of `block` that touches a particle with
+    /// √w > 0 in `sw` (the others add nothing), with ∇C from `grad` at `x`.
+    fn new<S: Shape<N>>(
+        block: &Block<N, S>,
+        x: &[DVec3],
+        sw: &[f64],
+        params: &[FamilyParams],
+        grad: impl Fn(&S, &[DVec3; N]) -> Option<[DVec3; N]>,
+    ) -> Self {
+        let mut t = Self::default();
+        for (idx, p, gr) in enabled_gradients(block, x, params, grad) {
+            let a: [DVec3; N] = std::array::from_fn(|j| gr[j] * sw[idx[j] as usize]);
+            if a.iter().all(|v| *v == DVec3::ZERO) {
+                continue;
+            }
+            t.idx.push(idx);
+            t.a.push(a);
+            t.kc.push([p.spring_stiffness, p.spring_damping]);
+        }
+        t
+    }
+
+    /// Adds M^{-1/2} K M^{-1/2} z into `out_k` and M^{-1/2} D M^{-1/2} z into `out_c`.
+    fn product(&self, z: &[DVec3], out_k: &mut [DVec3], out_c: &mut [DVec3]) {
+        for ((idx, a), [k, c]) in self.idx.iter().zip(&self.a).zip(&self.kc) {
+            let s: f64 = (0..N).map(|j| a[j].dot(z[idx[j] as usize])).sum();
+            for j in 0..N {
+                let i = idx[j] as usize;
+                out_k[i] += a[j] * (k * s);
+                out_c[i] += a[j] * (c * s);
+            }
         }
     }
 }
 
-/// Power iterations for the highest mode.
+/// Power iterations for the highest mode (at most).
 const POWER_ITERATIONS: usize = 150;
 
 /// The highest mode's (ω, γ) of the particles in `range`, by power iteration.
@@ -187,6 +208,25 @@ fn highest_mode(
             }
         })
         .collect();
+    let distance = Terms::new(&constraints.distance, x, &sw, params, |s, p| {
+        s.evaluate(p).map(|(_, g)| g)
+    });
+    let dihedral = Terms::new(&constraints.dihedral, x, &sw, params, |s, p| {
+        s.evaluate(p).map(|(_, g)| g)
+    });
+    let isometric = Terms::new(&constraints.isometric, x, &sw, params, isometric_gradient);
+    let tethers = Terms::new(&constraints.tethers, x, &sw, params, |_: &Tether, p| {
+        let d = p[0] - p[1];
+        let len = d.length();
+        (len > 1e-9).then(|| [d / len, -d / len])
+    });
+    let seams = Terms::new(
+        &constraints.seams,
+        x,
+        &sw,
+        &constraints.seam_params,
+        |s: &Seam, p| s.evaluate(p).map(|(_, g)| g),
+    );
     // A deterministic start with every sign pattern in it (the highest modes alternate).
     let mut z: Vec<DVec3> = (0..x.len())
         .map(|i| {
@@ -206,64 +246,11 @@ fn highest_mode(
         z.iter_mut().for_each(|v| *v /= norm);
         kz.fill(DVec3::ZERO);
         cz.fill(DVec3::ZERO);
-        let g = |s: &Distance, p: &[DVec3; 2]| s.evaluate(p).map(|(_, g)| g);
-        product(
-            &constraints.distance,
-            x,
-            &sw,
-            params,
-            g,
-            &z,
-            &mut kz,
-            &mut cz,
-        );
-        let g = |s: &Dihedral, p: &[DVec3; 4]| s.evaluate(p).map(|(_, g)| g);
-        product(
-            &constraints.dihedral,
-            x,
-            &sw,
-            params,
-            g,
-            &z,
-            &mut kz,
-            &mut cz,
-        );
-        product(
-            &constraints.isometric,
-            x,
-            &sw,
-            params,
-            isometric_gradient,
-            &z,
-            &mut kz,
-            &mut cz,
-        );
-        let g = |_: &Tether, p: &[DVec3; 2]| {
-            let d = p[0] - p[1];
-            let len = d.length();
-            (len > 1e-9).then(|| [d / len, -d / len])
-        };
-        product(
-            &constraints.tethers,
-            x,
-            &sw,
-            params,
-            g,
-            &z,
-            &mut kz,
-            &mut cz,
-        );
-        let g = |s: &Seam, p: &[DVec3; 2]| s.evaluate(p).map(|(_, g)| g);
-        product(
-            &constraints.seams,
-            x,
-            &sw,
-            &constraints.seam_params,
-            g,
-            &z,
-            &mut kz,
-            &mut cz,
-        );
+        distance.product(&z, &mut kz, &mut cz);
+        dihedral.product(&z, &mut kz, &mut cz);
+        isometric.product(&z, &mut kz, &mut cz);
+        tethers.product(&z, &mut kz, &mut cz);
+        seams.product(&z, &mut kz, &mut cz);
         lambda = dot(&z, &kz);
         damping = dot(&z, &cz);
         std::mem::swap(&mut z, &mut kz);
@@ -271,13 +258,15 @@ fn highest_mode(
     (lambda.max(0.0).sqrt(), damping.max(0.0))
 }
 
-/// The bound for the particles in `range`, linearised at positions `x` with inverse masses `w`.
+/// The bound for the particles in `range`, linearised at positions `x` with inverse masses `w`;
+/// with `mode`, the highest mode estimated too (otherwise its fields repeat the bound).
 pub(crate) fn bound(
     constraints: &ConstraintSet,
     x: &[DVec3],
     w: &[f64],
     params: &[FamilyParams],
     range: Range<usize>,
+    mode: bool,
 ) -> StabilityBound {
     let mut rows = Rows {
         k: vec![0.0; x.len()],
@@ -304,10 +293,15 @@ pub(crate) fn bound(
         |s, p| s.evaluate(p).map(|(_, g)| g),
     );
     let max = |v: &[f64]| v[range.clone()].iter().copied().fold(0.0, f64::max);
-    let (mode_omega, mode_gamma) = highest_mode(constraints, x, w, params, range.clone());
+    let (omega, gamma) = (max(&rows.k).sqrt(), max(&rows.c));
+    let (mode_omega, mode_gamma) = if mode {
+        highest_mode(constraints, x, w, params, range.clone())
+    } else {
+        (omega, gamma)
+    };
     StabilityBound {
-        omega: max(&rows.k).sqrt(),
-        gamma: max(&rows.c),
+        omega,
+        gamma,
         mode_omega,
         mode_gamma,
     }
