@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use crate::cloth::ClothMesh;
 use crate::constraints::{
-    BlockBuilder, ConstraintSet, Dihedral, Distance, Isometric, Seam, Tether,
+    Block, BlockBuilder, ConstraintSet, Dihedral, Distance, Isometric, Seam, Shape, Tether,
 };
 use crate::error::{BuildError, ParamError};
 use crate::forces::Forces;
@@ -32,6 +32,17 @@ pub struct SolverBuilder {
     tethers: BlockBuilder<2, Tether>,
     seams: BlockBuilder<2, Seam>,
     seam_params: Vec<FamilyParams>,
+    pins: Vec<KinematicPin>,
+}
+
+/// A builder's parts once its constraint blocks are finished.
+struct Finished {
+    constraints: ConstraintSet,
+    settings: Settings,
+    forces: Forces,
+    particles: Particles,
+    cloths: Vec<Cloth>,
+    params: Vec<FamilyParams>,
     pins: Vec<KinematicPin>,
 }
 
@@ -236,27 +247,70 @@ impl SolverBuilder {
 
     /// Colours the constraints and returns the solver.
     pub fn build(self) -> Solver {
-        let free: Vec<bool> = self.particles.inv_masses.iter().map(|&w| w > 0.0).collect();
-        let constraints = ConstraintSet {
-            distance: self.distance.finish(&free),
-            dihedral: self.dihedral.finish(&free),
-            isometric: self.isometric.finish(&free),
-            tethers: self.tethers.finish(&free),
-            seams: self.seams.finish(&free),
-            seam_params: self.seam_params,
-            isometric_forward: false,
-            isometric_constants: Default::default(),
-        };
-        let n = self.particles.len();
+        let p = self.finish(true);
+        let n = p.particles.len();
         Solver::assemble(
-            self.settings,
-            self.forces,
-            self.particles,
-            self.cloths,
-            self.params,
-            constraints,
-            self.pins,
+            p.settings,
+            p.forces,
+            p.particles,
+            p.cloths,
+            p.params,
+            p.constraints,
+            p.pins,
             vec![DVec3::ZERO; n],
         )
+    }
+
+    /// Gershgorin's bound on the springs' ω of cloth `cloth` (see
+    /// [`StabilityBound`](crate::StabilityBound)) from what was added, without building a
+    /// solver: its domains cost many times the bound.
+    pub(crate) fn spring_omega(self, cloth: usize) -> f64 {
+        let p = self.finish(false);
+        p.cloths.get(cloth).map_or(0.0, |c| {
+            crate::stability::bound(
+                &p.constraints,
+                &p.particles.positions,
+                &p.particles.inv_masses,
+                &p.params,
+                c.particles.clone(),
+                false,
+            )
+            .omega
+        })
+    }
+
+    /// What the solver is assembled from, its constraint blocks finished: coloured for the
+    /// solver's sweeps when `ordered`, as added otherwise.
+    fn finish(self, ordered: bool) -> Finished {
+        let free: Vec<bool> = self.particles.inv_masses.iter().map(|&w| w > 0.0).collect();
+        fn block<const N: usize, S: Shape<N>>(
+            b: BlockBuilder<N, S>,
+            free: &[bool],
+            ordered: bool,
+        ) -> Block<N, S> {
+            if ordered {
+                b.finish(free)
+            } else {
+                b.unordered()
+            }
+        }
+        Finished {
+            constraints: ConstraintSet {
+                distance: block(self.distance, &free, ordered),
+                dihedral: block(self.dihedral, &free, ordered),
+                isometric: block(self.isometric, &free, ordered),
+                tethers: block(self.tethers, &free, ordered),
+                seams: block(self.seams, &free, ordered),
+                seam_params: self.seam_params,
+                isometric_forward: false,
+                isometric_constants: Default::default(),
+            },
+            settings: self.settings,
+            forces: self.forces,
+            particles: self.particles,
+            cloths: self.cloths,
+            params: self.params,
+            pins: self.pins,
+        }
     }
 }

@@ -13,7 +13,6 @@ use crate::error::BuildError;
 use crate::forces::Forces;
 use crate::params::{ClothParams, Family};
 use crate::settings::Settings;
-use crate::solver::Solver;
 
 /// The substep the default spring constants are chosen for (s): dt = 1/60 s in 10 substeps.
 pub const DEFAULT_SPRING_SUBSTEP: f64 = 1.0 / 600.0;
@@ -73,8 +72,7 @@ pub fn stable_spring_defaults(
 fn probe_omega(mesh: &ClothMesh, params: ClothParams) -> Result<f64, BuildError> {
     let mut b = SolverBuilder::new(Settings::default(), Forces::default())?;
     let cloth = b.add_cloth("probe", mesh, params, 0.0)?;
-    let solver: Solver = b.build();
-    Ok(solver.stability(cloth).map_or(0.0, |s| s.omega))
+    Ok(b.spring_omega(cloth))
 }
 
 #[cfg(test)]

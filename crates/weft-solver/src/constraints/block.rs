@@ -109,6 +109,17 @@ impl<const N: usize, S: Shape<N>> BlockBuilder<N, S> {
         self.shapes.push(shape);
     }
 
+    /// The constraints as added, uncoloured: enough for a single pass over them (the
+    /// stability bound), not for a solver's sweeps.
+    pub fn unordered(self) -> Block<N, S> {
+        Block {
+            particles: self.particles,
+            group: self.group,
+            shapes: self.shapes,
+            ..Block::default()
+        }
+    }
+
     /// Colours the constraints (ignoring particles that are not `free`) and sorts them by colour,
     /// and inside a colour by particle part (see [`parts`]).
     pub fn finish(self, free: &[bool]) -> Block<N, S> {
