@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::collider::{default_dynamic_friction, default_static_friction};
+use super::exact;
 
 /// How a clip continues past its end: `loop` or `clamp`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
@@ -44,11 +45,19 @@ pub struct CharacterSection {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub animation: Option<AnimationKey>,
     /// Where the `model`'s origin goes (m, after `scale` and `rotation_deg`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "exact::option",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub position: Option<[f64; 3]>,
     /// The `model`'s rotation as XYZ Euler angles in degrees (e.g. `[-90, 0, 0]` for a z-up
     /// file), applied after `scale`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "exact::option",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub rotation_deg: Option<[f64; 3]>,
     /// `walker`, `cmu` (built-in body tables) or a body-table TOML file.
     #[serde(default = "default_walker")]
@@ -91,9 +100,14 @@ pub struct AttachSection {
     /// The panel (name in the garment file).
     pub panel: String,
     /// First and last outline edge, inclusive (as in the garment's seams).
+    #[serde(deserialize_with = "exact::array")]
     pub edges: [i64; 2],
     /// The part of that run to attach, as fractions of its vertices from its first corner
     /// to its last (default `[0, 1]`: all of it).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "exact::option",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub span: Option<[f64; 2]>,
 }

@@ -6,7 +6,7 @@ use serde::de::{self, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use weft_solver::Family;
 
-use super::{AttachSection, MethodName, MotionSpec};
+use super::{AttachSection, MethodName, MotionSpec, exact};
 use crate::family::Setting;
 
 /// The plane of a grid cloth.
@@ -134,10 +134,18 @@ cloth_section! {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub method: Option<MethodName>,
         /// Grid particles `[columns, rows]` (grid cloths).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(
+            default,
+            deserialize_with = "exact::option",
+            skip_serializing_if = "Option::is_none"
+        )]
         pub resolution: Option<[i64; 2]>,
         /// Grid size `[width, height]` (m).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(
+            default,
+            deserialize_with = "exact::option",
+            skip_serializing_if = "Option::is_none"
+        )]
         pub size: Option<[f64; 2]>,
         /// Grid plane: `vertical` or `horizontal`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -149,7 +157,11 @@ cloth_section! {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub scale: Option<f64>,
         /// Centre of a grid, or translation of a mesh (m).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(
+            default,
+            deserialize_with = "exact::option",
+            skip_serializing_if = "Option::is_none"
+        )]
         pub center: Option<[f64; 3]>,
         /// Total mass (kg); give this or `density`.
         #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::MotionSpec;
+use super::{MotionSpec, exact};
 
 /// A collider's shape kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
@@ -48,23 +48,35 @@ macro_rules! shape_section {
             #[serde(default, skip_serializing_if = "Option::is_none")]
             pub radius: Option<f64>,
             /// Cuboid half extents (m).
-            #[serde(default, skip_serializing_if = "Option::is_none")]
+            #[serde(
+                default,
+                deserialize_with = "exact::option",
+                skip_serializing_if = "Option::is_none"
+            )]
             pub half_extents: Option<[f64; 3]>,
             /// Capsule half height of the core segment (m).
             #[serde(default, skip_serializing_if = "Option::is_none")]
             pub half_height: Option<f64>,
             /// Plane outward normal.
-            #[serde(default, skip_serializing_if = "Option::is_none")]
+            #[serde(
+                default,
+                deserialize_with = "exact::option",
+                skip_serializing_if = "Option::is_none"
+            )]
             pub normal: Option<[f64; 3]>,
             /// Convex hull points (m).
-            #[serde(default, skip_serializing_if = "Option::is_none")]
+            #[serde(
+                default,
+                deserialize_with = "exact::option_list",
+                skip_serializing_if = "Option::is_none"
+            )]
             pub points: Option<Vec<[f64; 3]>>,
             $($middle)*
             /// Position in the parent frame (the world for a collider) (m).
-            #[serde(default)]
+            #[serde(default, deserialize_with = "exact::array")]
             pub position: [f64; 3],
             /// Rotation as XYZ Euler angles in degrees.
-            #[serde(default)]
+            #[serde(default, deserialize_with = "exact::array")]
             pub rotation_deg: [f64; 3],
             $($trail)*
         }

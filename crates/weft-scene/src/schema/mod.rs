@@ -11,6 +11,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 mod character;
 mod cloth;
 mod collider;
+mod exact;
 
 pub use character::{AnimationKey, AttachSection, CharacterSection, WrapName};
 pub use cloth::{ClothSection, OrientationName, PinSpec};
@@ -128,7 +129,7 @@ pub struct SimSection {
     #[serde(default = "default_iterations")]
     pub iterations: i64,
     /// Gravitational acceleration (m/s²).
-    #[serde(default = "default_gravity")]
+    #[serde(default = "default_gravity", deserialize_with = "exact::array")]
     pub gravity: [f64; 3],
     /// Global velocity damping rate (1/s).
     #[serde(default)]
@@ -173,7 +174,7 @@ impl Default for SimSection {
 #[serde(deny_unknown_fields)]
 pub struct WindSection {
     /// Wind velocity (m/s).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::array")]
     pub velocity: [f64; 3],
     /// Uniform drag rate (1/s).
     #[serde(default)]
@@ -217,11 +218,13 @@ pub enum MotionSpec {
     /// Constant velocity (m/s).
     Linear {
         /// Velocity (m/s).
+        #[serde(deserialize_with = "exact::array")]
         velocity: [f64; 3],
     },
     /// x₀ + A sin(2π f t).
     Oscillate {
         /// Amplitude (m).
+        #[serde(deserialize_with = "exact::array")]
         amplitude: [f64; 3],
         /// Frequency (Hz).
         frequency: f64,
@@ -229,8 +232,10 @@ pub enum MotionSpec {
     /// Rotation about an axis through a pivot.
     Rotate {
         /// A point on the axis (m).
+        #[serde(deserialize_with = "exact::array")]
         pivot: [f64; 3],
         /// Axis direction.
+        #[serde(deserialize_with = "exact::array")]
         axis: [f64; 3],
         /// Angular velocity (rad/s).
         angular_velocity: f64,
