@@ -5,6 +5,7 @@
 
 mod build;
 mod collide;
+mod duplicate;
 mod error;
 pub mod family;
 mod limits;

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use toml_edit::DocumentMut;
 
+use crate::duplicate::{Duplicate, duplicate};
 use crate::error::{Origin, SceneError, SceneErrors};
 use crate::limits::{
     BYTES_PER_PAIR, Limits, Member, built_bytes, estimate_bytes, grid_members, human,
@@ -91,6 +92,13 @@ pub fn from_text_with(
         message,
     };
     let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
+        let found = e
+            .span()
+            .filter(|_| e.message() == "duplicate key")
+            .and_then(|at| duplicate(text, at));
+        if let Some(d) = found {
+            return duplicate_error(name, d);
+        }
         let line = e.span().map(|s| line_at(text, s.start));
         file_error(line, format!("not valid TOML: {}", first_line(e.message())))
     })?;
@@ -196,6 +204,30 @@ pub fn from_text_with(
     })
 }
 
+/// The error for a key defined twice in the file `name`.
+fn duplicate_error(name: &str, d: Duplicate) -> SceneError {
+    let first = match d.first {
+        Some(l) if l == d.second => format!("defined twice on line {l}"),
+        Some(l) => format!("first defined on line {l}, again on line {}", d.second),
+        None => format!("defined again on line {}", d.second),
+    };
+    let (key, message) = match d.key {
+        Some(key) => (key, format!("duplicate key: {first}")),
+        None => (
+            String::new(),
+            format!("duplicate key `{}`: {first}", d.name),
+        ),
+    };
+    SceneError {
+        origin: Origin::File {
+            path: name.to_owned(),
+            line: Some(d.second),
+        },
+        key,
+        message,
+    }
+}
+
 fn first_line(s: &str) -> &str {
     s.lines().next().unwrap_or(s).trim()
 }
@@ -254,6 +286,27 @@ mod tests {
     fn self_collision(section: &str) -> Result<Scene, SceneErrors> {
         let text = format!("{CLOTH}[self_collision]\n{section}");
         from_text("s.toml", &text, &[], &DirFiles(".".into()))
+    }
+
+    #[test]
+    fn a_duplicate_key_names_the_file_the_key_and_both_lines() {
+        let err = |text: &str| {
+            from_text("d.toml", text, &[], &DirFiles(".".into()))
+                .expect_err("duplicate")
+                .to_string()
+        };
+        assert_eq!(
+            err("[sim]\ndt = 0.01\ndt = 0.02\n"),
+            "d.toml:3: sim.dt: duplicate key: first defined on line 2, again on line 3"
+        );
+        assert_eq!(
+            err(&format!("{CLOTH}[sim]\ndt = 0.01\n\n[sim]\nsubsteps = 2\n")),
+            "d.toml:8: sim: duplicate key: first defined on line 5, again on line 8"
+        );
+        assert_eq!(
+            err("[cloth.c]\nmotion = { kind = \"static\", kind = \"linear\" }\n"),
+            "d.toml:2: cloth.c.motion.kind: duplicate key: defined twice on line 2"
+        );
     }
 
     #[test]

@@ -53,29 +53,40 @@ impl Source {
 
     /// 1-based line of `key` (or of its nearest enclosing key that exists).
     pub fn line_of(&self, key: &str) -> Option<usize> {
+        self.find_line(key).map(|(line, _)| line)
+    }
+
+    /// 1-based line of `key` itself, if the file has it.
+    pub fn exact_line_of(&self, key: &str) -> Option<usize> {
+        self.find_line(key)
+            .and_then(|(line, exact)| exact.then_some(line))
+    }
+
+    /// The line of `key` or of its nearest enclosing key that exists, and whether it is
+    /// `key`'s own.
+    fn find_line(&self, key: &str) -> Option<(usize, bool)> {
         let doc = self.doc.as_ref()?;
         let raw = doc.raw();
         let mut node = Node::Table(doc.as_table());
         let mut best = None;
+        let mut exact = false;
         for (name, index) in split_key(key) {
             let Some((span, child)) = node.get(name) else {
-                break;
+                return best.map(|l| (l, false));
             };
-            if let Some(s) = span {
-                best = Some(line_at(raw, s.start));
-            }
+            exact = span.is_some();
+            best = span.map(|s| line_at(raw, s.start)).or(best);
             node = child;
             if let Some(i) = index {
                 let Some((span, child)) = node.index(i) else {
-                    break;
+                    return best.map(|l| (l, false));
                 };
-                if let Some(s) = span {
-                    best = Some(line_at(raw, s.start));
-                }
+                exact = span.is_some();
+                best = span.map(|s| line_at(raw, s.start)).or(best);
                 node = child;
             }
         }
-        best
+        best.map(|l| (l, exact))
     }
 }
 

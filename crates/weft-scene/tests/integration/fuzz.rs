@@ -121,14 +121,17 @@ fn mutate(text: &str, muts: &[Mutation]) -> String {
     lines.join("\n") + "\n"
 }
 
-/// Every error names the file and a line or a key (or comes from the command line).
+/// Every error names the file and a line or a key (or comes from the command line); a
+/// duplicate key names its key.
 fn well_named(errors: &SceneErrors, name: &str) -> Result<(), String> {
     for e in &errors.0 {
         let ok = match &e.origin {
             Origin::File { path, line } => path == name && (line.is_some() || !e.key.is_empty()),
             Origin::CommandLine => !e.key.is_empty(),
         };
-        if !ok || e.message.is_empty() {
+        // A duplicate key names the key, not only the line of its second definition.
+        let duplicate = e.message.contains("duplicate key");
+        if !ok || e.message.is_empty() || duplicate && e.key.is_empty() {
             return Err(format!("badly named error: {e:?}"));
         }
     }
