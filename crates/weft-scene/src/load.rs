@@ -112,7 +112,14 @@ pub fn from_text_with(
         let message = tidy(e.message());
         match e.span().and_then(|s| key_at(&effective, s.start)) {
             Some(key) => src.error(&key, message),
-            None => file_error(e.span().map(|s| line_at(&effective, s.start)), message),
+            // Lines of the effective text are the file's only while no override moved them.
+            None if effective == text => {
+                file_error(e.span().map(|s| line_at(text, s.start)), message)
+            }
+            None => file_error(
+                None,
+                format!("{message} (with the --set overrides applied)"),
+            ),
         }
     })?;
     if let Some((cap, origin)) = &limits.max_memory {
@@ -234,9 +241,7 @@ fn first_line(s: &str) -> &str {
 
 /// Shortens serde's messages: long lists of expected keys become a "did you mean".
 fn tidy(message: &str) -> String {
-    let message = first_line(message)
-        .replace("expected i64", "expected an integer")
-        .replace("expected f64", "expected a number");
+    let message = plain_types(first_line(message));
     let message = message.as_str();
     let Some(rest) = message.strip_prefix("unknown field `") else {
         return message.to_owned();
@@ -245,11 +250,7 @@ fn tidy(message: &str) -> String {
         return message.to_owned();
     };
     let expected: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
-    let best = expected
-        .iter()
-        .min_by_key(|c| edit_distance(field, c))
-        .filter(|c| edit_distance(field, c) <= 3.max(field.len() / 3));
-    match best {
+    match closest(field, &expected) {
         Some(b) => format!("unknown key `{field}` (did you mean `{b}`?)"),
         None if expected.len() <= 8 && !expected.is_empty() => {
             format!(
@@ -259,6 +260,44 @@ fn tidy(message: &str) -> String {
         }
         None => format!("unknown key `{field}` (see the scene key reference in docs/scenes.md)"),
     }
+}
+
+/// `message` in the scene's terms: serde's Rust types (`i64`, `struct SimSection`, `map`,
+/// `sequence`) named as TOML ones.
+fn plain_types(message: &str) -> String {
+    let mut out = message
+        .replace("expected i64", "expected an integer")
+        .replace("expected f64", "expected a number")
+        .replace("invalid type: map", "invalid type: table")
+        .replace("invalid type: sequence", "invalid type: array")
+        .replace("expected a map", "expected a table")
+        .replace("expected a sequence", "expected an array")
+        .replace("wanted string or table", "expected a name (a string)");
+    for (rust, toml) in [
+        (
+            "expected internally tagged enum ",
+            "expected a table with a `kind`",
+        ),
+        ("expected struct ", "expected a table"),
+    ] {
+        while let Some(at) = out.find(rust) {
+            let name = &out[at + rust.len()..];
+            let end = name
+                .find(|c: char| !c.is_ascii_alphanumeric() && c != '_')
+                .unwrap_or(name.len());
+            out.replace_range(at..at + rust.len() + end, toml);
+        }
+    }
+    out
+}
+
+/// The candidate close enough to `word` to be what was meant, if any.
+pub(crate) fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    candidates
+        .iter()
+        .copied()
+        .min_by_key(|c| edit_distance(word, c))
+        .filter(|c| edit_distance(word, c) <= 3.max(word.len() / 3))
 }
 
 fn edit_distance(a: &str, b: &str) -> usize {

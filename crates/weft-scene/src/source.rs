@@ -34,21 +34,47 @@ impl Source {
         })
     }
 
-    /// An error about `key`, located at the key's line or on the command line.
+    /// An error about `key`, located at the key's line or on the command line. A key the
+    /// file does not have, made by a `--set` of a key below it (a table the override
+    /// created), is placed at that `--set`.
     pub fn error(&self, key: &str, message: impl Into<String>) -> SceneError {
-        let origin = if self.is_overridden(key) {
-            Origin::CommandLine
-        } else {
-            Origin::File {
+        let message = message.into();
+        if self.is_overridden(key) {
+            return SceneError {
+                origin: Origin::CommandLine,
+                key: key.to_owned(),
+                message,
+            };
+        }
+        if let Some(o) = self.made_by_override(key) {
+            return SceneError {
+                origin: Origin::CommandLine,
+                key: o.to_owned(),
+                message,
+            };
+        }
+        SceneError {
+            origin: Origin::File {
                 path: self.path.clone(),
                 line: self.line_of(key),
-            }
-        };
-        SceneError {
-            origin,
+            },
             key: key.to_owned(),
-            message: message.into(),
+            message,
         }
+    }
+
+    /// The `--set` key below `key` that made it, if the file does not have `key`.
+    fn made_by_override(&self, key: &str) -> Option<&str> {
+        if self.doc.is_some() && self.exact_line_of(key).is_some() {
+            return None;
+        }
+        self.overridden
+            .iter()
+            .find(|o| {
+                o.strip_prefix(key)
+                    .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
+            })
+            .map(String::as_str)
     }
 
     /// 1-based line of `key` (or of its nearest enclosing key that exists).
@@ -198,12 +224,14 @@ fn find_in_table(entries: Vec<Entry<'_>>, offset: usize, path: &mut String) -> b
 
 fn find_in_item(item: &Item, offset: usize, path: &mut String) -> bool {
     match item {
-        Item::Table(t) => find_in_table(t.iter_spans(), offset, path),
+        // A table's span is its header: an error about the table as a whole (a missing
+        // key, a table where a list belongs) points there.
+        Item::Table(t) => find_in_table(t.iter_spans(), offset, path) || contains(t.span(), offset),
         Item::ArrayOfTables(a) => {
             for (i, t) in a.iter().enumerate() {
                 let base = path.len();
                 path.push_str(&format!("[{i}]"));
-                if find_in_table(t.iter_spans(), offset, path) {
+                if find_in_table(t.iter_spans(), offset, path) || contains(t.span(), offset) {
                     return true;
                 }
                 path.truncate(base);
@@ -261,5 +289,11 @@ mod tests {
         assert_eq!(at("0.01").as_deref(), Some("sim.dt"));
         assert_eq!(at("[1, 2").as_deref(), Some("cloth.flag.motion.velocity"));
         assert_eq!(at("2\n").as_deref(), Some("collider[1].radius"));
+        // An error about a table as a whole points at its header.
+        assert_eq!(at("[cloth.flag]").as_deref(), Some("cloth.flag"));
+        assert_eq!(at("[[collider]]\nradius").as_deref(), Some("collider[1]"));
+        assert_eq!(s.exact_line_of("collider[1]"), Some(11));
+        assert_eq!(s.exact_line_of("collider[1].shape"), None);
+        assert_eq!(s.line_of("collider[1].shape"), Some(11));
     }
 }
