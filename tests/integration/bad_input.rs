@@ -172,6 +172,70 @@ fn command_line_overrides_are_reported_as_such() {
 }
 
 #[test]
+fn overrides_never_add_a_cloth_or_a_list_entry() {
+    // A typo for the cloth `flag` used to add a second cloth; a negative index used to blame
+    // a line past the end of the file.
+    let (path, err) = check_fails("set-cloth", SMALL, &["--set", "cloth.flg.mass=5"]);
+    assert!(
+        err.contains(
+            "command line (--set cloth.flg.mass): cloth.flg.mass: no cloth named `flg` in the \
+             scene (did you mean `flag`?); its cloths: flag"
+        ),
+        "{err}"
+    );
+    let out = run(&["check", &path, "--set", "collider[-1].radius=1"]);
+    let (_, err) = texts(&out);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "command line (--set collider[-1].radius): collider[-1].radius: [-1] is a negative \
+             index, which is not valid"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains(&format!("{path}:")), "{err}");
+    let (_, err) = check_fails("set-list", SMALL, &["--set", "collider[0].radius=1"]);
+    assert!(
+        err.contains(
+            "collider[0].radius: the scene has no `collider` entries, so [0] does not exist"
+        ),
+        "{err}"
+    );
+    // Sections the file lacks are still made.
+    let dir = temp_dir("set-sections");
+    let cloth = SMALL.find("[cloth.flag]").expect("a cloth");
+    let bare = write(&dir, "bare.toml", &SMALL[cloth..]);
+    for set in [
+        "self_collision.enabled=true",
+        "sim.substeps=20",
+        "wind.aero.drag_coefficient=1",
+    ] {
+        let out = run(&["check", &bare, "--set", set]);
+        assert!(out.status.success(), "{set}: {:?}", texts(&out));
+    }
+}
+
+#[test]
+fn arrays_of_the_wrong_length_and_duplicate_keys_name_file_line_and_key() {
+    let text = SMALL.replace("resolution = [8, 8]", "resolution = [8, 8, 1]");
+    let (path, err) = check_fails("length", &text, &[]);
+    assert!(
+        err.contains(&format!(
+            "{path}:8: cloth.flag.resolution: takes 2 values, got 3"
+        )),
+        "{err}"
+    );
+    let text = SMALL.replace("damping = 0.1", "damping = 0.1\ndt = 0.02");
+    let (path, err) = check_fails("duplicate", &text, &[]);
+    assert!(
+        err.contains(&format!(
+            "{path}:6: sim.dt: duplicate key: first defined on line 3, again on line 6"
+        )),
+        "{err}"
+    );
+}
+
+#[test]
 fn missing_scene_file_fails_cleanly() {
     let out = run(&["run", "no/such/scene.toml", "--frames", "1"]);
     let (_, err) = texts(&out);
