@@ -97,6 +97,41 @@ pub struct PlannedRun {
     pub x: BTreeMap<String, f64>,
 }
 
+/// A step into an experiments file: a key or an array index.
+enum Seg {
+    Key(String),
+    Index(usize),
+}
+
+impl std::fmt::Display for Seg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Seg::Key(k) if k.contains('.') => write!(f, ".{}", Value::String(k.clone())),
+            Seg::Key(k) => write!(f, ".{k}"),
+            Seg::Index(i) => write!(f, "[{i}]"),
+        }
+    }
+}
+
+/// Where in `v` a null is (TOML has none: serde_json makes one of NaN and the infinities).
+fn null_at(v: &Value) -> Option<Vec<Seg>> {
+    let below = |seg: Seg, v: &Value| {
+        null_at(v).map(|mut rest| {
+            rest.insert(0, seg);
+            rest
+        })
+    };
+    match v {
+        Value::Null => Some(Vec::new()),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| below(Seg::Index(i), v)),
+        Value::Object(o) => o.iter().find_map(|(k, v)| below(Seg::Key(k.clone()), v)),
+        _ => None,
+    }
+}
+
 /// A JSON value written as TOML text for an override.
 pub fn toml_text(v: &Value) -> String {
     match v {
@@ -169,7 +204,69 @@ impl Spec {
                 path.display()
             );
         }
+        spec.check_finite(path, &text)?;
         Ok(spec)
+    }
+
+    /// Refuses a `set` or `vary` value that is, or holds, NaN or an infinity. No scene key
+    /// takes one, and the JSON values they are kept in cannot hold one: serde_json reads it
+    /// as null, which reached the scene as the string "null" and the report as `null`.
+    fn check_finite(&self, path: &Path, text: &str) -> anyhow::Result<()> {
+        let mut values: Vec<(Vec<Seg>, &Value)> = Vec::new();
+        for (k, v) in &self.set {
+            values.push((vec![Seg::Key("set".into()), Seg::Key(k.clone())], v));
+        }
+        for (i, s) in self.series.iter().enumerate() {
+            let series = || vec![Seg::Key("series".into()), Seg::Index(i)];
+            for (k, v) in &s.set {
+                let mut at = series();
+                at.extend([Seg::Key("set".into()), Seg::Key(k.clone())]);
+                values.push((at, v));
+            }
+            for (k, list) in &s.vary {
+                for (j, v) in list.iter().enumerate() {
+                    let mut at = series();
+                    at.extend([Seg::Key("vary".into()), Seg::Key(k.clone()), Seg::Index(j)]);
+                    values.push((at, v));
+                }
+            }
+        }
+        for (mut at, v) in values {
+            let Some(inside) = null_at(v) else {
+                continue;
+            };
+            at.extend(inside);
+            let key: String = at.iter().map(|s| s.to_string()).collect();
+            let key = key.trim_start_matches('.');
+            let found = toml_edit::Document::parse(text).ok().and_then(|doc| {
+                let mut item = doc.as_item();
+                for seg in &at {
+                    item = match seg {
+                        Seg::Key(k) => item.get(k.as_str())?,
+                        Seg::Index(i) => item.get(*i)?,
+                    };
+                }
+                let span = item.span()?;
+                let line = text.get(..span.start)?.matches('\n').count() + 1;
+                Some((line, text.get(span)?.trim().to_owned()))
+            });
+            let (line, raw) = found.unwrap_or_default();
+            let line = if line > 0 {
+                format!("{line}:")
+            } else {
+                String::new()
+            };
+            let got = if raw.is_empty() {
+                "NaN or an infinity".into()
+            } else {
+                raw
+            };
+            bail!(
+                "{}:{line} {key}: must be a finite number, got {got}",
+                path.display()
+            );
+        }
+        Ok(())
     }
 
     /// The base scene's path.

@@ -92,3 +92,38 @@ fn bad_experiment_runs_are_refused_before_any_simulation() {
     assert!(e.contains("command line (--set sim.substeps)"), "{e}");
     assert!(!dir.join("out/results/run-0.json").exists());
 }
+
+#[test]
+fn a_non_finite_set_or_swept_value_is_an_error_naming_its_line_and_key() {
+    // serde_json reads NaN and the infinities as null: the run was labelled
+    // `sim.damping=null` and the scene got the string "null".
+    let dir = temp_dir("experiments-nan");
+    write(&dir, "small.toml", SMALL);
+    let head = "scene = \"small.toml\"\nframes = 5\nmetrics = [\"sag\"]\n";
+    for (name, body, want) in [
+        (
+            "vary",
+            "[[series]]\nname = \"x\"\nvary = { \"sim.damping\" = [0.5, nan] }\n",
+            ":6: series[0].vary.\"sim.damping\"[1]: must be a finite number, got nan",
+        ),
+        (
+            "set",
+            "set = { \"sim.gravity\" = [0, -inf, 0] }\n[[series]]\nname = \"x\"\n",
+            ":4: set.\"sim.gravity\"[1]: must be a finite number, got -inf",
+        ),
+        (
+            "series-set",
+            "[[series]]\nname = \"x\"\n[[series]]\nname = \"y\"\n[series.set]\n\"sim.damping\" = +inf\n",
+            ":9: series[1].set.\"sim.damping\": must be a finite number, got +inf",
+        ),
+    ] {
+        let exp = write(&dir, &format!("{name}.toml"), &format!("{head}{body}"));
+        let out_dir = dir.join(format!("out-{name}"));
+        let out = run(&["experiments", &exp, "--out", &out_dir.to_string_lossy()]);
+        let (_, e) = texts(&out);
+        assert!(!out.status.success(), "{name}: {e}");
+        assert!(e.contains(&format!("{exp}{want}")), "{name}: {e}");
+        assert!(!e.contains("null"), "{name}: {e}");
+        assert!(!out_dir.join("results").exists(), "{name}: ran anyway");
+    }
+}
