@@ -7,13 +7,14 @@ use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::process::ExitCode;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use mcap::read::{ChunkReader, LinearReader, Options};
 use mcap::records::{MessageHeader, Metadata, Record};
 use mcap::{Attachment, Compression, WriteOptions};
 
 use crate::cli::RecoverArgs;
 use crate::output::{Named, Output, refuse_clashes};
+use crate::record::verify::looks_like_mcap;
 
 /// What was recovered.
 #[derive(Debug, Default, PartialEq, Eq)]
@@ -114,6 +115,9 @@ pub fn rebuild<W: std::io::Write + std::io::Seek>(
             other => keep(other, &mut kept, &mut frames_channel),
         }
     }
+    if kept.is_empty() {
+        bail!("no record in it reads whole: nothing to recover");
+    }
     let mut w = WriteOptions::new()
         .compression(Some(Compression::Zstd))
         .compression_threads(0)
@@ -181,6 +185,16 @@ pub fn recover(args: &RecoverArgs) -> anyhow::Result<ExitCode> {
     )?;
     let bytes = weft_scene::read_regular(&args.log, u64::MAX)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.log.display()))?;
+    let log = args.log.display();
+    if bytes.is_empty() {
+        bail!("{log} is empty: nothing to recover");
+    }
+    if !looks_like_mcap(&bytes) {
+        bail!(
+            "{log} is not an MCAP log (it does not start with MCAP's magic bytes): refusing to \
+             recover it"
+        );
+    }
     let out = Output::create(&args.out)?;
     let target = out.target().display().to_string();
     let (report, file) = rebuild(&bytes, BufWriter::new(out.handle()?))

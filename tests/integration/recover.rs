@@ -146,3 +146,39 @@ fn a_log_with_flipped_bytes_is_called_corrupt() {
     assert!(e.contains("is corrupt"), "{e}");
     assert!(!o.contains("replay differs"), "{o}");
 }
+
+#[test]
+fn a_file_that_is_not_mcap_is_refused_and_nothing_is_written() {
+    let dir = temp_dir("recover-not-mcap");
+    // Bytes that look like nothing: a small linear congruential generator.
+    let mut x: u32 = 61;
+    let noise: Vec<u8> = (0..4096)
+        .map(|_| {
+            x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (x >> 24) as u8
+        })
+        .collect();
+    let mut magic_then_noise = mcap::MAGIC.to_vec();
+    magic_then_noise.extend(&noise);
+    for (name, bytes, says) in [
+        ("s.toml", b"a = 1\n".to_vec(), "is not an MCAP log"),
+        ("noise.bin", noise, "is not an MCAP log"),
+        ("empty.mcap", Vec::new(), "is empty"),
+        ("magic.mcap", magic_then_noise, "nothing to recover"),
+    ] {
+        let input = dir.join(name);
+        std::fs::write(&input, bytes).expect("write");
+        let fixed = dir.join("o.mcap");
+        let out = run(&[
+            "recover",
+            &input.to_string_lossy(),
+            "--out",
+            &fixed.to_string_lossy(),
+        ]);
+        let (o, e) = texts(&out);
+        assert_eq!(out.status.code(), Some(1), "{name}: {o}{e}");
+        assert!(e.contains(says), "{name}: {e}");
+        assert!(!fixed.exists(), "{name}: no recovered log");
+        assert!(!partial(&fixed).exists(), "{name}: no temporary file left");
+    }
+}
