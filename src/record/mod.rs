@@ -6,4 +6,4 @@ pub mod messages;
 pub mod verify;
 mod writer;
 
-pub use writer::{RecordOptions, Recorder, Status};
+pub use writer::{CHANNELS, RecordOptions, Recorder, Status, foxglove_schema};

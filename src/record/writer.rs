@@ -10,6 +10,7 @@ use foxglove::Encode;
 use foxglove::messages::{PointCloud, SceneUpdate};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::{Attachment, Compression, WriteOptions, Writer};
+use serde_json::{Value, json};
 
 use crate::record::{body, collider_state, messages};
 use crate::sim::{FrameStats, Simulation};
@@ -61,9 +62,56 @@ pub struct Recorder {
     buf: Vec<u8>,
 }
 
-fn schema_of<T: Encode>(w: &mut Writer<BufWriter<File>>) -> anyhow::Result<u16> {
+/// The metadata record that describes a log's channels again, outside chunks: the recorder
+/// adds every schema and channel to the log's first chunk, and when that chunk is damaged
+/// `weft recover` rebuilds them from this. Keys are channel ids; each value is a JSON object
+/// with the channel's `topic`, `message_encoding` and `schema` (`id`, `name`, `encoding`, and
+/// for a JSON schema its `text`; a foxglove schema is named only, see [`foxglove_schema`]).
+pub const CHANNELS: &str = "weft.channels";
+
+/// The data of the foxglove schema called `name` (as the recorder writes it), if it is one.
+pub fn foxglove_schema(name: &str) -> Option<Vec<u8>> {
+    [PointCloud::get_schema(), SceneUpdate::get_schema()]
+        .into_iter()
+        .flatten()
+        .find(|s| s.name == name)
+        .map(|s| s.data.into_owned())
+}
+
+/// A schema added to a log: its id, and how the [`CHANNELS`] metadata describes it.
+type Added = (u16, Value);
+
+/// Adds the foxglove schema of `T`, described by its name.
+fn schema_of<T: Encode>(w: &mut Writer<BufWriter<File>>) -> anyhow::Result<Added> {
     let s = T::get_schema().context("foxglove schema missing")?;
-    Ok(w.add_schema(&s.name, &s.encoding, &s.data)?)
+    let id = w.add_schema(&s.name, &s.encoding, &s.data)?;
+    Ok((
+        id,
+        json!({"id": id, "name": s.name, "encoding": s.encoding}),
+    ))
+}
+
+/// Adds a JSON schema, described with its text.
+fn json_schema(w: &mut Writer<BufWriter<File>>, name: &str, text: &str) -> anyhow::Result<Added> {
+    let id = w.add_schema(name, "jsonschema", text.as_bytes())?;
+    Ok((
+        id,
+        json!({"id": id, "name": name, "encoding": "jsonschema", "text": text}),
+    ))
+}
+
+/// Adds a channel, and its entry to `described` (the [`CHANNELS`] metadata).
+fn channel(
+    w: &mut Writer<BufWriter<File>>,
+    described: &mut BTreeMap<String, String>,
+    schema: &Added,
+    topic: &str,
+    encoding: &str,
+) -> anyhow::Result<u16> {
+    let id = w.add_channel(schema.0, topic, encoding, &BTreeMap::new())?;
+    let entry = json!({"topic": topic, "message_encoding": encoding, "schema": schema.1});
+    described.insert(id.to_string(), entry.to_string());
+    Ok(id)
 }
 
 impl Recorder {
@@ -81,8 +129,8 @@ impl Recorder {
             .create(BufWriter::new(file))?;
         let pc = schema_of::<PointCloud>(&mut w)?;
         let su = schema_of::<SceneUpdate>(&mut w)?;
-        let st = w.add_schema("weft.FrameStats", "jsonschema", STATS_SCHEMA.as_bytes())?;
-        let none = BTreeMap::new();
+        let st = json_schema(&mut w, "weft.FrameStats", STATS_SCHEMA)?;
+        let mut described = BTreeMap::new();
         let scene = &sim.scene;
         // A character's body is logged with the colliders, and moves every frame.
         let has_body = !crate::body::parts(sim).is_empty() || scene.model.is_some();
@@ -91,29 +139,40 @@ impl Recorder {
         let mut meshes = Vec::new();
         for c in &scene.cloths {
             let topic = format!("/cloth/{}/particles", c.name);
-            particles.push(w.add_channel(pc, &topic, "protobuf", &none)?);
+            particles.push(channel(&mut w, &mut described, &pc, &topic, "protobuf")?);
             if options.mesh_every > 0 {
                 let topic = format!("/cloth/{}/mesh", c.name);
-                meshes.push(w.add_channel(su, &topic, "protobuf", &none)?);
+                meshes.push(channel(&mut w, &mut described, &su, &topic, "protobuf")?);
             }
         }
         let colliders = if no_colliders {
             None
         } else {
-            Some(w.add_channel(su, "/colliders", "protobuf", &none)?)
+            Some(channel(
+                &mut w,
+                &mut described,
+                &su,
+                "/colliders",
+                "protobuf",
+            )?)
         };
-        let stats = w.add_channel(st, "/stats", "json", &none)?;
+        let stats = channel(&mut w, &mut described, &st, "/stats", "json")?;
         // Added after every older schema and channel, so theirs keep their ids.
         let collider_state = if no_colliders {
             None
         } else {
-            let cs = w.add_schema(
+            let cs = json_schema(
+                &mut w,
                 collider_state::SCHEMA_NAME,
-                "jsonschema",
-                collider_state::schema().as_bytes(),
+                &collider_state::schema(),
             )?;
-            Some(w.add_channel(cs, collider_state::TOPIC, "json", &none)?)
+            let topic = collider_state::TOPIC;
+            Some(channel(&mut w, &mut described, &cs, topic, "json")?)
         };
+        w.write_metadata(&Metadata {
+            name: CHANNELS.into(),
+            metadata: described,
+        })?;
         let overrides: Vec<String> = scene.overrides.iter().map(|o| o.to_string()).collect();
         let run: BTreeMap<String, String> = [
             ("scene", scene.name.clone()),
@@ -266,17 +325,21 @@ impl Recorder {
     }
 
     /// Adds a JSON channel (described by a JSON schema) for messages written with
-    /// [`Recorder::json`], e.g. the viewer's `/interaction`.
+    /// [`Recorder::json`], e.g. the viewer's `/interaction`, and its own [`CHANNELS`] record.
     pub fn add_json_channel(
         &mut self,
         topic: &str,
         schema_name: &str,
         schema: &str,
     ) -> anyhow::Result<u16> {
-        let id = self
-            .w
-            .add_schema(schema_name, "jsonschema", schema.as_bytes())?;
-        Ok(self.w.add_channel(id, topic, "json", &BTreeMap::new())?)
+        let schema = json_schema(&mut self.w, schema_name, schema)?;
+        let mut described = BTreeMap::new();
+        let id = channel(&mut self.w, &mut described, &schema, topic, "json")?;
+        self.w.write_metadata(&Metadata {
+            name: CHANNELS.into(),
+            metadata: described,
+        })?;
+        Ok(id)
     }
 
     /// Writes one JSON message at simulated time `time` (s) on a channel from

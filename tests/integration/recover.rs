@@ -182,3 +182,106 @@ fn a_file_that_is_not_mcap_is_refused_and_nothing_is_written() {
         assert!(!partial(&fixed).exists(), "{name}: no temporary file left");
     }
 }
+
+/// The records of `bytes` after the opening magic, as (offset, opcode, body length), up to the
+/// first that does not fit.
+fn records(bytes: &[u8]) -> Vec<(usize, u8, usize)> {
+    let mut v = Vec::new();
+    let mut pos = mcap::MAGIC.len();
+    while pos + 9 <= bytes.len() {
+        let len = u64::from_le_bytes(bytes[pos + 1..pos + 9].try_into().expect("8 bytes"));
+        let len = usize::try_from(len).expect("a length");
+        if pos + 9 + len > bytes.len() {
+            break;
+        }
+        v.push((pos, bytes[pos], len));
+        pos += 9 + len;
+    }
+    v
+}
+
+/// Messages in the chunk record at `pos`.
+fn messages_in_chunk(bytes: &[u8], pos: usize, len: usize) -> usize {
+    let record = mcap::parse_record(mcap::records::op::CHUNK, &bytes[pos + 9..pos + 9 + len])
+        .expect("a chunk");
+    let mcap::records::Record::Chunk { header, data } = record else {
+        panic!("not a chunk");
+    };
+    mcap::read::ChunkReader::new(header, &data)
+        .expect("chunk opens")
+        .filter(|r| matches!(r, Ok(mcap::records::Record::Message { .. })))
+        .count()
+}
+
+/// Recovers `bytes` (written to `dir/name`), checks it succeeded and that the recovered log
+/// reads whole, and returns its message count and what recover said.
+fn recovered(dir: &std::path::Path, name: &str, bytes: &[u8]) -> (usize, String) {
+    let damaged = dir.join(name);
+    std::fs::write(&damaged, bytes).expect("write");
+    let fixed = dir.join(format!("fixed-{name}"));
+    let out = run(&[
+        "recover",
+        &damaged.to_string_lossy(),
+        "--out",
+        &fixed.to_string_lossy(),
+    ]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{name}: {o}{e}");
+    let log = read_log(&fixed);
+    assert_eq!(log.metadata["weft.status"]["status"], "recovered");
+    assert!(log.attachments.contains(&"scene/source.toml".to_owned()));
+    (log.counts.values().sum(), o)
+}
+
+#[test]
+fn a_damaged_record_is_skipped_and_every_intact_chunk_is_kept() {
+    let dir = temp_dir("recover-damaged");
+    let log = logged_run(&dir, "s.toml", &big(48), 100, "a.mcap");
+    let whole = std::fs::read(&log).expect("log");
+    // Cut two thirds of the way: no summary (which repeats the schemas and channels), as a
+    // killed run leaves its log.
+    let cut = &whole[..whole.len() * 2 / 3];
+    let chunks: Vec<_> = records(cut)
+        .into_iter()
+        .filter(|r| r.1 == mcap::records::op::CHUNK)
+        .collect();
+    assert!(chunks.len() >= 6, "{} chunks", chunks.len());
+    let (all, _) = recovered(&dir, "cut.mcap", cut);
+    assert_eq!(all, messages_before_the_cut(cut));
+    // The first chunk holds only the schemas and channels; the second holds messages.
+    let (first, second) = (chunks[0], chunks[1]);
+    assert_eq!(messages_in_chunk(cut, first.0, first.2), 0);
+
+    // A flipped byte in a chunk's length field: the chunk reads whole over the records after
+    // it (second byte), or runs past the end of the file (third byte). Before, recovery
+    // stopped there and kept nothing after it; now nothing is lost.
+    for (k, at) in [(1, second.0), (2, second.0), (2, first.0)] {
+        let mut bytes = cut.to_vec();
+        bytes[at + 1 + k] ^= 0xFF;
+        let (n, o) = recovered(&dir, &format!("length-{k}-{at}.mcap"), &bytes);
+        assert!(o.contains("1 damaged stretch"), "{o}");
+        assert_eq!(n, all, "length byte {k} of the chunk at {at}: {o}");
+    }
+
+    // The first chunk damaged inside: its schemas and channels are rebuilt from the
+    // `weft.channels` metadata and every message is kept (before: "Message 1 referenced
+    // unknown channel 1", and no recovered log).
+    let mut bytes = cut.to_vec();
+    bytes[first.0 + 9 + first.2 / 2] ^= 0xFF;
+    let (n, o) = recovered(&dir, "first.mcap", &bytes);
+    assert_eq!(n, all, "{o}");
+    assert!(
+        o.contains("rebuilt") && o.contains("1 damaged chunk"),
+        "{o}"
+    );
+
+    // A chunk of messages damaged inside: only its messages are lost, and said to be.
+    let (at, len) = (chunks[3].0, chunks[3].2);
+    let mut bytes = cut.to_vec();
+    bytes[at + 9 + len / 2] ^= 0xFF;
+    let (n, o) = recovered(&dir, "middle.mcap", &bytes);
+    let lost = messages_in_chunk(cut, at, len);
+    assert!(lost > 0);
+    assert_eq!(n, all - lost, "{o}");
+    assert!(o.contains(&format!("at least {lost} message(s)")), "{o}");
+}
