@@ -299,6 +299,22 @@ impl Output {
         })
     }
 
+    /// Starts writing the MCAP log `target`, as [`Output::create`], after refusing a target that
+    /// is not a regular file (`/dev/null`, a FIFO, a terminal): an MCAP writer seeks back into
+    /// its file to fill in each chunk's length and CRC, which such a file cannot take (written
+    /// to `/dev/null`, a whole run was simulated and then failed to sync it).
+    pub fn create_log(target: &Path) -> anyhow::Result<Self> {
+        if std::fs::metadata(target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+            bail!(
+                "cannot write an MCAP log to {}: it is not a regular file, and an MCAP log is \
+                 written by seeking back into it (to fill in each chunk's length and CRC), which \
+                 a device or a pipe does not allow; give the path of a file",
+                target.display()
+            );
+        }
+        Self::create(target)
+    }
+
     /// The final path.
     pub fn target(&self) -> &Path {
         &self.target

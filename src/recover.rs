@@ -484,7 +484,7 @@ pub fn recover(args: &RecoverArgs) -> anyhow::Result<ExitCode> {
             "{log} is not an MCAP log (it does not start with MCAP's magic bytes): refusing to recover it"
         );
     }
-    let out = Output::create(&args.out)?;
+    let out = Output::create_log(&args.out)?;
     let target = out.target().display().to_string();
     let (report, file) = rebuild(&bytes, BufWriter::new(out.handle()?))
         .with_context(|| format!("recovering {log} into {target}"))?;

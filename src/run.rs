@@ -83,7 +83,7 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
     refuse_clashes(&named_inputs, &outputs)?;
     // Claim the outputs before anything is simulated: an unwritable path, or one another weft
     // is writing, fails now. Nothing appears under the final names until the run is over.
-    let log = plan.out.map(Output::create).transpose()?;
+    let log = plan.out.map(Output::create_log).transpose()?;
     let dump = plan.dump_final.map(Output::create).transpose()?;
     let name = scene.name.clone();
     let mut sim = Simulation::new(scene)?;

@@ -74,7 +74,7 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
             }],
         )?;
     }
-    let file = args.record.as_deref().map(Output::create).transpose()?;
+    let file = args.record.as_deref().map(Output::create_log).transpose()?;
     let sim = Simulation::new(scene)?;
     let log = file
         .map(|f| {

@@ -143,3 +143,35 @@ fn a_full_device_is_named_and_leaves_no_file_passed_off_as_whole() {
     assert!(!target.exists(), "no file under the final name");
     assert!(!partial(&target).exists(), "no partial left");
 }
+
+#[test]
+fn a_log_to_a_device_or_a_pipe_is_refused_before_anything_is_simulated() {
+    let dir = temp_dir("out-device");
+    let scene = write(&dir, "s.toml", &big(48));
+    let fifo = dir.join("pipe.mcap");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    for target in [std::path::Path::new("/dev/null"), fifo.as_path()] {
+        // Before, /dev/null took the whole run (here endless) and then failed to sync it, and
+        // a pipe blocked until a reader came.
+        let child = spawn_logging(&["run", &scene, "--frames", "100000000"], target);
+        let (out, _) = exits_within(child, Duration::from_secs(20));
+        let (_, e) = texts(&out);
+        assert_eq!(out.status.code(), Some(1), "{}: {e}", target.display());
+        assert!(
+            e.contains("not a regular file") && e.contains(&*target.to_string_lossy()),
+            "{e}"
+        );
+        assert!(!e.contains("particles"), "no simulation was built: {e}");
+    }
+    let log = logged_run(&dir, "small.toml", SMALL, 2, "a.mcap");
+    for command in ["recover", "replay"] {
+        let out = run(&[command, &log.to_string_lossy(), "--out", "/dev/null"]);
+        let (_, e) = texts(&out);
+        assert_eq!(out.status.code(), Some(1), "{command}: {e}");
+        assert!(e.contains("not a regular file"), "{command}: {e}");
+    }
+}
