@@ -1,10 +1,11 @@
 //! `weft replay`: re-runs a logged run from the MCAP alone and compares the result.
 
 use std::collections::BTreeMap;
+use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, bail};
 use weft_scene::{MapFiles, Override, Scene};
@@ -115,17 +116,16 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
     let timing: bool = run_value(&log, "timing", "true or false")?;
     // A log cut short (interrupted, recovered) holds fewer frames than were asked for: replay
     // the frames it holds.
-    let frames = match &log.status {
-        Some(st)
-            if matches!(
-                st.get("status").map(String::as_str),
-                Some("interrupted" | "recovered")
-            ) =>
-        {
-            let held = st.get("frames").map(String::as_str).unwrap_or("");
+    let cut_short = log.status.as_ref().and_then(|st| {
+        let status = st.get("status")?;
+        matches!(status.as_str(), "interrupted" | "recovered").then_some((status, st.get("frames")))
+    });
+    let frames = match cut_short {
+        Some((_, held)) => {
+            let held = held.map(String::as_str).unwrap_or("");
             parsed::<u64>("weft.status frames", held, "a frame count")?.min(logged_frames)
         }
-        _ => logged_frames,
+        None => logged_frames,
     };
     let scene = logged_scene(&log, &args.limits.limits())?;
     let out = args.out.clone().unwrap_or_else(|| {
@@ -142,14 +142,173 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
         progress: !args.quiet,
     };
     let code = run::run(scene, &plan, stop)?;
-    let again = std::fs::read(&out)?;
+    if stop.load(Ordering::SeqCst) {
+        return Ok(code);
+    }
+    let again = std::fs::read(&out).with_context(|| format!("cannot read {}", out.display()))?;
+    let name = args.log.display();
     if again == bytes {
-        say!("replay is byte-identical to {}", args.log.display())?;
-    } else {
-        say!(
-            "replay differs from {} (expected if the log was interrupted, diverged, or used --timing)",
-            args.log.display()
-        )?;
+        say!("replay is byte-identical to {name}")?;
+        return Ok(code);
+    }
+    if let Some(difference) = first_difference(&bytes, &again, cut_short.is_some(), timing)? {
+        bail!(
+            "replay differs from {name} {difference}; the replay is in {}",
+            out.display()
+        );
+    }
+    match cut_short {
+        Some((status, _)) => {
+            say!(
+                "replay matches every message of {name} over the {frames} frame(s) it holds ({status} log)"
+            )?;
+        }
+        None => say!(
+            "replay matches every message of {name} (the wall-clock step_ms of --timing aside)"
+        )?,
     }
     Ok(code)
+}
+
+/// Why a replay whose messages differ from its log's does so.
+const NO_REPRODUCTION: &str = ": the logged run does not reproduce (its scene or the simulation \
+                               changed since it was written)";
+
+/// Where a replay first differs from its log, in words: the frame and topic of the first message
+/// that differs, and how; or, when every message matches, the first metadata record or
+/// attachment that differs. Messages are matched by sequence number. A log cut short
+/// (`partial`: interrupted, recovered) is compared over the messages it holds (a recovered log
+/// may lack some), and only by its messages; with `timing`, `/stats` messages are compared
+/// without their wall-clock `step_ms`, and only messages are compared.
+fn first_difference(
+    logged: &[u8],
+    again: &[u8],
+    partial: bool,
+    timing: bool,
+) -> anyhow::Result<Option<String>> {
+    let mut replayed = mcap::MessageStream::new(again)?;
+    // Frame k's messages come before its `/stats` message.
+    let mut frame = 0_u64;
+    for m in mcap::MessageStream::new(logged)? {
+        let m = m?;
+        let topic = &m.channel.topic;
+        let r = loop {
+            match replayed.next().transpose()? {
+                Some(r) if partial && r.sequence < m.sequence => {
+                    frame += u64::from(r.channel.topic == "/stats");
+                }
+                r => break r,
+            }
+        };
+        let at = format!("at frame {frame} on {topic}");
+        let Some(r) = r else {
+            let why = format!("{at} (the replay ends before it){NO_REPRODUCTION}");
+            return Ok((!partial).then_some(why));
+        };
+        let why = if r.channel.topic != *topic {
+            format!("the replay has {} there", r.channel.topic)
+        } else if r.sequence != m.sequence {
+            format!(
+                "message {} of the log is message {} of the replay",
+                m.sequence, r.sequence
+            )
+        } else if r.log_time != m.log_time {
+            format!("log time {} ns, replayed at {} ns", m.log_time, r.log_time)
+        } else if !same_data(topic, &m.data, &r.data, timing) {
+            format!("message {}: its data differ", m.sequence)
+        } else {
+            frame += u64::from(topic == "/stats");
+            continue;
+        };
+        return Ok(Some(format!("{at} ({why}){NO_REPRODUCTION}")));
+    }
+    if let Some(r) = replayed.next().transpose()?
+        && !partial
+    {
+        let topic = &r.channel.topic;
+        return Ok(Some(format!(
+            "at frame {frame} on {topic} (the log ends before it){NO_REPRODUCTION}"
+        )));
+    }
+    if partial || timing {
+        return Ok(None);
+    }
+    outside_messages(logged, again).map(Some)
+}
+
+/// Whether two messages on `topic` hold the same data (for `/stats` with `timing`, the same
+/// JSON but for `step_ms`).
+fn same_data(topic: &str, a: &[u8], b: &[u8], timing: bool) -> bool {
+    let without_step_ms = |d: &[u8]| {
+        let mut v = serde_json::from_slice::<serde_json::Value>(d).ok()?;
+        v.as_object_mut()?.remove("step_ms");
+        Some(v)
+    };
+    a == b
+        || (timing
+            && topic == "/stats"
+            && without_step_ms(a).is_some_and(|a| Some(a) == without_step_ms(b)))
+}
+
+/// The first metadata record (and key) or attachment in which two logs whose messages match
+/// differ, in words.
+fn outside_messages(logged: &[u8], again: &[u8]) -> anyhow::Result<String> {
+    let (a, b) = (records_outside(logged)?, records_outside(again)?);
+    for i in 0..a.len().max(b.len()) {
+        let why = match (a.get(i), b.get(i)) {
+            (Some(x), Some(y)) if x == y => continue,
+            (Some((x, _)), Some((y, _))) if x != y => {
+                format!("the log has {x} where the replay has {y}")
+            }
+            (Some((name, x)), Some((_, y))) => {
+                let key = x.keys().chain(y.keys()).find(|k| x.get(*k) != y.get(*k));
+                let value = |m: &BTreeMap<String, String>, k: &str| {
+                    m.get(k).map_or("nothing".to_owned(), |v| {
+                        format!("{:?}", weft_scene::elide(v))
+                    })
+                };
+                match key {
+                    Some(k) => format!(
+                        "{name}, `{k}`: {} in the log, {} in the replay",
+                        value(x, k),
+                        value(y, k)
+                    ),
+                    None => format!("{name} differs"),
+                }
+            }
+            (Some((name, _)), None) => format!("the replay lacks {name}"),
+            (None, Some((name, _))) => format!("the log lacks {name}"),
+            (None, None) => break,
+        };
+        return Ok(format!(
+            "outside its messages, which all match: {why} (written by another version of weft?)"
+        ));
+    }
+    Ok(
+        "outside its messages, metadata and attachments, which all match (written by another \
+        version of weft?)"
+            .into(),
+    )
+}
+
+/// A log's metadata records and attachments, in order: `metadata NAME` with its keys, and
+/// `attachment NAME` with its size and a hash of its bytes.
+fn records_outside(bytes: &[u8]) -> anyhow::Result<Vec<(String, BTreeMap<String, String>)>> {
+    let summary = mcap::Summary::read(bytes)?.context("the log has no summary section")?;
+    let mut v = Vec::new();
+    for idx in &summary.metadata_indexes {
+        let m = mcap::read::metadata(bytes, idx)?;
+        v.push((format!("metadata {}", m.name), m.metadata));
+    }
+    for idx in &summary.attachment_indexes {
+        let a = mcap::read::attachment(bytes, idx)?;
+        let mut h = DefaultHasher::new();
+        a.data.hash(&mut h);
+        let contents = format!("{} bytes, hash {:016x}", a.data.len(), h.finish());
+        v.push((
+            format!("attachment {}", a.name),
+            BTreeMap::from([("contents".to_owned(), contents)]),
+        ));
+    }
+    Ok(v)
 }

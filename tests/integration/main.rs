@@ -17,6 +17,7 @@ mod output_safety;
 mod recorder;
 mod recover;
 mod render_video;
+mod replay;
 mod small_things;
 mod stops;
 mod viewer;
