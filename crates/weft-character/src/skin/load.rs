@@ -134,6 +134,7 @@ impl SkinnedMesh {
                 doc.buffers().count()
             )));
         }
+        check_channels(doc)?;
         let get = |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice);
         let (nodes, order) = node_tree(doc)?;
         let skin = doc
@@ -316,6 +317,33 @@ fn node_tree(doc: &gltf::Document) -> Result<(Vec<NodeRest>, Vec<usize>), SkinEr
         return Err(SkinError::Invalid("the node hierarchy has a cycle".into()));
     }
     Ok((nodes, order))
+}
+
+/// Refuses animation channels whose target the gltf crate leaves unchecked (its
+/// `Target::property` and `Target::node` panic on them): an unknown property name, or a node
+/// index past the file's nodes.
+fn check_channels(doc: &gltf::Document) -> Result<(), SkinError> {
+    let json = doc.as_json();
+    for (a, animation) in json.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let target = &channel.target;
+            let problem = if !matches!(target.path, gltf::json::validation::Checked::Valid(_)) {
+                "its target property is not translation, rotation, scale or weights".to_owned()
+            } else if target.node.value() >= json.nodes.len() {
+                format!(
+                    "its target node {} is past the file's {} nodes",
+                    target.node.value(),
+                    json.nodes.len()
+                )
+            } else {
+                continue;
+            };
+            return Err(SkinError::Invalid(format!(
+                "animation {a}, channel {c}: {problem}"
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn read_channel<'a, 's, F>(

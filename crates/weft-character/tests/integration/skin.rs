@@ -90,6 +90,21 @@ fn broken_gltf_files_are_errors_not_panics() {
         SkinnedMesh::from_document(&doc, &data).err(),
         Some(SkinError::NoSkinnedMesh)
     );
+    // Channel targets the gltf crate leaves unchecked (it panicked reading them).
+    for (from, to, says) in [
+        (
+            "\"path\" : \"rotation\"",
+            "\"path\" : \"rotatio\"",
+            "target property",
+        ),
+        ("\"node\" : 2,", "\"node\" : 9,", "target node 9"),
+    ] {
+        let (doc, data) = embedded(&text.replacen(from, to, 1));
+        match SkinnedMesh::from_document(&doc, &data) {
+            Err(SkinError::Invalid(m)) => assert!(m.contains(says), "{m}"),
+            other => panic!("{to}: {other:?}"),
+        }
+    }
     let bad_base64 = text.replacen("base64,AAAB", "base64,!AAB", 1);
     assert!(matches!(
         parse_gltf_slice(bad_base64.as_bytes()),
