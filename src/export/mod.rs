@@ -148,8 +148,10 @@ fn run(args: &ExportArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
     )?;
     let bytes = weft_scene::read_regular(path, u64::MAX)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-    if let Err(fault) = crate::record::verify::verify(&bytes) {
-        bail!("{}", fault.message(path));
+    match crate::record::verify::verify(&bytes, stop) {
+        Ok(()) => {}
+        Err(crate::record::verify::Fault::Stopped) => return Err(Stopped.into()),
+        Err(fault) => bail!("{}", fault.message(path)),
     }
     let logged = crate::replay::read_log(&bytes).with_context(|| format!("{}", path.display()))?;
     let scene = crate::replay::logged_scene(&logged, &limits)

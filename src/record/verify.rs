@@ -2,6 +2,7 @@
 //! (chunks, data section, summary) intact. A log cut short points to `weft recover`.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
@@ -17,6 +18,8 @@ pub enum Fault {
     Truncated,
     /// A CRC or a record does not hold: the bytes changed after they were written.
     Corrupt(String),
+    /// The stop flag was raised before the check finished.
+    Stopped,
 }
 
 impl Fault {
@@ -24,6 +27,7 @@ impl Fault {
     pub fn message(&self, path: &Path) -> String {
         let p = path.display();
         match self {
+            Fault::Stopped => format!("the check of {p} was stopped"),
             Fault::Empty => {
                 format!("{p} is empty: the run that wrote it was killed before its first chunk")
             }
@@ -59,8 +63,8 @@ pub fn looks_like_mcap(bytes: &[u8]) -> bool {
 /// Reads every record of `bytes`, checking every CRC. A log is truncated only when its last
 /// record fails and it lacks the closing magic: one that ends with it is whole in length, so a
 /// record running past its end has a damaged length field (corruption, not a cut), and a
-/// record that fails before the last is corruption too.
-pub fn verify(bytes: &[u8]) -> Result<(), Fault> {
+/// record that fails before the last is corruption too. A raised `stop` ends the check.
+pub fn verify(bytes: &[u8], stop: &AtomicBool) -> Result<(), Fault> {
     if bytes.is_empty() {
         return Err(Fault::Empty);
     }
@@ -86,6 +90,10 @@ pub fn verify(bytes: &[u8]) -> Result<(), Fault> {
     let cut = first_unfit(bytes);
     let mut rest = bytes;
     while let Some(event) = reader.next_event() {
+        // Checking a log of hundreds of MB takes seconds: a stop must not wait for it.
+        if stop.load(Ordering::Relaxed) {
+            return Err(Fault::Stopped);
+        }
         match event {
             Ok(LinearReadEvent::ReadRequest(need)) => {
                 let n = need.min(rest.len());
@@ -147,6 +155,9 @@ mod tests {
     use crate::record::{RecordOptions, Recorder, Status};
     use crate::sim::Simulation;
 
+    /// A flag never raised.
+    static GO: AtomicBool = AtomicBool::new(false);
+
     /// A small log: a 4×4 cloth, two frames.
     fn small_log() -> Vec<u8> {
         let text = "[sim]\ndt = \"1/60\"\nsubsteps = 2\n\n[cloth.c]\nresolution = [4, 4]\n\
@@ -178,12 +189,12 @@ mod tests {
     #[test]
     fn a_flipped_byte_is_corruption_and_a_cut_is_truncation() {
         let bytes = small_log();
-        assert_eq!(verify(&bytes), Ok(()));
+        assert_eq!(verify(&bytes, &GO), Ok(()));
         for x in [0xFF_u8, 0x01, 0x80, 0xA5] {
             for i in 0..bytes.len() {
                 let mut b = bytes.clone();
                 b[i] ^= x;
-                let r = verify(&b);
+                let r = verify(&b, &GO);
                 assert!(
                     matches!(r, Err(Fault::Corrupt(_))),
                     "byte {i} of {} xor {x:#04x}: {r:?}",
@@ -192,7 +203,11 @@ mod tests {
             }
         }
         for cut in 1..bytes.len() {
-            assert_eq!(verify(&bytes[..cut]), Err(Fault::Truncated), "cut at {cut}");
+            assert_eq!(
+                verify(&bytes[..cut], &GO),
+                Err(Fault::Truncated),
+                "cut at {cut}"
+            );
         }
         // A killed writer's log: its last chunk has the placeholder header (lengths all ones)
         // and part of its data.
@@ -211,7 +226,14 @@ mod tests {
         killed.extend(b"zstd");
         killed.extend(u64::MAX.to_le_bytes());
         killed.extend(&bytes[100..400]);
-        assert_eq!(verify(&killed), Err(Fault::Truncated));
-        assert_eq!(verify(b"a = 1\n"), Err(Fault::NotMcap));
+        assert_eq!(verify(&killed, &GO), Err(Fault::Truncated));
+        assert_eq!(verify(b"a = 1\n", &GO), Err(Fault::NotMcap));
+    }
+
+    #[test]
+    fn a_raised_stop_ends_the_check() {
+        let bytes = small_log();
+        assert_eq!(verify(&bytes, &AtomicBool::new(true)), Err(Fault::Stopped));
+        assert_eq!(verify(&bytes, &GO), Ok(()));
     }
 }
