@@ -10,6 +10,7 @@ mod e2e_drag;
 mod experiments;
 mod export;
 mod export_body;
+mod fuzz_inputs;
 mod hostile_names;
 mod limits;
 mod mcap_log;
