@@ -135,6 +135,7 @@ impl SkinnedMesh {
             )));
         }
         check_channels(doc)?;
+        check_accessors(doc, buffers)?;
         let get = |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice);
         let (nodes, order) = node_tree(doc)?;
         let skin = doc
@@ -342,6 +343,43 @@ fn check_channels(doc: &gltf::Document) -> Result<(), SkinError> {
                 "animation {a}, channel {c}: {problem}"
             )));
         }
+    }
+    Ok(())
+}
+
+/// Refuses accessors the gltf crate's readers would index out of range or overflow on (with
+/// overflow checks on, a panic): no elements, a stride shorter than an element, or elements
+/// that reach past their buffer view, or a view past its buffer.
+fn check_accessors(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<(), SkinError> {
+    for a in doc.accessors() {
+        let Some(view) = a.view() else { continue };
+        let (count, size) = (a.count(), a.size());
+        let stride = view.stride().unwrap_or(size);
+        let end = count
+            .checked_sub(1)
+            .and_then(|last| last.checked_mul(stride))
+            .and_then(|x| x.checked_add(size))
+            .and_then(|x| x.checked_add(a.offset()));
+        let buffer = buffers.get(view.buffer().index()).map_or(0, Vec::len);
+        let view_end = view.offset().checked_add(view.length());
+        let problem = if count == 0 {
+            "has no elements".to_owned()
+        } else if stride < size {
+            format!("has a stride of {stride} bytes for {size}-byte elements")
+        } else if end.is_none_or(|e| e > view.length()) {
+            format!(
+                "holds {count} elements of {size} bytes, past its buffer view's {} bytes",
+                view.length()
+            )
+        } else if view_end.is_none_or(|e| e > buffer) {
+            format!("reads a buffer view past its buffer's {buffer} bytes")
+        } else {
+            continue;
+        };
+        return Err(SkinError::Invalid(format!(
+            "accessor {} {problem}",
+            a.index()
+        )));
     }
     Ok(())
 }

@@ -98,6 +98,12 @@ fn broken_gltf_files_are_errors_not_panics() {
             "target property",
         ),
         ("\"node\" : 2,", "\"node\" : 9,", "target node 9"),
+        // An accessor count that overflowed the gltf crate's reader.
+        (
+            "\"count\" : 2,",
+            "\"count\" : 18446744073709551615,",
+            "past its buffer view",
+        ),
     ] {
         let (doc, data) = embedded(&text.replacen(from, to, 1));
         match SkinnedMesh::from_document(&doc, &data) {
