@@ -17,6 +17,7 @@ mod resolve;
 mod scene;
 pub mod schema;
 mod source;
+mod suggest;
 
 pub use build::SolverGroup;
 pub use collide::{DelayedSelfCollision, collider_desc};

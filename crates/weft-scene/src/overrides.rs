@@ -5,7 +5,7 @@ use std::str::FromStr;
 use toml_edit::{DocumentMut, InlineTable, Item, Table, TableLike, Value};
 
 use crate::error::{Origin, SceneError};
-use crate::load::closest;
+use crate::suggest::closest;
 
 /// One `KEY=VALUE` override; the value is parsed as TOML, falling back to a string.
 #[derive(Clone, Debug, PartialEq, Eq)]
