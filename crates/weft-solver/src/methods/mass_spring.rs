@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::Strategy;
+use super::{ForcePass, Strategy};
 use crate::constraints::{ConstraintSet, Rule};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
@@ -20,7 +20,7 @@ impl Strategy for MassSpring {
         constraints: &ConstraintSet,
         particles: &Particles,
         params: &[FamilyParams],
-        _h: f64,
+        _pass: ForcePass<'_>,
         force: &mut [DVec3],
         accel: &mut [DVec3],
     ) {

@@ -9,5 +9,5 @@ mod xpbd;
 pub(crate) use implicit_mass_spring::ImplicitMassSpring;
 pub(crate) use mass_spring::MassSpring;
 pub(crate) use pbd::Pbd;
-pub(crate) use strategy::Strategy;
+pub(crate) use strategy::{ForcePass, Strategy};
 pub(crate) use xpbd::Xpbd;

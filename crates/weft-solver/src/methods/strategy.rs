@@ -1,21 +1,39 @@
 //! The strategy a method plugs into the shared substep loop.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, Rule};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
 
+/// The substep a force pass is for: its length, and the flag that abandons the frame.
+#[derive(Clone, Copy)]
+pub(crate) struct ForcePass<'a> {
+    /// The substep h (s).
+    pub h: f64,
+    /// Raised to abandon the frame: a long solve stops early (see `Solver::set_stop`).
+    pub stop: Option<&'a AtomicBool>,
+}
+
+impl ForcePass<'_> {
+    /// Whether the frame is being abandoned.
+    pub fn stopping(&self) -> bool {
+        self.stop.is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+}
+
 /// What distinguishes one method inside the shared substep loop.
 pub(crate) trait Strategy: Sync {
-    /// Adds internal (constraint) accelerations for substep `h` before integration, on top of
-    /// the external ones in `accel`; `force` is scratch.
+    /// Adds internal (constraint) accelerations for the substep of `pass` before integration,
+    /// on top of the external ones in `accel`; `force` is scratch.
     fn add_internal_forces(
         &self,
         _constraints: &ConstraintSet,
         _particles: &Particles,
         _params: &[FamilyParams],
-        _h: f64,
+        _pass: ForcePass<'_>,
         _force: &mut [DVec3],
         _accel: &mut [DVec3],
     ) {

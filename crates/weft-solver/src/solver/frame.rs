@@ -12,6 +12,7 @@ use crate::chunk::CHUNK;
 use crate::constraints::Rule;
 use crate::domains::{AosChunk, Domain, Finish, Integration, Start};
 use crate::hook::{SubstepContext, SubstepHook};
+use crate::methods::ForcePass;
 
 /// How a frame ended.
 pub(super) struct Frame {
@@ -220,11 +221,15 @@ impl Solver {
             if !inline_accel {
                 self.forces
                     .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
+                let pass = ForcePass {
+                    h,
+                    stop: self.stop.as_deref(),
+                };
                 strategy.add_internal_forces(
                     &self.constraints,
                     &self.particles,
                     &self.params,
-                    h,
+                    pass,
                     &mut self.force,
                     &mut self.accel,
                 );
