@@ -216,11 +216,21 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         }
         // Validate every run's scene before simulating any, keeping only its memory estimate:
         // a loaded scene holds its cloths' meshes, so each run loads its own when it starts.
+        // `jobs` at a time, as the runs will go (a scene loaded is less than its run needs).
         let limits = args.limits.limits();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+        let loaded: Vec<_> = pool.install(|| {
+            mine.par_iter()
+                .map(|r| {
+                    weft_scene::load_with(&scene_path, &r.overrides, &limits)
+                        .map(|s| s.estimated_bytes())
+                })
+                .collect()
+        });
         let mut needs = Vec::with_capacity(mine.len());
-        for r in &mine {
-            match weft_scene::load_with(&scene_path, &r.overrides, &limits) {
-                Ok(s) => needs.push(s.estimated_bytes()),
+        for (r, need) in mine.iter().zip(loaded) {
+            match need {
+                Ok(bytes) => needs.push(bytes),
                 Err(e) => bail!("run {} ({} {}):\n{e}", r.index, r.series, r.label),
             }
         }
@@ -241,7 +251,6 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
             .then(weft_render::Gpu::headless)
             .transpose()
             .context("cannot render (--render)")?;
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
         // From here a signal raises the flag: running runs close their logs, runs not yet
         // started are left `not run`.
         let _polling = crate::stop::Polling::start();
