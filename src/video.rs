@@ -26,6 +26,9 @@ use crate::view;
 const GIF_MIN_DELAY_MS: f64 = 20.0;
 /// GIF colour quantisation speed (1 best … 30 fastest).
 const GIF_SPEED: i32 = 10;
+/// The GIF's longest side at most (px): a preview, shrunk from larger images (quantising an
+/// 8192² frame takes seconds); the PNGs keep the full size.
+const GIF_MAX_SIDE: u32 = 1920;
 
 /// Parses `WxH` (e.g. `800x600`) into a size in pixels.
 pub fn parse_size(s: &str) -> Result<UVec2, String> {
@@ -77,6 +80,8 @@ pub struct VideoRecorder<'g> {
     gif_stride: u64,
     gif_delay_ms: u32,
     fps: f64,
+    /// Raised by a signal: the image being written is abandoned (see [`Self::set_stop`]).
+    stop: Option<Arc<AtomicBool>>,
     /// The last image written (kept to mark a divergence).
     last: Option<image::RgbaImage>,
 }
@@ -122,8 +127,22 @@ impl<'g> VideoRecorder<'g> {
             gif_stride,
             gif_delay_ms,
             fps: 1.0 / (sim.scene.settings.dt * every as f64),
+            stop: None,
             last: None,
         })
+    }
+
+    /// A flag polled while an image is written: once raised, the PNG being compressed is
+    /// abandoned (its partial file removed) and no GIF frame is added, so a stop is honoured
+    /// within a second even at 8192².
+    pub fn set_stop(&mut self, flag: Arc<AtomicBool>) {
+        self.stop = Some(flag);
+    }
+
+    fn stopping(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
     /// Images written so far.
@@ -142,13 +161,28 @@ impl<'g> VideoRecorder<'g> {
 
     /// Writes one image as the next PNG (and GIF frame, every `gif_stride`).
     fn write(&mut self, image: image::RgbaImage) -> anyhow::Result<()> {
+        if self.stopping() {
+            return Err(Stopped.into());
+        }
         let png = self.dir.join(format!("frame_{:05}.png", self.images));
-        save_png(&image, &png).with_context(|| format!("cannot write {}", png.display()))?;
+        save_png(&image, &png, self.stop.as_deref())
+            .with_context(|| format!("cannot write {}", png.display()))?;
+        if self.stopping() {
+            return Err(Stopped.into());
+        }
         if self.images % self.gif_stride == 0
             && let Some(gif) = self.gif.as_mut()
         {
             let delay = Delay::from_numer_denom_ms(self.gif_delay_ms, 1);
-            gif.encode_frame(Frame::from_parts(image.clone(), 0, 0, delay))
+            let (w, h) = image.dimensions();
+            let frame = if w.max(h) > GIF_MAX_SIDE {
+                let scale = f64::from(GIF_MAX_SIDE) / f64::from(w.max(h));
+                let size = |v: u32| ((f64::from(v) * scale).round() as u32).max(1);
+                image::imageops::thumbnail(&image, size(w), size(h))
+            } else {
+                image.clone()
+            };
+            gif.encode_frame(Frame::from_parts(frame, 0, 0, delay))
                 .with_context(|| format!("cannot write {}", self.gif_path().display()))?;
         }
         self.images += 1;
@@ -216,6 +250,10 @@ impl<'g> VideoRecorder<'g> {
             // write: check the file ends with the GIF trailer byte (0x3B) instead. An
             // unfinished output removes its partial file when dropped.
             drop(gif);
+            if self.images == 0 && self.stopping() {
+                // Stopped before the first image: nothing to keep, nothing wrong.
+                return Ok(written);
+            }
             if !ends_with_trailer(out.partial()) {
                 bail!("cannot write {} (incomplete)", gif_path.display());
             }
@@ -345,20 +383,67 @@ pub fn mark_diverged(mut image: image::RgbaImage) -> image::RgbaImage {
     image
 }
 
+/// A frame abandoned because the stop flag was raised while it was written.
+#[derive(Debug)]
+pub struct Stopped;
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("stopped while writing an image")
+    }
+}
+
+impl std::error::Error for Stopped {}
+
+/// A writer that fails once `stop` is raised, so an encoder writing through it gives up
+/// between two of its writes.
+struct StopWriter<'a, W> {
+    inner: W,
+    stop: Option<&'a AtomicBool>,
+}
+
+impl<W: std::io::Write> std::io::Write for StopWriter<'_, W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+            return Err(std::io::Error::other(Stopped));
+        }
+        self.inner.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
 /// Writes `image` as a PNG with the strongest compression (about half the default's size),
-/// to its partial file, renamed into place when whole.
-fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
+/// to its partial file, renamed into place when whole; a raised `stop` abandons it (the
+/// partial file is removed) with [`Stopped`].
+fn save_png(
+    image: &image::RgbaImage,
+    path: &Path,
+    stop: Option<&AtomicBool>,
+) -> anyhow::Result<()> {
     use image::ImageEncoder;
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     let out = Output::create(path)?;
-    let mut file = BufWriter::new(out.handle()?);
+    let mut file = StopWriter {
+        inner: BufWriter::new(out.handle()?),
+        stop,
+    };
     PngEncoder::new_with_quality(&mut file, CompressionType::Best, FilterType::Adaptive)
         .write_image(
             image.as_raw(),
             image.width(),
             image.height(),
             image::ExtendedColorType::Rgba8,
-        )?;
+        )
+        .map_err(|e| {
+            if stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+                anyhow::Error::new(Stopped)
+            } else {
+                e.into()
+            }
+        })?;
     std::io::Write::flush(&mut file)?;
     drop(file);
     out.commit()
@@ -419,6 +504,7 @@ pub fn render(
     sim.set_stop(Arc::clone(stop));
     let _polling = crate::stop::Polling::start();
     let mut rec = VideoRecorder::new(&gpu, &sim, plan.out, plan.size, plan.every, plan.options)?;
+    rec.set_stop(Arc::clone(stop));
     eprintln!(
         "weft: rendering {} on {} at {}x{}, every {} frame(s) of {}",
         sim.scene.name,
@@ -459,7 +545,14 @@ pub fn render(
             );
             return Ok(ExitCode::from(EXIT_DIVERGED));
         }
-        rec.frame(&sim)?;
+        match rec.frame(&sim) {
+            Err(e) if e.is::<Stopped>() => {
+                eprintln!("weft: interrupted after {} frames", sim.frame());
+                code = ExitCode::from(EXIT_INTERRUPTED);
+                break;
+            }
+            r => r?,
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -488,6 +581,23 @@ mod tests {
             let e = parse_size(bad).expect_err(bad);
             assert!(e.contains(bad), "{e}");
         }
+    }
+
+    #[test]
+    fn a_raised_stop_abandons_a_png_and_leaves_no_file() {
+        let dir = std::env::temp_dir().join(format!("weft-png-stop-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let img =
+            image::RgbaImage::from_fn(512, 512, |x, y| image::Rgba([x as u8, y as u8, 7, 255]));
+        let path = dir.join("frame.png");
+        let raised = AtomicBool::new(true);
+        let e = save_png(&img, &path, Some(&raised)).expect_err("stopped");
+        assert!(e.is::<Stopped>(), "{e}");
+        let left: Vec<_> = std::fs::read_dir(&dir).expect("dir").collect();
+        assert!(left.is_empty(), "{left:?}");
+        save_png(&img, &path, Some(&AtomicBool::new(false))).expect("written");
+        assert_eq!(image::open(&path).expect("a PNG").to_rgba8(), img);
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
