@@ -177,7 +177,11 @@ mod tests {
             polls.set(polls.get() + 1);
             polls.get() > 3
         });
-        assert_eq!(polls.get(), 4, "polled once per iteration, stopped at the fourth");
+        assert_eq!(
+            polls.get(),
+            4,
+            "polled once per iteration, stopped at the fourth"
+        );
         assert_ne!(full, cut, "three iterations do not solve it");
         let none = conjugate_gradients(&apply, &b, &diag, &w, &|| true);
         assert!(none.iter().all(|v| *v == DVec3::ZERO), "no iteration ran");
