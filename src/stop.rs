@@ -48,3 +48,15 @@ impl Drop for Polling {
         POLLING.fetch_sub(1, Ordering::SeqCst);
     }
 }
+
+/// Work abandoned because the stop flag was raised (an export, an image being written).
+#[derive(Debug)]
+pub struct Stopped;
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("stopped")
+    }
+}
+
+impl std::error::Error for Stopped {}

@@ -20,6 +20,7 @@ use weft_scene::Scene;
 use crate::output::Output;
 use crate::run::{EXIT_DIVERGED, EXIT_INTERRUPTED};
 use crate::sim::Simulation;
+use crate::stop::Stopped;
 use crate::view;
 
 /// Shortest GIF frame delay players honour (ms); faster frames are dropped to keep real time.
@@ -382,18 +383,6 @@ pub fn mark_diverged(mut image: image::RgbaImage) -> image::RgbaImage {
     }
     image
 }
-
-/// A frame abandoned because the stop flag was raised while it was written.
-#[derive(Debug)]
-pub struct Stopped;
-
-impl std::fmt::Display for Stopped {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("stopped while writing an image")
-    }
-}
-
-impl std::error::Error for Stopped {}
 
 /// A writer that fails once `stop` is raised, so an encoder writing through it gives up
 /// between two of its writes.

@@ -14,18 +14,7 @@ use weft_scene::Scene;
 
 use super::collider_track::{ColliderTrack, logged_pose};
 use crate::record::collider_state::{self, ColliderState};
-
-/// The export was stopped by SIGINT or SIGTERM.
-#[derive(Debug)]
-pub struct Stopped;
-
-impl std::fmt::Display for Stopped {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("stopped")
-    }
-}
-
-impl std::error::Error for Stopped {}
+use crate::stop::Stopped;
 
 /// One cloth over the exported frames.
 pub struct ClothTrack {

@@ -25,9 +25,9 @@ use anyhow::{Context, bail};
 
 use crate::cli::{ExportArgs, ExportFormat, Interpolation};
 use crate::output::{Named, Output, refuse_clashes};
-use crate::stop::EXIT_INTERRUPTED;
+use crate::stop::{EXIT_INTERRUPTED, Stopped};
 use estimate::Needs;
-use log::{Stopped, Tracks};
+use log::Tracks;
 
 /// Runs `weft export`.
 pub fn export(args: &ExportArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
