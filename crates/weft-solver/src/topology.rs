@@ -25,32 +25,62 @@ pub struct Topology {
 impl Topology {
     /// Builds the topology of `triangles` (indices must be valid; see [`crate::MeshError`]).
     ///
-    /// Every half-edge (triangle t's edge k is half-edge 3t + k) is sorted by its undirected
-    /// key, so that each edge's uses lie together in the order they appear; edges are then
-    /// numbered by their first use. Two sorts, no hashing and no allocation per edge: a 1024²
-    /// grid's 6 million half-edges take a fraction of a second.
+    /// Every half-edge (triangle t's edge k is half-edge 3t + k) is bucketed by its smaller
+    /// vertex (a counting sort, in order) and each bucket sorted by the other vertex, stably,
+    /// so that each edge's uses lie together in the order they appear; edges are then numbered
+    /// by their first use, walking the half-edges in order. Linear but for the buckets' few
+    /// entries, no hashing and no allocation per edge.
     pub fn new(triangles: &[[u32; 3]]) -> Self {
-        let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-        let mut half: Vec<(u64, u32)> = Vec::with_capacity(3 * triangles.len());
+        let n = triangles
+            .iter()
+            .flatten()
+            .max()
+            .map_or(0, |&m| m as usize + 1);
+        let ends = |tri: &[u32; 3], k: usize| {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            (a.min(b), a.max(b))
+        };
+        // bucket[v]..bucket[v + 1]: the half-edges whose smaller vertex is v.
+        let mut bucket = vec![0u32; n + 1];
+        for tri in triangles {
+            for k in 0..3 {
+                bucket[ends(tri, k).0 as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            bucket[v + 1] += bucket[v];
+        }
+        let mut fill = bucket.clone();
+        // (the larger vertex, the half-edge), by smaller vertex, then larger, then half-edge.
+        let mut half = vec![(0u32, 0u32); 3 * triangles.len()];
         for (t, tri) in triangles.iter().enumerate() {
             for k in 0..3 {
-                half.push((key(tri[k], tri[(k + 1) % 3]), (3 * t + k) as u32));
+                let (lo, hi) = ends(tri, k);
+                half[fill[lo as usize] as usize] = (hi, (3 * t + k) as u32);
+                fill[lo as usize] += 1;
             }
         }
-        // (key, half-edge) pairs are distinct, so the order is unique.
-        half.sort_unstable();
-        // Per edge: its first use and its run of uses in `half`.
-        let mut runs: Vec<(u32, usize, usize)> = Vec::new();
-        let mut start = 0;
-        while start < half.len() {
-            let mut end = start + 1;
-            while end < half.len() && half[end].0 == half[start].0 {
-                end += 1;
-            }
-            runs.push((half[start].1, start, end));
-            start = end;
+        for v in 0..n {
+            half[bucket[v] as usize..bucket[v + 1] as usize].sort_by_key(|&(hi, _)| hi);
         }
-        runs.sort_unstable_by_key(|r| r.0);
+        // Each edge's run of uses in `half`, found at its first use: walking the half-edges in
+        // order then numbers the edges by first use without a second sort.
+        let mut run_at = vec![(0u32, 0u32, 0u32); half.len()];
+        for v in 0..n {
+            let (mut start, end) = (bucket[v] as usize, bucket[v + 1] as usize);
+            while start < end {
+                let mut stop = start + 1;
+                while stop < end && half[stop].0 == half[start].0 {
+                    stop += 1;
+                }
+                run_at[half[start].1 as usize] = (v as u32, start as u32, (stop - start) as u32);
+                start = stop;
+            }
+        }
+        let runs: Vec<(u32, usize, usize)> = (run_at.iter())
+            .filter(|&&(_, _, len)| len > 0)
+            .map(|&(v, start, len)| (v, start as usize, (start + len) as usize))
+            .collect();
         // Half-edge h as (its directed edge, the vertex opposite it).
         let use_of = |h: u32| {
             let (t, k) = ((h / 3) as usize, (h % 3) as usize);
@@ -60,9 +90,8 @@ impl Topology {
         let mut edges = Vec::with_capacity(runs.len());
         let mut wings = Vec::new();
         let mut non_manifold_edges = Vec::new();
-        for &(_, start, end) in &runs {
-            let k = half[start].0;
-            let edge = [(k >> 32) as u32, k as u32];
+        for &(lo, start, end) in &runs {
+            let edge = [lo, half[start].0];
             edges.push(edge);
             match end - start {
                 1 => {}
@@ -105,5 +134,72 @@ mod tests {
     fn three_triangles_on_one_edge_are_non_manifold() {
         let topo = Topology::new(&[[0, 1, 2], [1, 0, 3], [0, 1, 4]]);
         assert_eq!(topo.non_manifold_edges, vec![[0, 1]]);
+    }
+
+    /// The map-based construction this replaces: edges and users in order of appearance.
+    fn by_map(triangles: &[[u32; 3]]) -> Topology {
+        let mut map = std::collections::HashMap::new();
+        let mut users: Vec<Vec<([u32; 2], u32)>> = Vec::new();
+        let mut edges = Vec::new();
+        for t in triangles {
+            for k in 0..3 {
+                let (a, b, opp) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                let key = (a.min(b), a.max(b));
+                let id = *map.entry(key).or_insert_with(|| {
+                    edges.push([key.0, key.1]);
+                    users.push(Vec::new());
+                    edges.len() - 1
+                });
+                users[id].push(([a, b], opp));
+            }
+        }
+        let mut topo = Topology {
+            edges,
+            ..Topology::default()
+        };
+        for (id, u) in users.iter().enumerate() {
+            match u.as_slice() {
+                [(edge, wing_a), (_, wing_b)] => topo.wings.push(EdgeWings {
+                    edge: *edge,
+                    wing_a: *wing_a,
+                    wing_b: *wing_b,
+                }),
+                [_] => {}
+                _ => topo.non_manifold_edges.push(topo.edges[id]),
+            }
+        }
+        topo
+    }
+
+    #[test]
+    fn sorting_half_edges_numbers_edges_as_first_seen() {
+        // A 9 × 7 grid of quads split both ways, its triangles in a scrambled order, and a
+        // fan of three triangles on one edge (non-manifold).
+        let n = 10u32;
+        let mut tris = Vec::new();
+        for j in 0..6 {
+            for i in 0..n - 1 {
+                let (a, b, c, d) = (
+                    j * n + i,
+                    j * n + i + 1,
+                    (j + 1) * n + i,
+                    (j + 1) * n + i + 1,
+                );
+                if (i + j) % 2 == 0 {
+                    tris.extend([[a, b, d], [a, d, c]]);
+                } else {
+                    tris.extend([[a, b, c], [b, d, c]]);
+                }
+            }
+        }
+        let len = tris.len();
+        let scrambled: Vec<[u32; 3]> = (0..len).map(|k| tris[(k * 37) % len]).collect();
+        let mut all = scrambled;
+        all.extend([[200, 201, 202], [201, 200, 203], [200, 201, 204]]);
+        let (a, b) = (Topology::new(&all), by_map(&all));
+        assert_eq!(a.edges, b.edges);
+        assert_eq!(a.wings, b.wings);
+        assert_eq!(a.non_manifold_edges, b.non_manifold_edges);
+        assert_eq!(a.non_manifold_edges, vec![[200, 201]]);
     }
 }
