@@ -2,7 +2,7 @@
 //! the scene may need once built, estimated from its particle count before any cloth exists.
 
 use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, Scene, SelfCollisionSpec};
-use crate::schema::SceneFile;
+use crate::schema::{DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, SceneFile};
 
 /// What a load may read and allocate.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -110,13 +110,13 @@ pub(crate) fn grid_members(file: &SceneFile) -> Vec<(String, Member, bool)> {
         .iter()
         .filter(|(_, s)| s.mesh.is_none() && s.garment.is_none())
         .map(|(name, s)| {
-            let [nx, ny] = s.resolution.unwrap_or([20, 20]);
+            let [nx, ny] = s.resolution.unwrap_or(DEFAULT_RESOLUTION);
             let particles = (nx.clamp(0, 4096) as u64) * (ny.clamp(0, 4096) as u64);
-            let [w, h] = s.size.unwrap_or([1.0, 1.0]);
+            let [w, h] = s.size.unwrap_or(DEFAULT_SIZE);
             let member = Member {
                 particles,
                 area: (w * h).abs(),
-                thickness: s.thickness.unwrap_or(0.005).abs(),
+                thickness: s.thickness.unwrap_or(DEFAULT_THICKNESS).abs(),
             };
             let collides = match &chosen {
                 None => false,

@@ -11,7 +11,9 @@ use super::{Checker, valid_name};
 use crate::family::{self, Field, Setting};
 use crate::ranges;
 use crate::scene::ClothSpec;
-use crate::schema::{ClothSection, OrientationName, PinSpec};
+use crate::schema::{
+    ClothSection, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, OrientationName, PinSpec,
+};
 
 fn named_pin(name: &str) -> Option<Pin> {
     Some(match name {
@@ -95,7 +97,7 @@ pub(super) fn cloth(
             c.within(&k(&family::key(fam, field)), v, range);
         }
     }
-    let thickness = s.thickness.unwrap_or(0.005);
+    let thickness = s.thickness.unwrap_or(DEFAULT_THICKNESS);
     c.within(&k("thickness"), thickness, &ranges::THICKNESS);
     let motion = c.motion(&k("motion"), &s.motion);
     let seam_time = s.seam_time.unwrap_or(DEFAULT_SEAM_TIME);
@@ -158,14 +160,14 @@ pub(super) fn cloth(
             .ok()?
     } else {
         c.unused(&k("scale"), &s.scale, "by a grid cloth");
-        let [nx, ny] = s.resolution.unwrap_or([20, 20]);
+        let [nx, ny] = s.resolution.unwrap_or(DEFAULT_RESOLUTION);
         if !(2..=4096).contains(&nx) || !(2..=4096).contains(&ny) {
             c.bad(
                 &k("resolution"),
                 format!("each count must be in 2..=4096, got [{nx}, {ny}]"),
             );
         }
-        let [w, h] = s.size.unwrap_or([1.0, 1.0]);
+        let [w, h] = s.size.unwrap_or(DEFAULT_SIZE);
         c.within(&k("size"), w, &ranges::SIZE);
         c.within(&k("size"), h, &ranges::SIZE);
         let mut grid_pins = Vec::new();

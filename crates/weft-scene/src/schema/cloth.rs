@@ -9,6 +9,13 @@ use weft_solver::Family;
 use super::{AttachSection, MethodName, MotionSpec, exact};
 use crate::family::Setting;
 
+/// A grid cloth's `resolution` when the file gives none.
+pub const DEFAULT_RESOLUTION: [i64; 2] = [20, 20];
+/// A grid cloth's `size` (m) when the file gives none.
+pub const DEFAULT_SIZE: [f64; 2] = [1.0, 1.0];
+/// A cloth's collision `thickness` (m) when the file gives none.
+pub const DEFAULT_THICKNESS: f64 = 0.005;
+
 /// The plane of a grid cloth.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]

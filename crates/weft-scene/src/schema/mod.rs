@@ -14,7 +14,9 @@ mod collider;
 mod exact;
 
 pub use character::{AnimationKey, AttachSection, CharacterSection, WrapName};
-pub use cloth::{ClothSection, OrientationName, PinSpec};
+pub use cloth::{
+    ClothSection, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, OrientationName, PinSpec,
+};
 pub use collider::{ColliderSection, PartSection, ShapeKind};
 
 /// A whole scene file.
