@@ -31,21 +31,23 @@ impl LimitArgs {
     }
 }
 
-/// This process's peak resident memory so far (`VmHWM` in /proc/self/status), in bytes
-/// (`None` where there is no such file).
-pub fn peak_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
+/// The `KEY:  N kB` line of a /proc file, in bytes (`None` where there is no such file or line).
+fn proc_kib(path: &str, key: &str) -> Option<u64> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let prefix = format!("{key}:");
+    let line = text.lines().find(|l| l.starts_with(&prefix))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib * 1024)
 }
 
+/// This process's peak resident memory so far (`VmHWM` in /proc/self/status), in bytes.
+pub fn peak_memory() -> Option<u64> {
+    proc_kib("/proc/self/status", "VmHWM")
+}
+
 /// `MemAvailable` from /proc/meminfo, in bytes (`None` where there is no such file).
 pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
+    proc_kib("/proc/meminfo", "MemAvailable")
 }
 
 /// A size in bytes: `123`, `64K`, `512M`, `8G`, `1T` (powers of 1024; `B`/`iB` suffixes
