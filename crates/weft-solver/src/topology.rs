@@ -77,23 +77,20 @@ impl Topology {
                 start = stop;
             }
         }
-        let runs: Vec<(u32, usize, usize)> = (run_at.iter())
-            .filter(|&&(_, _, len)| len > 0)
-            .map(|&(v, start, len)| (v, start as usize, (start + len) as usize))
-            .collect();
         // Half-edge h as (its directed edge, the vertex opposite it).
         let use_of = |h: u32| {
             let (t, k) = ((h / 3) as usize, (h % 3) as usize);
             let tri = triangles[t];
             ([tri[k], tri[(k + 1) % 3]], tri[(k + 2) % 3])
         };
-        let mut edges = Vec::with_capacity(runs.len());
+        let mut edges = Vec::new();
         let mut wings = Vec::new();
         let mut non_manifold_edges = Vec::new();
-        for &(lo, start, end) in &runs {
+        for &(lo, start, len) in run_at.iter().filter(|r| r.2 > 0) {
+            let start = start as usize;
             let edge = [lo, half[start].0];
             edges.push(edge);
-            match end - start {
+            match len {
                 1 => {}
                 2 => {
                     let (directed, wing_a) = use_of(half[start].1);

@@ -78,7 +78,7 @@ pub fn build_garment(spec: &GarmentSpec) -> Result<Garment, GarmentError> {
     let mut starts_of = Vec::with_capacity(spec.panels.len());
     for (i, (panel, outline)) in spec.panels.iter().zip(&outlines).enumerate() {
         let (boundary, starts) = samples(outline, &pieces[i]);
-        let estimate = polygon_area(outline) / (3f64.sqrt() / 4.0 * h * h);
+        let estimate = interior_vertices(outline, h);
         let budget = (4.0 * estimate) as usize + 4 * boundary.len() + 64;
         if positions.len() + budget > MAX_GARMENT_VERTICES {
             return Err(panel_error(
@@ -334,17 +334,22 @@ fn seam_aware_pieces(
     Ok(pieces)
 }
 
-/// Vertices that triangulating `outlines` to edge length `h` makes, about: each panel's area
-/// over an equilateral triangle's, and its boundary samples (in floating point, so no count
-/// can overflow).
+/// Vertices that triangulating `outlines` to edge length `h` makes, about: each panel's
+/// interior and its boundary samples (in floating point, so no count can overflow).
 fn estimated_vertices(outlines: &[Vec<DVec2>], h: f64) -> f64 {
     outlines
         .iter()
         .map(|o| {
             let boundary: f64 = edge_lengths(o).iter().map(|l| (l / h).ceil()).sum();
-            polygon_area(o) / (3f64.sqrt() / 4.0 * h * h) + boundary
+            interior_vertices(o, h) + boundary
         })
         .sum()
+}
+
+/// Vertices inside `outline` at edge length `h`, about: its area over an equilateral
+/// triangle's.
+fn interior_vertices(outline: &[DVec2], h: f64) -> f64 {
+    polygon_area(outline) / (3f64.sqrt() / 4.0 * h * h)
 }
 
 /// R = R_z R_y R_x from degrees about x, y, z.
