@@ -10,7 +10,7 @@ use crate::common;
 
 use std::os::unix::process::ExitStatusExt;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
 
 use common::*;
@@ -280,12 +280,13 @@ fn mutated_logs_never_crash_or_hang_recover() {
     // Not MCAP at all: refused, nothing written.
     std::fs::write(&case_log, b"[sim]\ndt = 0.01\n").expect("write");
     let _ = std::fs::remove_file(&out);
-    let status = Command::new(env!("CARGO_BIN_EXE_weft"))
-        .args(["recover", case_log.to_str().expect("utf-8")])
-        .args(["--out", out.to_str().expect("utf-8")])
-        .output()
-        .expect("runs")
-        .status;
+    let status = run(&[
+        "recover",
+        case_log.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ])
+    .status;
     assert_eq!(status.code(), Some(1));
     assert!(!out.exists());
 }
