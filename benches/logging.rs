@@ -1,23 +1,11 @@
 //! MCAP logging overhead of `weft run` on the 128² default scene (`assets/scenes/hanging.toml`
-//! with `--set cloth.cloth.resolution=[128, 128]`), in process through the binary's own code:
-//! `src/sim.rs` (`Simulation`) and `src/record/` (`Recorder`) are compiled into this bench.
+//! with `--set cloth.cloth.resolution=[128, 128]`), in process through the crates `weft run` uses:
+//! weft-sim (`Simulation`) and weft-record (`Recorder`).
 //!
 //! Per frame, as `weft run` does it: `no_log` steps the simulation; `mcap` steps it and logs
 //! the frame (`Recorder::frame` with the CLI defaults: particles, the cloth mesh every frame,
 //! `/stats`) to a file under the system temp dir; `writer_only` logs a fixed frame without
 //! stepping. Opening and finishing the log (once per run) are outside the timing.
-
-// The binary crate has no library target; its modules are included by path.
-// (their unit tests compile here too, without a harness to use their imports)
-#[allow(dead_code, unused_imports)]
-#[path = "../src/body/mod.rs"]
-mod body;
-#[allow(dead_code, unused_imports)]
-#[path = "../src/record/mod.rs"]
-mod record;
-#[allow(dead_code)]
-#[path = "../src/sim.rs"]
-mod sim;
 
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -27,8 +15,8 @@ use criterion::{
     BenchmarkId, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
 };
 
-use record::{RecordOptions, Recorder, Status};
-use sim::Simulation;
+use weft_record::{RecordOptions, Recorder, Status};
+use weft_sim::Simulation;
 
 const N: usize = 128;
 

@@ -5,18 +5,15 @@
 #[macro_use]
 mod say;
 mod app;
-mod body;
 mod cli;
 mod default_scene;
 mod experiments;
 mod export;
 mod limits;
 mod output;
-mod record;
 mod recover;
 mod replay;
 mod run;
-mod sim;
 mod stability;
 mod stop;
 mod video;
@@ -30,8 +27,8 @@ use clap::Parser;
 use weft_scene::{Limits, Scene, SceneErrors};
 
 use cli::{Cli, Command, RunArgs};
-use record::RecordOptions;
 use run::RunPlan;
+use weft_record::RecordOptions;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();

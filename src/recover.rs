@@ -7,7 +7,7 @@
 //! otherwise reading resumes at the next offset from which records read whole up to one a CRC
 //! vouches for (a chunk, an attachment) or up to the closing magic. Schemas and channels lost
 //! with a damaged chunk are rebuilt from the log's `weft.channels` metadata
-//! ([`crate::record::CHANNELS`]); messages on a channel that cannot be rebuilt are lost.
+//! ([`weft_record::CHANNELS`]); messages on a channel that cannot be rebuilt are lost.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufWriter, Read};
@@ -22,7 +22,7 @@ use serde_json::Value;
 
 use crate::cli::RecoverArgs;
 use crate::output::{Named, Output, refuse_clashes};
-use crate::record::{CHANNELS, foxglove_schema, verify::looks_like_mcap};
+use weft_record::{CHANNELS, foxglove_schema, verify::looks_like_mcap};
 
 /// What was recovered, and what was lost.
 #[derive(Debug, Default, PartialEq, Eq)]

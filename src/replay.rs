@@ -11,8 +11,8 @@ use anyhow::{Context, bail};
 use weft_scene::{MapFiles, Override, Scene};
 
 use crate::cli::ReplayArgs;
-use crate::record::RecordOptions;
 use crate::run::{self, RunPlan};
+use weft_record::RecordOptions;
 
 /// What a log says about the run that wrote it.
 pub struct LoggedRun {
@@ -107,7 +107,7 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
     let bytes = weft_scene::read_regular(&args.log, u64::MAX)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", args.log.display()))?;
     // Whole and every CRC intact, or say what is wrong and how to recover it.
-    if let Err(fault) = crate::record::verify::verify(&bytes, stop) {
+    if let Err(fault) = weft_record::verify::verify(&bytes, stop) {
         bail!("{}", fault.message(&args.log));
     }
     let log = read_log(&bytes).with_context(|| format!("{}", args.log.display()))?;

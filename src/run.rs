@@ -13,8 +13,8 @@ use weft_scene::Scene;
 use weft_solver::SolverError;
 
 use crate::output::{Named, Output, refuse_clashes};
-use crate::record::{RecordOptions, Recorder, Status};
-use crate::sim::Simulation;
+use weft_record::{RecordOptions, Recorder, Status};
+use weft_sim::Simulation;
 
 /// Exit code of a run that diverged.
 pub const EXIT_DIVERGED: u8 = 2;

@@ -19,9 +19,9 @@ use weft_scene::Scene;
 
 use crate::output::Output;
 use crate::run::{EXIT_DIVERGED, EXIT_INTERRUPTED};
-use crate::sim::Simulation;
 use crate::stop::Stopped;
 use crate::view;
+use weft_sim::Simulation;
 
 /// Shortest GIF frame delay players honour (ms); faster frames are dropped to keep real time.
 const GIF_MIN_DELAY_MS: f64 = 20.0;

@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec3};
 use weft_render::{Camera, ClothTopology, Renderer, SceneMeshes, TriMesh};
 
-use crate::sim::Simulation;
+use weft_sim::Simulation;
 
 /// What the renderer draws for a simulation, and where its ground is.
 pub struct SceneView {
@@ -53,8 +53,8 @@ pub fn scene_meshes(sim: &Simulation) -> SceneView {
         })
         .collect();
     // A character's body parts, each rigid in its own frame: made once, posed every frame.
-    colliders.extend(crate::body::parts(sim).iter().map(|(_, p)| {
-        let (positions, indices) = crate::body::mesh::round_cone(p.r0, p.r1, p.half_height());
+    colliders.extend(weft_sim::body::parts(sim).iter().map(|(_, p)| {
+        let (positions, indices) = weft_sim::body::mesh::round_cone(p.r0, p.r1, p.half_height());
         TriMesh { positions, indices }
     }));
     SceneView {
@@ -93,7 +93,7 @@ pub fn frame_poses(sim: &Simulation) -> Vec<Mat4> {
     colliders(sim)
         .iter()
         .map(|c| c.world_matrix())
-        .chain(crate::body::parts(sim).iter().map(|(_, p)| p.matrix()))
+        .chain(weft_sim::body::parts(sim).iter().map(|(_, p)| p.matrix()))
         .collect()
 }
 

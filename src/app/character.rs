@@ -123,7 +123,7 @@ mod tests {
 
     use super::*;
     use crate::app::picking::Ray;
-    use crate::sim::Simulation;
+    use weft_sim::Simulation;
 
     fn skirt() -> Session {
         let source = SceneSource::File(PathBuf::from("assets/scenes/skirt.toml"));
@@ -145,14 +145,14 @@ mod tests {
     fn drawn_and_at(
         s: &Session,
         t: f64,
-    ) -> (Vec<crate::body::PartPose>, Vec<crate::body::PartPose>) {
-        let drawn = crate::body::parts(&s.sim)
+    ) -> (Vec<weft_sim::body::PartPose>, Vec<weft_sim::body::PartPose>) {
+        let drawn = weft_sim::body::parts(&s.sim)
             .into_iter()
             .map(|(_, p)| p)
             .collect();
         let mut at: Vec<BodyPart> = Vec::new();
         character_of(s).parts_at(t, &mut at);
-        (drawn, at.iter().map(crate::body::PartPose::of).collect())
+        (drawn, at.iter().map(weft_sim::body::PartPose::of).collect())
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use weft_solver::glam::DVec3;
 
 use crate::app::picking::{Ray, pick, ray_plane};
-use crate::sim::Simulation;
+use weft_sim::Simulation;
 
 /// A particle held by the user.
 #[derive(Clone, Copy, Debug, PartialEq)]

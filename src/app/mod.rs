@@ -35,9 +35,9 @@ use winit::event_loop::EventLoop;
 use crate::cli::ViewArgs;
 use crate::output::{Named, Output, refuse_clashes};
 use crate::run::{EXIT_INTERRUPTED, scene_inputs};
-use crate::sim::Simulation;
 use recording::SessionLog;
 use session::{SceneSource, Session};
+use weft_sim::Simulation;
 use window::{App, WindowConfig};
 
 /// Opens the viewer as `args` say; returns when the window closes.

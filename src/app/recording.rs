@@ -5,8 +5,8 @@ use anyhow::Context;
 
 use crate::app::grab::Grab;
 use crate::output::Output;
-use crate::record::{RecordOptions, Recorder, Status};
-use crate::sim::{FrameStats, Simulation};
+use weft_record::{RecordOptions, Recorder, Status};
+use weft_sim::{FrameStats, Simulation};
 
 /// The JSON schema of `/interaction` messages.
 const INTERACTION_SCHEMA: &str = r#"{"title":"weft.Interaction","type":"object","properties":{"frame":{"type":"integer","description":"frame of the session (continues across resets)"},"time":{"type":"number","description":"simulated time of the session (s)"},"grabbed":{"type":"boolean"},"cloth":{"type":["string","null"],"description":"name of the grabbed cloth"},"cloth_index":{"type":["integer","null"]},"particle":{"type":["integer","null"],"description":"index within the cloth, as in /cloth/<name>/particles"},"target":{"type":["array","null"],"items":{"type":"number"},"description":"drag target (m)"}},"required":["frame","time","grabbed"]}"#;
@@ -94,7 +94,7 @@ impl SessionLog {
                 "target": null,
             }),
         };
-        self.rec.json(self.interaction, self.time, &json)
+        Ok(self.rec.json(self.interaction, self.time, &json)?)
     }
 
     /// Writes the status and the summary, closes the file and renames it into place.

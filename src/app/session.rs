@@ -12,8 +12,8 @@ use crate::app::grab::Grab;
 use crate::app::picking::Ray;
 use crate::app::recording::SessionLog;
 use crate::default_scene;
-use crate::record::Status;
-use crate::sim::Simulation;
+use weft_record::Status;
+use weft_sim::Simulation;
 
 /// Where a scene came from (to reset it, and to list it in the panel).
 #[derive(Clone, Debug, PartialEq, Eq)]

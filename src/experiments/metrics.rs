@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::sim::{FrameStats, Simulation};
+use weft_sim::{FrameStats, Simulation};
 
 /// A quantity reported per run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize, Serialize)]

@@ -19,10 +19,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::cli::ExperimentArgs;
 use crate::output::{Named, Output, refuse_clashes};
-use crate::record::{RecordOptions, Recorder, Status};
-use crate::sim::Simulation;
 use metrics::Meter;
 use spec::{PlannedRun, Spec, parse_shard};
+use weft_record::{RecordOptions, Recorder, Status};
+use weft_sim::Simulation;
 
 /// A run and its result, when it has one (a row of the summary and of its plots).
 pub struct Row<'a> {

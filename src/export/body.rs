@@ -5,8 +5,8 @@
 use weft_collide::KinematicBody;
 use weft_scene::Scene;
 
-use crate::body::{PartPose, mesh, part_name};
 use crate::export::collider_track::{ColliderTrack, logged_pose};
+use weft_sim::body::{PartPose, mesh, part_name};
 
 /// One track per body part of `scene`'s character (none without one).
 pub fn tracks(

@@ -4,7 +4,7 @@ use anyhow::Context;
 use glam::Vec3;
 use weft_solver::glam::{DQuat, DVec3};
 
-use crate::record::collider_state;
+use weft_record::collider_state;
 
 /// One collider over the exported frames.
 pub struct ColliderTrack {

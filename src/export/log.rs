@@ -13,8 +13,8 @@ use foxglove::messages::{PointCloud, SceneUpdate};
 use weft_scene::Scene;
 
 use super::collider_track::{ColliderTrack, logged_pose};
-use crate::record::collider_state::{self, ColliderState};
 use crate::stop::Stopped;
+use weft_record::collider_state::{self, ColliderState};
 
 /// One cloth over the exported frames.
 pub struct ClothTrack {
@@ -187,7 +187,7 @@ pub fn read_tracks(
         }
         cloths.push(ClothTrack {
             name: spec.name.clone(),
-            color: rgba(crate::record::messages::method_color(spec.method)),
+            color: rgba(weft_record::messages::method_color(spec.method)),
             triangles,
             positions: track,
         });

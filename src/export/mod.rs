@@ -148,9 +148,9 @@ fn run(args: &ExportArgs, stop: &AtomicBool) -> anyhow::Result<ExitCode> {
     )?;
     let bytes = weft_scene::read_regular(path, u64::MAX)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-    match crate::record::verify::verify(&bytes, stop) {
+    match weft_record::verify::verify(&bytes, stop) {
         Ok(()) => {}
-        Err(crate::record::verify::Fault::Stopped) => return Err(Stopped.into()),
+        Err(weft_record::verify::Fault::Stopped) => return Err(Stopped.into()),
         Err(fault) => bail!("{}", fault.message(path)),
     }
     let logged = crate::replay::read_log(&bytes).with_context(|| format!("{}", path.display()))?;

@@ -10,7 +10,7 @@ use common::*;
 use weft_character::{Character, Geometry};
 use weft_solver::glam::DVec3;
 
-/// The walker and a small cloth away from it (the log test in `src/record/body.rs` runs it too).
+/// The walker and a small cloth away from it (the log test in `crates/weft-record/src/body.rs` runs it too).
 const WALKER: &str = include_str!("../fixtures/walker.toml");
 
 /// Objects of an OBJ file: name and vertices.

@@ -8,7 +8,7 @@ pub mod mesh;
 use weft_collide::{BodyPart, KinematicBody};
 use weft_solver::glam::{DQuat, DVec3};
 
-use crate::sim::Simulation;
+use crate::Simulation;
 
 /// One body part at one instant, in its own frame.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -10,7 +10,7 @@ use serde_json::{Map, Value, json};
 use weft_collide::ShapeDesc;
 use weft_scene::ColliderSpec;
 
-use crate::body::PartPose;
+use weft_sim::body::PartPose;
 use weft_solver::glam::{DQuat, DVec3};
 
 /// The channel's topic.

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use weft_scene::{Scene, SolverGroup};
+use weft_scene::{Scene, SceneError, SolverGroup};
 use weft_solver::SolverError;
 use weft_solver::glam::DVec3;
 
@@ -41,7 +41,7 @@ pub struct Simulation {
 
 impl Simulation {
     /// Builds the scene's solvers.
-    pub fn new(scene: Scene) -> anyhow::Result<Self> {
+    pub fn new(scene: Scene) -> Result<Self, SceneError> {
         let groups = scene.build()?;
         let mut places = vec![(0, 0..0); scene.cloths.len()];
         for (g, group) in groups.iter().enumerate() {

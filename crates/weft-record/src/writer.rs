@@ -5,15 +5,15 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 
-use anyhow::Context;
 use foxglove::Encode;
 use foxglove::messages::{PointCloud, SceneUpdate};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::{Attachment, Compression, WriteOptions, Writer};
 use serde_json::{Value, json};
 
-use crate::record::{body, collider_state, messages};
-use crate::sim::{FrameStats, Simulation};
+use crate::error::{RecordError, Result};
+use crate::{body, collider_state, messages};
+use weft_sim::{FrameStats, Simulation};
 
 /// What a run logs besides particles.
 #[derive(Clone, Copy, Debug)]
@@ -82,8 +82,8 @@ pub fn foxglove_schema(name: &str) -> Option<Vec<u8>> {
 type Added = (u16, Value);
 
 /// Adds the foxglove schema of `T`, described by its name.
-fn schema_of<T: Encode>(w: &mut Writer<BufWriter<File>>) -> anyhow::Result<Added> {
-    let s = T::get_schema().context("foxglove schema missing")?;
+fn schema_of<T: Encode>(w: &mut Writer<BufWriter<File>>) -> Result<Added> {
+    let s = T::get_schema().ok_or(RecordError::SchemaMissing(std::any::type_name::<T>()))?;
     let id = w.add_schema(&s.name, &s.encoding, &s.data)?;
     Ok((
         id,
@@ -92,7 +92,7 @@ fn schema_of<T: Encode>(w: &mut Writer<BufWriter<File>>) -> anyhow::Result<Added
 }
 
 /// Adds a JSON schema, described with its text.
-fn json_schema(w: &mut Writer<BufWriter<File>>, name: &str, text: &str) -> anyhow::Result<Added> {
+fn json_schema(w: &mut Writer<BufWriter<File>>, name: &str, text: &str) -> Result<Added> {
     let id = w.add_schema(name, "jsonschema", text.as_bytes())?;
     Ok((
         id,
@@ -107,7 +107,7 @@ fn channel(
     schema: &Added,
     topic: &str,
     encoding: &str,
-) -> anyhow::Result<u16> {
+) -> Result<u16> {
     let id = w.add_channel(schema.0, topic, encoding, &BTreeMap::new())?;
     let entry = json!({"topic": topic, "message_encoding": encoding, "schema": schema.1});
     described.insert(id.to_string(), entry.to_string());
@@ -116,12 +116,7 @@ fn channel(
 
 impl Recorder {
     /// Starts the log in `file` (already created): schemas, channels, the scene and settings.
-    pub fn new(
-        file: File,
-        sim: &Simulation,
-        frames: u64,
-        options: RecordOptions,
-    ) -> anyhow::Result<Self> {
+    pub fn new(file: File, sim: &Simulation, frames: u64, options: RecordOptions) -> Result<Self> {
         let mut w = WriteOptions::new()
             .compression(Some(Compression::Zstd))
             .compression_threads(0)
@@ -133,7 +128,7 @@ impl Recorder {
         let mut described = BTreeMap::new();
         let scene = &sim.scene;
         // A character's body is logged with the colliders, and moves every frame.
-        let has_body = !crate::body::parts(sim).is_empty() || scene.model.is_some();
+        let has_body = !weft_sim::body::parts(sim).is_empty() || scene.model.is_some();
         let no_colliders = scene.colliders.is_empty() && !has_body;
         let mut particles = Vec::new();
         let mut meshes = Vec::new();
@@ -248,16 +243,17 @@ impl Recorder {
         })
     }
 
-    fn put<T: Encode>(&mut self, channel: u16, time: f64, msg: &T) -> anyhow::Result<()>
+    fn put<T: Encode>(&mut self, channel: u16, time: f64, msg: &T) -> Result<()>
     where
-        T::Error: Send + Sync + 'static,
+        T::Error: std::error::Error + Send + Sync + 'static,
     {
         self.buf.clear();
-        msg.encode(&mut self.buf)?;
+        msg.encode(&mut self.buf)
+            .map_err(|e| RecordError::Encode(Box::new(e)))?;
         self.raw(channel, time)
     }
 
-    fn raw(&mut self, channel: u16, time: f64) -> anyhow::Result<()> {
+    fn raw(&mut self, channel: u16, time: f64) -> Result<()> {
         let t = messages::nanos(time);
         self.sequence += 1;
         self.w.write_to_known_channel(
@@ -273,9 +269,9 @@ impl Recorder {
     }
 
     /// Logs the current state of every cloth, the colliders and the frame's statistics.
-    pub fn frame(&mut self, sim: &Simulation, stats: &FrameStats) -> anyhow::Result<()> {
+    pub fn frame(&mut self, sim: &Simulation, stats: &FrameStats) -> Result<()> {
         let time = stats.time;
-        let parts = crate::body::parts(sim);
+        let parts = weft_sim::body::parts(sim);
         for (i, c) in sim.scene.cloths.iter().enumerate() {
             let x = sim.cloth_positions(i);
             let ch = self.particles[i];
@@ -296,7 +292,7 @@ impl Recorder {
             // A skinned body is as large as a cloth mesh: logged when the cloth meshes are.
             let every = self.options.mesh_every;
             if (stats.frame == 0 || (every > 0 && stats.frame % every == 0))
-                && let Some((vertices, triangles)) = crate::body::model_mesh(sim)
+                && let Some((vertices, triangles)) = weft_sim::body::model_mesh(sim)
             {
                 m.entities
                     .push(body::model_entity(time, vertices, triangles));
@@ -331,7 +327,7 @@ impl Recorder {
         topic: &str,
         schema_name: &str,
         schema: &str,
-    ) -> anyhow::Result<u16> {
+    ) -> Result<u16> {
         let schema = json_schema(&mut self.w, schema_name, schema)?;
         let mut described = BTreeMap::new();
         let id = channel(&mut self.w, &mut described, &schema, topic, "json")?;
@@ -344,18 +340,13 @@ impl Recorder {
 
     /// Writes one JSON message at simulated time `time` (s) on a channel from
     /// [`Recorder::add_json_channel`].
-    pub fn json(
-        &mut self,
-        channel: u16,
-        time: f64,
-        value: &serde_json::Value,
-    ) -> anyhow::Result<()> {
+    pub fn json(&mut self, channel: u16, time: f64, value: &serde_json::Value) -> Result<()> {
         self.buf = serde_json::to_vec(value)?;
         self.raw(channel, time)
     }
 
     /// Writes the status record, the summary section and the footer, and syncs the file.
-    pub fn finish(mut self, status: &Status, frames_simulated: u64) -> anyhow::Result<()> {
+    pub fn finish(mut self, status: &Status, frames_simulated: u64) -> Result<()> {
         let message = match status {
             Status::Diverged(m) => m.clone(),
             _ => String::new(),

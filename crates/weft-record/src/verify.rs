@@ -152,8 +152,8 @@ fn first_unfit(bytes: &[u8]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::record::{RecordOptions, Recorder, Status};
-    use crate::sim::Simulation;
+    use crate::{RecordOptions, Recorder, Status};
+    use weft_sim::Simulation;
 
     /// A flag never raised.
     static GO: AtomicBool = AtomicBool::new(false);

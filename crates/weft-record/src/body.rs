@@ -6,9 +6,9 @@
 use foxglove::messages::{CylinderPrimitive, SceneEntity, SpherePrimitive};
 use weft_solver::glam::{DQuat, DVec3};
 
-use crate::body::PartPose;
-use crate::body::mesh::tangent_angle;
-use crate::record::messages::{FRAME_ID, GREY, pose, timestamp, triangle_list, vec3};
+use crate::messages::{FRAME_ID, GREY, pose, timestamp, triangle_list, vec3};
+use weft_sim::body::PartPose;
+use weft_sim::body::mesh::tangent_angle;
 
 /// The entities of the body parts `parts` at time `time` (s).
 pub fn entities(time: f64, parts: &[(String, PartPose)]) -> Vec<SceneEntity> {
@@ -61,7 +61,7 @@ pub fn model_entity(time: f64, vertices: &[DVec3], triangles: &[[u32; 3]]) -> Sc
     SceneEntity {
         timestamp: Some(timestamp(time)),
         frame_id: FRAME_ID.into(),
-        id: format!("collider/{}", crate::body::MODEL_NAME),
+        id: format!("collider/{}", weft_sim::body::MODEL_NAME),
         triangles: vec![triangle_list(
             pose(DVec3::ZERO, DQuat::IDENTITY),
             vertices,
@@ -77,11 +77,11 @@ mod tests {
     use weft_character::{Character, Geometry};
     use weft_solver::glam::DVec3;
 
-    use crate::record::{RecordOptions, Recorder, Status};
-    use crate::sim::Simulation;
+    use crate::{RecordOptions, Recorder, Status};
+    use weft_sim::Simulation;
 
     /// The walker and a small cloth far from it (the file `weft export`'s test runs too).
-    const SCENE: &str = include_str!("../../tests/fixtures/walker.toml");
+    const SCENE: &str = include_str!("../../../tests/fixtures/walker.toml");
 
     fn walking() -> Simulation {
         let scene =
@@ -133,7 +133,7 @@ mod tests {
                 updates += 1;
                 continue;
             }
-            if m.channel.topic != super::super::collider_state::TOPIC {
+            if m.channel.topic != crate::collider_state::TOPIC {
                 continue;
             }
             states += 1;
