@@ -282,7 +282,10 @@ fn scan<'a>(bytes: &'a [u8], report: &mut Recovered) -> Found<'a> {
                 .map(|(_, _, end)| end)
                 .filter(|&end| end == bytes.len() || resumes_at(bytes, end));
             let resumes = |p: &usize| *p != pos && resumes_at(bytes, *p);
-            let Some(next) = held.or_else(|| (last + 1..bytes.len()).find(resumes)) else {
+            // Not inside the data of a chunk already read (an uncompressed chunk's messages
+            // read whole there, and would be taken twice): from where its header ends it.
+            let from = chunk_extent(bytes, last).map_or(last + 1, |(_, end)| end.max(last + 1));
+            let Some(next) = held.or_else(|| (from..bytes.len()).find(resumes)) else {
                 report.lost_bytes += (bytes.len() - pos) as u64;
                 if bytes.ends_with(MAGIC) {
                     report.damaged += 1;
