@@ -30,7 +30,7 @@ fn results(dir: &std::path::Path) -> usize {
         d.filter(|e| {
             e.as_ref().is_ok_and(|e| {
                 let name = e.file_name().to_string_lossy().into_owned();
-                name.ends_with(".json") && !name.contains(".partial.")
+                name.ends_with(".json") && !name.contains(".partial")
             })
         })
         .count()
