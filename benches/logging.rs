@@ -1,98 +1,146 @@
-//! MCAP logging overhead of `weft run` on the 128² default scene (`assets/scenes/hanging.toml`
-//! with `--set cloth.cloth.resolution=[128, 128]`), in process through the crates `weft run` uses:
-//! weft-sim (`Simulation`) and weft-record (`Recorder`).
+//! MCAP logging against no log, in process through the crates `weft run` uses: weft-sim
+//! (`Simulation`) and weft-record (`Recorder`, its log written on its own thread).
 //!
-//! Per frame, as `weft run` does it: `no_log` steps the simulation; `mcap` steps it and logs
-//! the frame (`Recorder::frame` with the CLI defaults: particles, the cloth mesh every frame,
-//! `/stats`) to a file under the system temp dir; `writer_only` logs a fixed frame without
-//! stepping. Opening and finishing the log (once per run) are outside the timing.
+//! Two scenes: the 128² reference (`assets/scenes/reference.toml`) and the walker in its
+//! T-shirt (`assets/scenes/character.toml`). Per frame, as `weft run --out` does it: `no_log`
+//! steps the simulation; each other row steps it and hands the frame to the recorder with the
+//! options it names (`particles` is `weft run`'s default: particles, no compression; `all`
+//! adds the surface every frame; `zstd` compresses the chunks; `f16` halves the positions).
+//! The time of a sample includes finishing its log (the queue written out, the summary, the
+//! sync); opening the log is outside it.
 
 use std::hint::black_box;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use criterion::{
     BenchmarkId, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
 };
 
-use weft_record::{RecordOptions, Recorder, Status};
+use weft_record::{Channels, Compression, Precision, RecordOptions, Recorder, Status};
 use weft_sim::Simulation;
 
-const N: usize = 128;
-
-fn simulation() -> Simulation {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/hanging.toml");
-    let resolution: weft_scene::Override = format!("cloth.cloth.resolution=[{N}, {N}]")
-        .parse()
-        .expect("well-formed override");
-    let scene = weft_scene::load(&path, &[resolution]).expect("hanging.toml loads");
-    Simulation::new(scene).expect("scene builds")
+fn simulation(scene: &str) -> Simulation {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(scene);
+    let scene = weft_scene::load(&path, &[]).expect("the scene loads");
+    Simulation::new(scene).expect("the scene builds")
 }
-
-/// The options `weft run` uses by default (`--mesh-every 1`, no `--timing`).
-const OPTIONS: RecordOptions = RecordOptions {
-    mesh_every: 1,
-    timing: false,
-};
 
 fn sink() -> PathBuf {
     std::env::temp_dir().join(format!("weft-bench-logging-{}.mcap", std::process::id()))
 }
 
-/// Opens a fresh log at `path` for `sim`, as `weft run --out` does.
-fn recorder(sim: &Simulation, path: &PathBuf, frames: u64) -> Recorder {
-    let file = std::fs::File::create(path).expect("temp file");
-    Recorder::new(file, sim, frames, OPTIONS).expect("recorder")
+/// The rows: a name and the recorder's options.
+fn variants() -> Vec<(&'static str, RecordOptions)> {
+    let default = RecordOptions::default();
+    let all = RecordOptions {
+        channels: Channels::All,
+        ..default
+    };
+    let zstd = |o: RecordOptions| RecordOptions {
+        compression: Compression::Zstd,
+        ..o
+    };
+    vec![
+        ("particles", default),
+        ("all", all),
+        ("particles_zstd", zstd(default)),
+        ("all_zstd", zstd(all)),
+        (
+            "particles_f16",
+            RecordOptions {
+                precision: Precision::F16,
+                ..default
+            },
+        ),
+    ]
 }
 
-fn logging(c: &mut Criterion) {
+fn scene_group(c: &mut Criterion, name: &str, scene: &str, seconds: u64) {
     let path = sink();
-    let mut group = c.benchmark_group(format!("weft_run/{}", N * N));
+    let mut group = c.benchmark_group(format!("logging/{name}"));
     group
         .sample_size(10)
         .sampling_mode(SamplingMode::Flat)
         .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3))
+        .measurement_time(Duration::from_secs(seconds))
         .throughput(Throughput::Elements(1));
 
-    let mut sim = simulation();
+    let mut sim = simulation(scene);
     group.bench_function(BenchmarkId::from_parameter("no_log"), |b| {
         b.iter(|| black_box(sim.step().expect("stable")));
     });
-
-    let mut sim = simulation();
-    group.bench_function(BenchmarkId::from_parameter("mcap"), |b| {
-        b.iter_custom(|iters| {
-            let mut rec = recorder(&sim, &path, iters);
-            let t = Instant::now();
-            for _ in 0..iters {
-                let stats = sim.step().expect("stable");
-                rec.frame(&sim, &stats).expect("log frame");
-            }
-            let elapsed = t.elapsed();
-            rec.finish(&Status::Complete, iters).expect("finish log");
-            elapsed
+    for (label, options) in variants() {
+        let mut sim = simulation(scene);
+        group.bench_function(BenchmarkId::from_parameter(label), |b| {
+            b.iter_custom(|iters| {
+                let file = std::fs::File::create(&path).expect("a temporary file");
+                let mut rec = Recorder::new(file, &sim, iters, options).expect("a recorder");
+                let t = Instant::now();
+                for _ in 0..iters {
+                    let stats = sim.step().expect("stable");
+                    rec.frame(&sim, &stats).expect("a frame logged");
+                }
+                rec.finish(&Status::Complete, iters)
+                    .expect("the log finished");
+                t.elapsed()
+            });
         });
-    });
-
-    let sim = simulation();
-    let stats = sim.stats(0.0, 0);
-    group.bench_function(BenchmarkId::from_parameter("writer_only"), |b| {
-        b.iter_custom(|iters| {
-            let mut rec = recorder(&sim, &path, iters);
-            let t = Instant::now();
-            for _ in 0..iters {
-                rec.frame(&sim, &stats).expect("log frame");
-            }
-            let elapsed = t.elapsed();
-            rec.finish(&Status::Complete, iters).expect("finish log");
-            elapsed
-        });
-    });
+    }
     group.finish();
-    let size = std::fs::metadata(&path).map_or(0, |m| m.len());
-    eprintln!("last log: {size} bytes at {}", path.display());
     let _ = std::fs::remove_file(&path);
+}
+
+/// Bytes a frame costs in each row's log: a 120-frame run's file over its 121 logged frames
+/// (its header, scene and summary included), as `{"<scene>/<row>": bytes}` in
+/// `<criterion>/logging_bytes.json` for the summary script.
+fn bytes_per_frame(scenes: &[(&str, &str)]) {
+    const FRAMES: u64 = 120;
+    let path = sink();
+    let mut entries = Vec::new();
+    for (name, scene) in scenes {
+        for (label, options) in variants() {
+            let mut sim = simulation(scene);
+            let file = std::fs::File::create(&path).expect("a temporary file");
+            let mut rec = Recorder::new(file, &sim, FRAMES, options).expect("a recorder");
+            rec.frame(&sim, &sim.stats(0.0, 0)).expect("frame 0");
+            for _ in 0..FRAMES {
+                let stats = sim.step().expect("stable");
+                rec.frame(&sim, &stats).expect("a frame logged");
+            }
+            rec.finish(&Status::Complete, FRAMES)
+                .expect("the log finished");
+            let size = std::fs::metadata(&path).map_or(0, |m| m.len());
+            let per_frame = size / (FRAMES + 1);
+            eprintln!("logging/{name}/{label}: {per_frame} bytes a frame");
+            entries.push(format!("\"{name}/{label}\": {per_frame}"));
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+    let dir = std::env::var_os("CRITERION_HOME")
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("CARGO_TARGET_DIR").map(|t| PathBuf::from(t).join("criterion"))
+        })
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion"));
+    let json = format!("{{{}}}\n", entries.join(", "));
+    if let Err(e) = std::fs::create_dir_all(&dir)
+        .and_then(|()| std::fs::write(dir.join("logging_bytes.json"), json))
+    {
+        eprintln!("logging_bytes.json not written in {}: {e}", dir.display());
+    }
+}
+
+const SCENES: [(&str, &str); 2] = [
+    ("reference", "assets/scenes/reference.toml"),
+    ("walker", "assets/scenes/character.toml"),
+];
+
+fn logging(c: &mut Criterion) {
+    for ((name, scene), seconds) in SCENES.iter().zip([3, 6]) {
+        scene_group(c, name, scene, seconds);
+    }
+    bytes_per_frame(&SCENES);
 }
 
 criterion_group!(benches, logging);

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
+use weft_record::{Channels, Compression, Precision, RecordOptions};
 use weft_scene::Override;
 use weft_solver::Method;
 
@@ -134,10 +135,11 @@ pub struct RunArgs {
     /// Write every cloth's final positions (as float32) to this JSON file.
     #[arg(long, value_name = "FILE.json")]
     pub dump_final: Option<PathBuf>,
-    /// Log the cloth surface every N frames (0: never).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    pub mesh_every: u64,
-    /// Add wall-clock step time to /stats (the file is then no longer reproducible byte for byte).
+    /// What the log carries.
+    #[command(flatten)]
+    pub log: LogArgs,
+    /// Add wall-clock step time and the wait for the log to /stats (the file is then no
+    /// longer reproducible byte for byte).
     #[arg(long)]
     pub timing: bool,
     /// No progress bar.
@@ -168,6 +170,43 @@ fn overrides(method: Option<Method>, set: &[Override]) -> Vec<Override> {
     v
 }
 
+/// What a log carries (`weft run --out`, `weft view --record`).
+#[derive(Debug, Args)]
+pub struct LogArgs {
+    /// What the log carries of each cloth: `particles` (positions), `surface` (the triangle
+    /// list Foxglove draws) or `all` (both; the surface every --mesh-every frames).
+    #[arg(long = "log", default_value = "particles", value_name = "CHANNELS")]
+    pub channels: Channels,
+    /// Log every N-th frame (and the last one).
+    #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: u64,
+    /// Log the cloth surface every N frames with `--log all` (0: never).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub mesh_every: u64,
+    /// Particle positions as `f32` (within 2^-24 of each coordinate) or `f16` (half the
+    /// bytes, within 2^-11: 0.49 mm at 1 m from the origin; Foxglove cannot draw them).
+    #[arg(long, default_value = "f32", value_name = "PRECISION")]
+    pub precision: Precision,
+    /// Chunk compression: `none` (keeps pace with the solver) or `zstd` (about half the
+    /// bytes, on one worker per core).
+    #[arg(long, default_value = "none", value_name = "KIND")]
+    pub compression: Compression,
+}
+
+impl LogArgs {
+    /// The recorder's options, `timing` as asked.
+    pub fn options(&self, timing: bool) -> RecordOptions {
+        RecordOptions {
+            channels: self.channels,
+            every: self.every,
+            mesh_every: self.mesh_every,
+            precision: self.precision,
+            compression: self.compression,
+            timing,
+        }
+    }
+}
+
 /// `weft view` (and `weft` with no command).
 #[derive(Debug, Args)]
 pub struct ViewArgs {
@@ -182,9 +221,9 @@ pub struct ViewArgs {
     /// Log the session to this MCAP file (as `weft run --out`, plus an `/interaction` channel).
     #[arg(long, value_name = "FILE.mcap")]
     pub record: Option<PathBuf>,
-    /// Log the cloth surface every N frames when recording (0: never).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    pub mesh_every: u64,
+    /// What the log of --record carries.
+    #[command(flatten)]
+    pub log: LogArgs,
     /// Window size in pixels.
     #[arg(long, default_value = "1280x800", value_name = "WxH")]
     pub size: WindowSize,

@@ -28,7 +28,6 @@ use weft_scene::{Limits, Scene, SceneErrors};
 
 use cli::{Cli, Command, RunArgs};
 use run::RunPlan;
-use weft_record::RecordOptions;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -98,10 +97,7 @@ fn run_command(args: &RunArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCod
         frames: args.frames,
         out: args.out.as_deref(),
         dump_final: args.dump_final.as_deref(),
-        record: RecordOptions {
-            mesh_every: args.mesh_every,
-            timing: args.timing,
-        },
+        record: args.log.options(args.timing),
         progress: !args.quiet,
     };
     run::run(scene, &plan, stop)

@@ -12,7 +12,7 @@ use weft_scene::{MapFiles, Override, Scene};
 
 use crate::cli::ReplayArgs;
 use crate::run::{self, RunPlan};
-use weft_record::RecordOptions;
+use weft_record::{Channels, Compression, Precision, RecordOptions};
 
 /// What a log says about the run that wrote it.
 pub struct LoggedRun {
@@ -69,6 +69,19 @@ fn run_value<T: std::str::FromStr>(log: &LoggedRun, key: &str, what: &str) -> an
     parsed(key, v, what)
 }
 
+/// A `weft.run` value that older logs do not have, or `default` when absent.
+fn run_value_or<T: std::str::FromStr>(
+    log: &LoggedRun,
+    key: &str,
+    what: &str,
+    default: T,
+) -> anyhow::Result<T> {
+    match log.run.get(key) {
+        Some(v) => parsed(key, v, what),
+        None => Ok(default),
+    }
+}
+
 /// The scene a log was run with, rebuilt from its `scene/source.toml` and `files/…`
 /// attachments with the logged overrides (as `weft replay` and `weft export` need it).
 pub fn logged_scene(log: &LoggedRun, limits: &weft_scene::Limits) -> anyhow::Result<Scene> {
@@ -114,6 +127,14 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
     let logged_frames: u64 = run_value(&log, "frames", "a frame count")?;
     let mesh_every: u64 = run_value(&log, "mesh_every", "a frame count")?;
     let timing: bool = run_value(&log, "timing", "true or false")?;
+    let record = RecordOptions {
+        channels: run_value_or(&log, "log", "particles, surface or all", Channels::All)?,
+        every: run_value_or(&log, "every", "a frame count", 1)?,
+        mesh_every,
+        precision: run_value_or(&log, "precision", "f32 or f16", Precision::F32)?,
+        compression: run_value_or(&log, "compression", "none or zstd", Compression::Zstd)?,
+        timing,
+    };
     // A log cut short (interrupted, recovered) holds fewer frames than were asked for: replay
     // the frames it holds.
     let cut_short = log.status.as_ref().and_then(|st| {
@@ -138,7 +159,7 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
         frames,
         out: Some(&out),
         dump_final: None,
-        record: RecordOptions { mesh_every, timing },
+        record,
         progress: !args.quiet,
     };
     let code = run::run(scene, &plan, stop)?;
@@ -164,7 +185,7 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
             )?;
         }
         None => say!(
-            "replay matches every message of {name} (the wall-clock step_ms of --timing aside)"
+            "replay matches every message of {name} (the wall-clock step_ms and log_wait_ms of --timing aside)"
         )?,
     }
     Ok(code)
@@ -241,7 +262,9 @@ fn first_difference(
 fn same_data(topic: &str, a: &[u8], b: &[u8], timing: bool) -> bool {
     let without_step_ms = |d: &[u8]| {
         let mut v = serde_json::from_slice::<serde_json::Value>(d).ok()?;
-        v.as_object_mut()?.remove("step_ms");
+        let o = v.as_object_mut()?;
+        o.remove("step_ms");
+        o.remove("log_wait_ms");
         Some(v)
     };
     a == b

@@ -126,6 +126,9 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
                     last = stats;
                     if let Some(r) = rec.as_mut() {
                         r.frame(&sim, &stats)?;
+                        if stats.frame % 16 == 0 {
+                            bar.set_message(log_progress(&r.progress(), plan));
+                        }
                     }
                 }
                 Err(e) if sim.interrupted(&e) => {
@@ -146,19 +149,30 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
         Ok(())
     })();
     bar.finish_and_clear();
-    let wall = start.elapsed().as_secs_f64();
     let frames = last.frame;
+    let mut logged = None;
     // Close the log on every way out, so it is readable and says how the run ended; only a
     // finished log is renamed into place.
-    if let (Some(r), Some(o)) = (rec, log) {
+    if let (Some(mut r), Some(o)) = (rec, log) {
         let target = o.target().display().to_string();
+        // A run logged every N frames still ends its log with its last state (unless the
+        // stop tore the last frame apart or it diverged).
+        let whole = !torn && !matches!(status, Status::Diverged(_));
+        let result = match result {
+            Ok(()) if whole => r.last_frame(&sim, &last).map_err(anyhow::Error::from),
+            result => result,
+        };
+        let progress = r.progress();
         let finished = r.finish(&status, frames);
         result.with_context(|| format!("writing {target}"))?;
         finished.with_context(|| format!("finishing {target}"))?;
         o.commit()?;
+        logged = Some(progress);
     } else {
         result?;
     }
+    // The run's wall time includes writing out what the log's queue still held.
+    let wall = start.elapsed().as_secs_f64();
     if let Some(mut o) = dump {
         if torn {
             eprintln!(
@@ -195,6 +209,14 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
     if let Some(p) = plan.out {
         let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
         say!("wrote {} ({size} bytes)", p.display())?;
+        if let Some(l) = logged {
+            say!(
+                "log: {} frame(s), {:.1} KB a frame; the run waited {:.1} ms for the log's queue",
+                l.frames,
+                size as f64 / 1e3 / l.frames.max(1) as f64,
+                l.waited.as_secs_f64() * 1e3
+            )?;
+        }
     }
     Ok(match status {
         Status::Complete => ExitCode::SUCCESS,
@@ -242,13 +264,26 @@ pub fn divergence_hint(e: &SolverError, sim: &Simulation) -> Option<String> {
     None
 }
 
+/// The progress bar's log part: frames written, megabytes, and the size the log is heading
+/// for.
+fn log_progress(p: &weft_record::LogProgress, plan: &RunPlan<'_>) -> String {
+    let every = plan.record.every.max(1);
+    let total = plan.frames / every + 2;
+    let mb = p.bytes as f64 / 1e6;
+    let projected = mb / p.written_frames.max(1) as f64 * total as f64;
+    format!(
+        "log {} frames, {mb:.0} MB, about {projected:.0} MB at the end",
+        p.written_frames
+    )
+}
+
 fn progress_bar(frames: u64, wanted: bool) -> ProgressBar {
     if !wanted || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::with_draw_target(Some(frames), ProgressDrawTarget::stderr());
     if let Ok(style) =
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}  {msg}")
     {
         bar.set_style(style);
     }

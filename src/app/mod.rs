@@ -81,7 +81,7 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
             SessionLog::new(
                 f,
                 &sim,
-                args.mesh_every,
+                args.log.options(false),
                 args.exit_after_frames.unwrap_or(0),
             )
         })

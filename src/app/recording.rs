@@ -25,13 +25,9 @@ impl SessionLog {
     pub fn new(
         out: Output,
         sim: &Simulation,
-        mesh_every: u64,
+        options: RecordOptions,
         planned: u64,
     ) -> anyhow::Result<Self> {
-        let options = RecordOptions {
-            mesh_every,
-            timing: false,
-        };
         let target = out.target().display().to_string();
         let mut rec = Recorder::new(out.handle()?, sim, planned, options)
             .with_context(|| format!("writing {target}"))?;

@@ -296,7 +296,9 @@ mod tests {
         let _ = std::fs::remove_file(&path);
         let out = crate::output::Output::create(&path).expect("temp file");
         let partial = out.partial().to_path_buf();
-        s.log = Some(SessionLog::new(out, &s.sim, 0, 0).expect("log"));
+        s.log = Some(
+            SessionLog::new(out, &s.sim, weft_record::RecordOptions::default(), 0).expect("log"),
+        );
         let e = s.switch_scene(SceneSource::Default).expect_err("refused");
         assert!(format!("{e}").contains("recorded"), "{e}");
         assert_eq!(s.source, file);

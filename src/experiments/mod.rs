@@ -389,7 +389,7 @@ fn execute(
         Some(o) => {
             let options = RecordOptions {
                 mesh_every: 0,
-                timing: false,
+                ..RecordOptions::default()
             };
             let rec = Recorder::new(o.handle()?, &sim, frames, options)
                 .with_context(|| format!("writing {}", o.target().display()))?;

@@ -1,6 +1,7 @@
 //! What an export reads from a log: the logged frames (from `/stats`), each cloth's triangles
 //! (the first `/cloth/<name>/mesh` message, or the logged scene's when the log has no surface),
-//! its positions at the chosen frames (`/cloth/<name>/particles`), and each collider's mesh in
+//! its positions at the chosen frames (`/cloth/<name>/particles`, or the surface's points in a
+//! log without particles), and each collider's mesh in
 //! its own frame (the logged scene's shape, tessellated) with its pose at those frames
 //! (`/colliders/state`, or the scene's prescribed motion for logs written before that channel).
 
@@ -101,24 +102,45 @@ pub fn read_tracks(
             .and_then(|t| t.rsplit_once('/'))
             .and_then(|(name, what)| Some((*cloth_index.get(name)?, what)));
         match cloth {
-            Some((i, "mesh")) if logged_triangles[i].is_none() => {
+            Some((i, "mesh")) => {
+                // A surface-only log (`--log surface`) gives the positions too; the particles,
+                // written before the surface within a frame, are preferred.
+                let at = slot
+                    .get(&m.log_time)
+                    .copied()
+                    .filter(|&k| positions[i][k].is_none());
+                if logged_triangles[i].is_some() && at.is_none() {
+                    continue;
+                }
                 let update = SceneUpdate::decode(&m.data[..])
                     .with_context(|| format!("{topic}: not a foxglove.SceneUpdate"))?;
-                let indices = update
+                let list = update
                     .entities
                     .first()
                     .and_then(|e| e.triangles.first())
-                    .map(|t| t.indices.clone())
                     .with_context(|| format!("{topic}: a message without triangles"))?;
-                if indices.len() % 3 != 0 {
-                    bail!("{topic}: {} indices, not whole triangles", indices.len());
+                if logged_triangles[i].is_none() {
+                    if list.indices.len() % 3 != 0 {
+                        bail!(
+                            "{topic}: {} indices, not whole triangles",
+                            list.indices.len()
+                        );
+                    }
+                    logged_triangles[i] = Some(
+                        list.indices
+                            .chunks_exact(3)
+                            .map(|t| [t[0], t[1], t[2]])
+                            .collect(),
+                    );
                 }
-                logged_triangles[i] = Some(
-                    indices
-                        .chunks_exact(3)
-                        .map(|t| [t[0], t[1], t[2]])
-                        .collect(),
-                );
+                if let Some(k) = at {
+                    positions[i][k] = Some(
+                        list.points
+                            .iter()
+                            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+                            .collect(),
+                    );
+                }
             }
             Some((i, "particles")) => {
                 let Some(&k) = slot.get(&m.log_time) else {
@@ -126,21 +148,14 @@ pub fn read_tracks(
                 };
                 let cloud = PointCloud::decode(&m.data[..])
                     .with_context(|| format!("{topic}: not a foxglove.PointCloud"))?;
-                if cloud.point_stride != 12 || cloud.data.len() % 12 != 0 {
-                    bail!(
-                        "{topic}: points are not float32 x, y, z (stride {})",
+                let points = weft_record::messages::positions_of(&cloud).with_context(|| {
+                    format!(
+                        "{topic}: points are neither float32 x, y, z nor binary16 x_f16, y_f16, \
+                         z_f16 (stride {})",
                         cloud.point_stride
-                    );
-                }
-                let f =
-                    |c: &[u8], o: usize| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]]);
-                positions[i][k] = Some(
-                    cloud
-                        .data
-                        .chunks_exact(12)
-                        .map(|c| [f(c, 0), f(c, 4), f(c, 8)])
-                        .collect(),
-                );
+                    )
+                })?;
+                positions[i][k] = Some(points);
             }
             _ => {
                 if topic == collider_state::TOPIC
@@ -163,14 +178,13 @@ pub fn read_tracks(
         for (k, p) in per_frame.into_iter().enumerate() {
             let p = p.with_context(|| {
                 format!(
-                    "/cloth/{}/particles has no message at frame {}",
+                    "neither /cloth/{0}/particles nor /cloth/{0}/mesh has a message at frame {1}",
                     spec.name, frames[k]
                 )
             })?;
             if p.len() != count {
                 bail!(
-                    "/cloth/{}/particles holds {} points at frame {}; the logged scene's cloth \
-                     has {count}",
+                    "/cloth/{} holds {} points at frame {}; the logged scene's cloth has {count}",
                     spec.name,
                     p.len(),
                     frames[k]

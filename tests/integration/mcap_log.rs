@@ -29,7 +29,13 @@ fn log_holds_every_frame_and_matches_the_dumped_positions() {
     assert!(o.contains("20 frames, 0.333 s simulated"), "{o}");
     let log = read_log(&mcap);
     assert_eq!(log.counts["/cloth/flag/particles"], 21, "{:?}", log.counts);
-    assert_eq!(log.counts["/cloth/flag/mesh"], 21);
+    // By default the particles only: the surface is `--log all`'s.
+    assert!(
+        !log.counts.contains_key("/cloth/flag/mesh"),
+        "{:?}",
+        log.counts
+    );
+    assert_eq!(log.metadata["weft.run"]["log"], "particles");
     assert_eq!(log.counts["/stats"], 21);
     assert_eq!(log.metadata["weft.status"]["status"], "complete");
     assert_eq!(log.metadata["weft.run"]["frames"], "20");
@@ -40,6 +46,72 @@ fn log_holds_every_frame_and_matches_the_dumped_positions() {
         serde_json::from_value(dumped["cloths"]["flag"].clone()).expect("positions");
     assert_eq!(log.last["/cloth/flag/particles"], expected);
     assert_eq!(expected.len(), 64);
+}
+
+/// Runs `SMALL` for 20 frames logged with `options`; returns the log and the dumped positions.
+fn logged_with(dir: &Path, name: &str, options: &[&str]) -> (Log, Vec<[f32; 3]>) {
+    let scene = write(dir, "small.toml", SMALL);
+    let mcap = dir.join(format!("{name}.mcap"));
+    let json = dir.join(format!("{name}.json"));
+    let (mcap_arg, json_arg) = (mcap.to_string_lossy(), json.to_string_lossy());
+    let mut args = vec![
+        "run",
+        &scene,
+        "--frames",
+        "20",
+        "--out",
+        &mcap_arg,
+        "--dump-final",
+        &json_arg,
+    ];
+    args.extend_from_slice(options);
+    let out = run(&args);
+    assert!(out.status.success(), "{options:?}: {:?}", texts(&out));
+    let dumped: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parses");
+    let expected = serde_json::from_value(dumped["cloths"]["flag"].clone()).expect("positions");
+    (read_log(&mcap), expected)
+}
+
+/// Each logging choice gives the channels and frames it names, ending at the dumped state.
+#[test]
+fn logging_choices_give_the_channels_frames_and_precision_they_name() {
+    let dir = temp_dir("log-choices");
+    let (all, expected) = logged_with(&dir, "all", &["--log", "all", "--mesh-every", "2"]);
+    assert_eq!(all.counts["/cloth/flag/particles"], 21);
+    assert_eq!(all.counts["/cloth/flag/mesh"], 11);
+    assert_eq!(all.last["/cloth/flag/particles"], expected);
+
+    let (surface, _) = logged_with(&dir, "surface", &["--log", "surface"]);
+    assert!(!surface.counts.contains_key("/cloth/flag/particles"));
+    assert_eq!(surface.counts["/cloth/flag/mesh"], 21);
+
+    // Every 6th frame (0, 6, 12, 18) and the last (20).
+    let (every, _) = logged_with(&dir, "every", &["--every", "6"]);
+    assert_eq!(every.counts["/cloth/flag/particles"], 5);
+    assert_eq!(every.counts["/stats"], 5);
+    assert_eq!(every.last["/cloth/flag/particles"], expected);
+    assert_eq!(every.metadata["weft.run"]["every"], "6");
+
+    let (zstd, _) = logged_with(&dir, "zstd", &["--compression", "zstd"]);
+    assert_eq!(zstd.last["/cloth/flag/particles"], expected);
+    assert_eq!(zstd.metadata["weft.run"]["compression"], "zstd");
+
+    // Half floats: within 2^-11 of each coordinate (the flag hangs within 2 m of the origin).
+    let (half, _) = logged_with(&dir, "half", &["--precision", "f16"]);
+    let got = &half.last["/cloth/flag/particles"];
+    assert_eq!(got.len(), expected.len());
+    let worst = got
+        .iter()
+        .flatten()
+        .zip(expected.iter().flatten())
+        .map(|(a, b)| (a - b).abs() / b.abs().max(1e-3))
+        .fold(0.0_f32, f32::max);
+    assert!(worst <= 2f32.powi(-11), "relative error {worst}");
+    assert!(
+        worst > 0.0,
+        "f16 positions equal the f32 ones: not half floats"
+    );
 }
 
 #[test]
@@ -75,6 +147,37 @@ fn reruns_and_replays_are_byte_identical() {
     let out = run(&["run", &scene, "--frames", "15", "--out", &paths[1]]);
     assert!(out.status.success());
     assert_ne!(a, std::fs::read(&paths[1]).expect("b"));
+    // Every logging choice is in the log, and its replay is byte-identical too.
+    let chosen = dir.join("chosen.mcap");
+    let out = run(&[
+        "run",
+        &scene,
+        "--frames",
+        "15",
+        "--out",
+        &chosen.to_string_lossy(),
+        "--log",
+        "all",
+        "--every",
+        "4",
+        "--mesh-every",
+        "2",
+        "--precision",
+        "f16",
+        "--compression",
+        "zstd",
+    ]);
+    assert!(out.status.success(), "{:?}", texts(&out));
+    let again = dir.join("chosen-again.mcap");
+    let out = run(&[
+        "replay",
+        &chosen.to_string_lossy(),
+        "--out",
+        &again.to_string_lossy(),
+    ]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(o.contains("byte-identical"), "{o}");
 }
 
 #[test]
@@ -97,10 +200,18 @@ fn the_default_scene_is_hanging_toml() {
 }
 
 fn interrupted_run_leaves_a_valid_log(signal: &str) {
-    let dir = temp_dir(&format!("signal-{signal}"));
-    let scene = write(&dir, "small.toml", SMALL);
+    interrupted_log(signal, SMALL, &[]);
+}
+
+/// Runs `scene` logged with `options` until `signal`; checks the log is valid, interrupted,
+/// and holds every frame simulated; returns the log's path.
+fn interrupted_log(signal: &str, scene: &str, options: &[&str]) -> std::path::PathBuf {
+    let dir = temp_dir(&format!("signal-{signal}-{}", options.len()));
+    let scene = write(&dir, "small.toml", scene);
     let mcap = dir.join("run.mcap");
-    let child = spawn_logging(&["run", &scene, "--frames", "100000000"], &mcap);
+    let mut args = vec!["run", scene.as_str(), "--frames", "100000000"];
+    args.extend_from_slice(options);
+    let child = spawn_logging(&args, &mcap);
     std::thread::sleep(Duration::from_millis(800));
     let kill = std::process::Command::new("kill")
         .args([format!("-{signal}"), child.id().to_string()])
@@ -118,6 +229,30 @@ fn interrupted_run_leaves_a_valid_log(signal: &str) {
     assert!(frames > 0, "no frame simulated before the signal");
     assert_eq!(log.counts["/cloth/flag/particles"], frames + 1);
     assert_eq!(log.counts["/stats"], frames + 1);
+    mcap
+}
+
+/// SIGINT while the log's queue is full (the surface compressed on a 64² cloth is slower to
+/// log than to simulate): every frame handed to the queue is in the file, and it is valid.
+#[test]
+fn sigint_with_a_queued_backlog_keeps_every_frame_handed_over() {
+    let options = ["--log", "all", "--compression", "zstd", "--timing"];
+    let mcap = interrupted_log("INT", &big(64), &options);
+    // The run waited for the queue: frames were queued when the signal came.
+    let bytes = std::fs::read(&mcap).expect("the log");
+    let waited = mcap::MessageStream::new(&bytes)
+        .expect("readable")
+        .filter_map(|m| m.ok())
+        .filter(|m| m.channel.topic == "/stats")
+        .filter_map(|m| serde_json::from_slice::<serde_json::Value>(&m.data).ok())
+        .filter_map(|v| v["log_wait_ms"].as_f64())
+        .fold(0.0, f64::max);
+    assert!(waited > 0.0, "the queue never filled");
+    let log = read_log(&mcap);
+    let frames: usize = log.metadata["weft.status"]["frames"]
+        .parse()
+        .expect("number");
+    assert_eq!(log.counts["/cloth/flag/mesh"], frames + 1);
 }
 
 #[test]

@@ -147,5 +147,8 @@ fn an_interrupted_or_timed_log_matches_over_what_it_holds() {
     assert!(out.status.success(), "{:?}", texts(&out));
     let (code, o, e) = replay(&dir, &timed);
     assert_eq!(code, Some(0), "{o}{e}");
-    assert!(o.contains("step_ms of --timing aside"), "{o}");
+    assert!(
+        o.contains("step_ms and log_wait_ms of --timing aside"),
+        "{o}"
+    );
 }

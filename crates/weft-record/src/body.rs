@@ -107,7 +107,7 @@ mod tests {
         let file = std::fs::File::create(&path).expect("a temporary file");
         let options = RecordOptions {
             mesh_every: 0,
-            timing: false,
+            ..RecordOptions::default()
         };
         let frames = 40;
         let mut rec = Recorder::new(file, &sim, frames, options).expect("a recorder");

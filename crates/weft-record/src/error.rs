@@ -15,6 +15,9 @@ pub enum RecordError {
     /// A Foxglove message could not be encoded.
     #[error("encoding a Foxglove message: {0}")]
     Encode(Box<dyn std::error::Error + Send + Sync>),
+    /// The log's own thread stopped without saying why.
+    #[error("{0}")]
+    Worker(String),
     /// The foxglove crate has no schema for a message type it should describe.
     #[error("the foxglove schema of {0} is missing")]
     SchemaMissing(&'static str),

@@ -8,6 +8,8 @@ use foxglove::messages::{
     Vector3,
 };
 use weft_collide::ShapeDesc;
+
+use crate::options::Precision;
 use weft_scene::ColliderSpec;
 use weft_solver::glam::{DQuat, DVec3};
 
@@ -47,23 +49,40 @@ pub(super) fn pose(position: DVec3, rotation: DQuat) -> Pose {
 
 /// Every particle's position as float32 x, y, z in particle order.
 pub fn point_cloud(time: f64, positions: &[DVec3]) -> PointCloud {
-    let mut data = Vec::with_capacity(12 * positions.len());
+    point_cloud_as(time, positions, Precision::F32)
+}
+
+/// Every particle's position in particle order at `precision`: float32 `x`, `y`, `z`, or
+/// IEEE binary16 `x_f16`, `y_f16`, `z_f16` (declared UINT16: Foxglove has no 16-bit float).
+pub fn point_cloud_as(time: f64, positions: &[DVec3], precision: Precision) -> PointCloud {
+    let (size, names, kind) = match precision {
+        Precision::F32 => (4, ["x", "y", "z"], NumericType::Float32),
+        Precision::F16 => (2, ["x_f16", "y_f16", "z_f16"], NumericType::Uint16),
+    };
+    let mut data = Vec::with_capacity(3 * size * positions.len());
     for p in positions {
         for c in [p.x, p.y, p.z] {
-            data.extend_from_slice(&(c as f32).to_le_bytes());
+            match precision {
+                Precision::F32 => data.extend_from_slice(&(c as f32).to_le_bytes()),
+                Precision::F16 => data.extend_from_slice(&half::f16::from_f64(c).to_le_bytes()),
+            }
         }
     }
-    let field = |name: &str, offset| PackedElementField {
-        name: name.into(),
-        offset,
-        r#type: NumericType::Float32 as i32,
-    };
+    let fields = names
+        .iter()
+        .zip(0..)
+        .map(|(name, i)| PackedElementField {
+            name: (*name).into(),
+            offset: i * size as u32,
+            r#type: kind as i32,
+        })
+        .collect();
     PointCloud {
         timestamp: Some(timestamp(time)),
         frame_id: FRAME_ID.into(),
         pose: Some(pose(DVec3::ZERO, DQuat::IDENTITY)),
-        point_stride: 12,
-        fields: vec![field("x", 0), field("y", 4), field("z", 8)],
+        point_stride: 3 * size as u32,
+        fields,
         data: Bytes::from(data),
     }
 }
@@ -227,5 +246,71 @@ pub fn colliders(time: f64, colliders: &[ColliderSpec]) -> SceneUpdate {
     SceneUpdate {
         deletions: vec![],
         entities,
+    }
+}
+
+/// The positions of a point cloud written by [`point_cloud_as`] (float32 `x`, `y`, `z` or
+/// binary16 `x_f16`, `y_f16`, `z_f16`), as float32; `None` for any other layout.
+pub fn positions_of(cloud: &PointCloud) -> Option<Vec<[f32; 3]>> {
+    let names: Vec<(&str, u32)> = cloud
+        .fields
+        .iter()
+        .map(|f| (f.name.as_str(), f.offset))
+        .collect();
+    let data = &cloud.data[..];
+    match (cloud.point_stride, names.as_slice()) {
+        (12, [("x", 0), ("y", 4), ("z", 8)]) if data.len() % 12 == 0 => {
+            let f = |c: &[u8], o: usize| f32::from_le_bytes([c[o], c[o + 1], c[o + 2], c[o + 3]]);
+            Some(
+                data.chunks_exact(12)
+                    .map(|c| [f(c, 0), f(c, 4), f(c, 8)])
+                    .collect(),
+            )
+        }
+        (6, [("x_f16", 0), ("y_f16", 2), ("z_f16", 4)]) if data.len() % 6 == 0 => {
+            let f = |c: &[u8], o: usize| half::f16::from_le_bytes([c[o], c[o + 1]]).to_f32();
+            Some(
+                data.chunks_exact(6)
+                    .map(|c| [f(c, 0), f(c, 2), f(c, 4)])
+                    .collect(),
+            )
+        }
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Positions read back at each precision are within its stated bound of the originals.
+    #[test]
+    fn positions_read_back_within_their_precision() {
+        let x: Vec<DVec3> = (0..200)
+            .map(|i| {
+                let t = i as f64 * 0.037;
+                DVec3::new(t.sin() * 1.9, -t * 0.01, 0.3 + t.cos())
+            })
+            .collect();
+        for (precision, bound) in [
+            (Precision::F32, 2f64.powi(-24)),
+            (Precision::F16, 2f64.powi(-11)),
+        ] {
+            let cloud = point_cloud_as(1.0, &x, precision);
+            let back = positions_of(&cloud).expect("a layout it wrote");
+            assert_eq!(back.len(), x.len());
+            for (p, q) in x.iter().zip(&back) {
+                for (a, b) in [(p.x, q[0]), (p.y, q[1]), (p.z, q[2])] {
+                    let err = (a - f64::from(b)).abs();
+                    assert!(
+                        err <= bound * a.abs().max(6.1e-5),
+                        "{precision:?}: {a} read as {b}"
+                    );
+                }
+            }
+        }
+        let mut odd = point_cloud(0.0, &x);
+        odd.point_stride = 16;
+        assert!(positions_of(&odd).is_none());
     }
 }

@@ -169,7 +169,7 @@ mod tests {
         let file = std::fs::File::create(&path).expect("a temporary file");
         let options = RecordOptions {
             mesh_every: 0,
-            timing: false,
+            ..RecordOptions::default()
         };
         let mut rec = Recorder::new(file, &sim, 2, options).expect("a recorder");
         rec.frame(&sim, &sim.stats(0.0, 0)).expect("frame 0");

@@ -48,6 +48,8 @@ pub fn logged_run(dir: &Path, name: &str, scene: &str, frames: u32, log: &str) -
         &frames.to_string(),
         "--out",
         &path.to_string_lossy(),
+        "--log",
+        "all",
     ]);
     assert!(out.status.success(), "{:?}", texts(&out));
     path
@@ -147,15 +149,26 @@ pub fn read_log(path: &Path) -> Log {
         previous_time = m.log_time;
         if topic.ends_with("/particles") {
             let pc = PointCloud::decode(&m.data[..]).expect("PointCloud decodes");
-            assert_eq!(pc.point_stride, 12);
-            let pts = pc
-                .data
-                .chunks_exact(12)
-                .map(|c| {
-                    let f = |k: usize| f32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
-                    [f(0), f(4), f(8)]
-                })
-                .collect();
+            // float32 x, y, z, or binary16 (`--precision f16`), read with the `half` crate.
+            let pts = match pc.point_stride {
+                12 => pc
+                    .data
+                    .chunks_exact(12)
+                    .map(|c| {
+                        let f = |k: usize| f32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+                        [f(0), f(4), f(8)]
+                    })
+                    .collect(),
+                6 => pc
+                    .data
+                    .chunks_exact(6)
+                    .map(|c| {
+                        let f = |k: usize| half::f16::from_le_bytes([c[k], c[k + 1]]).to_f32();
+                        [f(0), f(2), f(4)]
+                    })
+                    .collect(),
+                other => panic!("{topic}: point stride {other}"),
+            };
             last.insert(topic, pts);
         }
     }
