@@ -10,6 +10,7 @@ mod layout;
 pub mod messages;
 mod options;
 mod sink;
+mod surface;
 pub mod verify;
 mod worker;
 mod writer;

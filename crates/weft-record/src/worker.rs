@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, SyncSender};
 
 use foxglove::Encode;
-use foxglove::messages::{Color, SceneUpdate};
+use foxglove::messages::SceneUpdate;
 use mcap::records::{MessageHeader, Metadata};
 use serde_json::Value;
 use weft_sim::FrameStats;
@@ -16,6 +16,7 @@ use crate::error::{RecordError, Result};
 use crate::layout::{CHANNELS, Ids, LogWriter, channel, json_schema};
 use crate::messages;
 use crate::options::RecordOptions;
+use crate::surface::SurfaceEncoder;
 use crate::writer::Status;
 
 /// One frame as the run handed it over: copies, so the run may step on at once.
@@ -67,24 +68,14 @@ pub(crate) enum Job {
     },
 }
 
-/// What the log needs of each scene cloth besides its positions.
-pub(crate) struct ClothInfo {
-    /// The cloth's name.
-    pub name: String,
-    /// Its method's colour.
-    pub color: Color,
-    /// Its triangles.
-    pub triangles: Vec<[u32; 3]>,
-}
-
 /// The log's thread's state.
 pub(crate) struct Worker {
     /// The MCAP writer.
     pub w: LogWriter,
     /// Its channels.
     pub ids: Ids,
-    /// The scene's cloths.
-    pub cloths: Vec<ClothInfo>,
+    /// Each scene cloth's surface messages.
+    pub surfaces: Vec<SurfaceEncoder>,
     /// What is logged.
     pub options: RecordOptions,
     /// Position buffers handed back to the run for reuse.
@@ -162,10 +153,8 @@ impl Worker {
                 self.put(ch, time, &messages::point_cloud_as(time, x, precision))?;
             }
             if f.surface {
-                let c = &self.cloths[i];
-                let m = messages::cloth_mesh(time, &c.name, x, &c.triangles, c.color);
-                let ch = self.ids.meshes[i];
-                self.put(ch, time, &m)?;
+                self.surfaces[i].encode(time, x, &mut self.buf);
+                self.raw(self.ids.meshes[i], time)?;
             }
         }
         if let (Some(ch), Some(m)) = (self.ids.colliders, &f.colliders) {

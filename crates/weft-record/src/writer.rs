@@ -16,7 +16,8 @@ use crate::error::{RecordError, Result};
 use crate::layout::{self, Ids};
 use crate::options::RecordOptions;
 use crate::sink::Sink;
-use crate::worker::{ClothInfo, Frame, Job, Worker};
+use crate::surface::SurfaceEncoder;
+use crate::worker::{Frame, Job, Worker};
 use crate::{body, collider_state, messages};
 
 /// How a run ended, written as the `weft.status` metadata record.
@@ -79,13 +80,12 @@ impl Recorder {
         let written = Arc::new(AtomicU64::new(0));
         let (w, ids) = layout::open(Sink::new(file, Arc::clone(&written)), sim, frames, &options)?;
         let scene = &sim.scene;
-        let cloths = scene
+        let surfaces = scene
             .cloths
             .iter()
-            .map(|c| ClothInfo {
-                name: c.name.clone(),
-                color: messages::method_color(c.method),
-                triangles: c.mesh.triangles.clone(),
+            .filter(|_| options.has_surface())
+            .map(|c| {
+                SurfaceEncoder::new(&c.name, &c.mesh.triangles, messages::method_color(c.method))
             })
             .collect();
         let particles: usize = (0..scene.cloths.len())
@@ -100,7 +100,7 @@ impl Recorder {
             frames: Arc::clone(&written_frames),
             w,
             ids: ids.clone(),
-            cloths,
+            surfaces,
             options,
             spare: give_back,
             sequence: 0,
