@@ -123,6 +123,7 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
     // Finish the log on every way out (window closed, q, Ctrl-C, an error).
     let interrupted = app.interrupted;
     let error = app.error.take();
+    let rate = app.frame_rate();
     let session = app.session_mut();
     let frames = session.frames;
     let finished = session.finish(interrupted);
@@ -132,6 +133,9 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
     }
     finished.context("finishing the MCAP file")?;
     println!("{frames} frames simulated");
+    if let Some((drawn, per_second)) = rate {
+        println!("{drawn} frames drawn, {per_second:.1} a second");
+    }
     if let Some(p) = &args.record {
         let size = std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
         println!("wrote {} ({size} bytes)", p.display());

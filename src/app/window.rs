@@ -63,6 +63,8 @@ pub struct App {
     drag: Option<(DragMode, MouseButton)>,
     shift: bool,
     last_frame: Option<Instant>,
+    /// The first frame's start and the frames drawn since.
+    drawn: Option<(Instant, u64)>,
     /// Set when the loop must end with an error (no adapter, a failed log write).
     pub error: Option<anyhow::Error>,
     /// Whether SIGINT/SIGTERM ended the session.
@@ -70,6 +72,13 @@ pub struct App {
 }
 
 impl App {
+    /// Frames drawn and the frames a second they came at, once two have been drawn.
+    pub fn frame_rate(&self) -> Option<(u64, f64)> {
+        let (start, n) = self.drawn?;
+        let seconds = start.elapsed().as_secs_f64();
+        (n > 1 && seconds > 0.0).then(|| (n, (n - 1) as f64 / seconds))
+    }
+
     /// A viewer of `session`; `stop` is raised by the signal handler.
     pub fn new(
         session: Session,
@@ -101,6 +110,7 @@ impl App {
             drag: None,
             shift: false,
             last_frame: None,
+            drawn: None,
             error: None,
             interrupted: false,
         }
@@ -252,6 +262,7 @@ impl App {
         if let Some(last) = self.last_frame.replace(now) {
             self.session.stats.frame_ms = (now - last).as_secs_f64() * 1e3;
         }
+        self.drawn.get_or_insert((now, 0)).1 += 1;
         if let Err(e) = self.session.advance(self.config.exit_after_frames) {
             return self.fail(event_loop, e);
         }
