@@ -315,14 +315,41 @@ def not_benches():
     print()
 
 
-def logging(r):
-    print("## MCAP logging, default scene at 128² (`weft run` with and without `--out`)\n")
-    a, b, w = (ms(r, f"weft_run/16384/{k}") for k in ["no_log", "mcap", "writer_only"])
-    over = f"{100 * (b - a) / a:+.0f} %" if a and b else "–"
-    print("| no log ms/frame | with MCAP ms/frame | overhead | writer alone ms/frame |")
-    print("|---|---|---|---|")
-    print(f"| {fmt(a)} | {fmt(b)} | {over} | {fmt(w)} |")
-    print()
+LOG_ROWS = [
+    ("particles", "`--log particles` (the default): positions, no compression"),
+    ("particles_f16", "`--log particles --precision f16`"),
+    ("particles_zstd", "`--log particles --compression zstd`"),
+    ("all", "`--log all`: positions and the surface every frame"),
+    ("all_zstd", "`--log all --compression zstd`"),
+]
+
+
+def logging(r, root):
+    print("## MCAP logging (`weft run --out`, the log on its own thread)\n")
+    path = root / "logging_bytes.json"
+    try:
+        sizes = json.loads(path.read_text())
+    except (OSError, ValueError):
+        sizes = {}
+    scenes = [("reference", "the 128² reference"), ("walker", "the walker in its T-shirt")]
+    head = " | ".join(f"{label} ms/frame | × no log | KB/frame" for _, label in scenes)
+    print(f"| log | {head} |")
+    print("|---|" + "---|" * (3 * len(scenes)))
+    cells = []
+    for scene, _ in scenes:
+        cells += [fmt(ms(r, f"logging/{scene}/no_log")), "1", "–"]
+    print("| no log | " + " | ".join(cells) + " |")
+    for row, label in LOG_ROWS:
+        cells = []
+        for scene, _ in scenes:
+            base, t = ms(r, f"logging/{scene}/no_log"), ms(r, f"logging/{scene}/{row}")
+            size = sizes.get(f"{scene}/{row}")
+            cells += [fmt(t), f"{t / base:.2f}" if base and t else "–",
+                      f"{size / 1e3:.0f}" if size else "–"]
+        print(f"| {label} | " + " | ".join(cells) + " |")
+    print("\nEach sample's time includes finishing its log (the queue written out, the summary, "
+          "the sync). KB/frame: a 120-frame log's size over its 121 frames "
+          "(`logging_bytes.json`, written by the bench).\n")
 
 
 def cpu_model():
@@ -417,7 +444,7 @@ def write_page(r, root, note):
     mesh_contact(r)
     character(r)
     dressed(r)
-    logging(r)
+    logging(r, root)
     not_benches()
 
 
@@ -507,8 +534,15 @@ SPEED_ROWS = [
      (DRESSED, "solve + body contact + self-collision", "ms/frame", "the walker in its T-shirt")),
     ("skinned glTF character", "`glb_character.toml`: a cape on a jumping body", "all",
      (DRESSED, "solve + skinned-body contact + self-collision", "ms/frame", "the BCN glTF")),
-    ("`weft run`, no log", "`hanging.toml` at 128²", "all", (LOGGING, None, "no log", None)),
-    ("`weft run --out`, MCAP log", "the same", "all", (LOGGING, None, "with MCAP", None)),
+    ("`weft run --out` (particles, the default)", "`reference.toml` at 128²", "all",
+     (LOGGING, "`--log particles` (the default): positions, no compression",
+      "128² reference ms/frame", None)),
+    ("`weft run --out --log all`", "the same", "all",
+     (LOGGING, "`--log all`: positions and the surface every frame", "128² reference ms/frame",
+      None)),
+    ("`weft run --out` (particles, the default)", "`character.toml`", "all",
+     (LOGGING, "`--log particles` (the default): positions, no compression",
+      "T-shirt ms/frame", None)),
 ]
 
 
