@@ -180,6 +180,51 @@ fn reruns_and_replays_are_byte_identical() {
     assert!(o.contains("byte-identical"), "{o}");
 }
 
+/// The same bytes on 1 and 2 solver threads, and with 1 or 2 zstd workers (one per core the
+/// process may use: `taskset` gives it one).
+#[test]
+fn logs_are_the_same_bytes_on_any_number_of_threads() {
+    let dir = temp_dir("threads");
+    let scene = write(&dir, "s.toml", &big(24));
+    let log = |name: &str, threads: &str, one_core: bool| {
+        let path = dir.join(name);
+        let args = [
+            "run",
+            scene.as_str(),
+            "--frames",
+            "20",
+            "--log",
+            "all",
+            "--compression",
+            "zstd",
+            "--out",
+            &path.to_string_lossy(),
+        ];
+        let mut cmd = if one_core {
+            let mut c = std::process::Command::new("taskset");
+            c.args(["-c", "0", env!("CARGO_BIN_EXE_weft")]);
+            c.current_dir(env!("CARGO_MANIFEST_DIR"));
+            c
+        } else {
+            weft()
+        };
+        let out = cmd
+            .args(args)
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .expect("weft starts");
+        assert!(out.status.success(), "{name}: {:?}", texts(&out));
+        std::fs::read(&path).expect("the log")
+    };
+    let one = log("one.mcap", "1", true);
+    assert_eq!(one, log("two.mcap", "2", false), "1 and 2 threads differ");
+    assert_eq!(
+        one,
+        log("mixed.mcap", "2", true),
+        "1 and 2 zstd workers differ"
+    );
+}
+
 #[test]
 fn the_default_scene_is_hanging_toml() {
     let dir = temp_dir("default");
