@@ -10,6 +10,7 @@ use foxglove::messages::{
 use weft_collide::ShapeDesc;
 
 use crate::options::Precision;
+use half::slice::HalfFloatSliceExt;
 use weft_scene::ColliderSpec;
 use weft_solver::glam::{DQuat, DVec3};
 
@@ -53,18 +54,33 @@ pub fn point_cloud(time: f64, positions: &[DVec3]) -> PointCloud {
 }
 
 /// Every particle's position in particle order at `precision`: float32 `x`, `y`, `z`, or
-/// IEEE binary16 `x_f16`, `y_f16`, `z_f16` (declared UINT16: Foxglove has no 16-bit float).
+/// IEEE binary16 `x_f16`, `y_f16`, `z_f16` (declared UINT16: Foxglove has no 16-bit float),
+/// rounded through float32 (within 2⁻¹¹ + 2⁻²⁴ of each coordinate).
 pub fn point_cloud_as(time: f64, positions: &[DVec3], precision: Precision) -> PointCloud {
     let (size, names, kind) = match precision {
         Precision::F32 => (4, ["x", "y", "z"], NumericType::Float32),
         Precision::F16 => (2, ["x_f16", "y_f16", "z_f16"], NumericType::Uint16),
     };
     let mut data = Vec::with_capacity(3 * size * positions.len());
-    for p in positions {
-        for c in [p.x, p.y, p.z] {
-            match precision {
-                Precision::F32 => data.extend_from_slice(&(c as f32).to_le_bytes()),
-                Precision::F16 => data.extend_from_slice(&half::f16::from_f64(c).to_le_bytes()),
+    match precision {
+        Precision::F32 => {
+            for p in positions {
+                for c in [p.x, p.y, p.z] {
+                    data.extend_from_slice(&(c as f32).to_le_bytes());
+                }
+            }
+        }
+        Precision::F16 => {
+            // Through float32, whose slice conversion uses the CPU's F16C instructions where it
+            // has them: 4× as fast as `f16::from_f64` one value at a time.
+            let wide: Vec<f32> = positions
+                .iter()
+                .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+                .collect();
+            let mut narrow = vec![half::f16::ZERO; wide.len()];
+            narrow.convert_from_f32_slice(&wide);
+            for h in narrow {
+                data.extend_from_slice(&h.to_le_bytes());
             }
         }
     }
@@ -294,7 +310,7 @@ mod tests {
             .collect();
         for (precision, bound) in [
             (Precision::F32, 2f64.powi(-24)),
-            (Precision::F16, 2f64.powi(-11)),
+            (Precision::F16, 2f64.powi(-11) + 2f64.powi(-24)),
         ] {
             let cloud = point_cloud_as(1.0, &x, precision);
             let back = positions_of(&cloud).expect("a layout it wrote");
