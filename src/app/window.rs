@@ -453,9 +453,17 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        // A bound key is the viewer's unless a text field is being edited: egui never sees
+        // it, so Tab does not move its focus and Space does not press a focused widget.
+        let viewer_key = match &event {
+            WindowEvent::KeyboardInput { event: k, .. } => {
+                input::action_for(&k.logical_key).is_some() && !self.egui.text_edit_focused()
+            }
+            _ => false,
+        };
         let consumed = match self.gfx.as_mut() {
-            Some(g) => g.egui_state.on_window_event(&g.window, &event).consumed,
-            None => false,
+            Some(g) if !viewer_key => g.egui_state.on_window_event(&g.window, &event).consumed,
+            _ => false,
         };
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
@@ -467,11 +475,17 @@ impl ApplicationHandler for App {
             WindowEvent::RedrawRequested => self.frame(event_loop),
             WindowEvent::ModifiersChanged(m) => self.shift = m.state().shift_key(),
             WindowEvent::KeyboardInput { event, .. } => {
-                if event.state == ElementState::Pressed
+                if viewer_key
+                    && event.state == ElementState::Pressed
                     && !event.repeat
-                    && !self.egui.egui_wants_keyboard_input()
                     && let Some(a) = input::action_for(&event.logical_key)
                 {
+                    // A button or list the panel had focused lets it go.
+                    self.egui.memory_mut(|m| {
+                        if let Some(id) = m.focused() {
+                            m.surrender_focus(id);
+                        }
+                    });
                     self.act(a, event_loop);
                 }
             }

@@ -7,6 +7,7 @@ mod common;
 mod bad_input;
 mod collider_state;
 mod e2e_drag;
+mod e2e_keys;
 mod experiments;
 mod export;
 mod export_body;

@@ -9,6 +9,8 @@ use std::time::Duration;
 use foxglove::Decode;
 use foxglove::messages::PointCloud;
 
+pub mod x11;
+
 /// The binary under test.
 pub fn weft() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_weft"));
