@@ -145,6 +145,10 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Exit with an error, running nothing, when a cloth's explicit springs are past their
+    /// stability limit (the warning `weft check` prints).
+    #[arg(long)]
+    pub strict: bool,
     /// Memory and file-size limits.
     #[command(flatten)]
     pub limits: LimitArgs,
@@ -317,9 +321,19 @@ pub struct CheckArgs {
     /// Overrides to validate with the file.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<Override>,
+    /// Shorthand for `--set sim.method=…` (xpbd, pbd, mass-spring or implicit-mass-spring).
+    #[arg(long)]
+    pub method: Option<Method>,
     /// Memory and file-size limits.
     #[command(flatten)]
     pub limits: LimitArgs,
+}
+
+impl CheckArgs {
+    /// The overrides, `--method` first.
+    pub fn overrides(&self) -> Vec<Override> {
+        overrides(self.method, &self.set)
+    }
 }
 
 /// `weft replay`.
@@ -395,6 +409,9 @@ pub struct RenderArgs {
     /// Override a scene key: `--set sim.substeps=20` (repeatable; values are TOML, else strings).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<Override>,
+    /// Shorthand for `--set sim.method=…` (xpbd, pbd, mass-spring or implicit-mass-spring).
+    #[arg(long)]
+    pub method: Option<Method>,
     /// Draw the cloth's edges.
     #[arg(long)]
     pub wireframe: bool,
@@ -413,6 +430,13 @@ pub struct RenderArgs {
     /// Memory and file-size limits.
     #[command(flatten)]
     pub limits: LimitArgs,
+}
+
+impl RenderArgs {
+    /// The overrides, `--method` first.
+    pub fn overrides(&self) -> Vec<Override> {
+        overrides(self.method, &self.set)
+    }
 }
 
 /// A range of frame numbers: `A..B` (B excluded), `A..=B`, `A..`, `..B`, `..=B` or `..`.

@@ -99,12 +99,17 @@ fn run_command(args: &RunArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCod
         dump_final: args.dump_final.as_deref(),
         record: args.log.options(args.timing),
         progress: !args.quiet,
+        strict: args.strict,
     };
     run::run(scene, &plan, stop)
 }
 
 fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitCode> {
-    let scene = match load_scene(args.scene.as_deref(), &args.set, &args.limits.limits()) {
+    let scene = match load_scene(
+        args.scene.as_deref(),
+        &args.overrides(),
+        &args.limits.limits(),
+    ) {
         Ok(s) => s,
         Err(e) => return Ok(report(&e)),
     };
@@ -141,7 +146,7 @@ fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Res
 
 /// `weft check`: loads and builds the scene. Nothing is written, so a signal ends it at once.
 fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
-    match weft_scene::load_with(&args.scene, &args.set, &args.limits.limits()) {
+    match weft_scene::load_with(&args.scene, &args.overrides(), &args.limits.limits()) {
         Ok(scene) => {
             let groups = match scene.build() {
                 Ok(g) => g,

@@ -161,6 +161,7 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
         dump_final: None,
         record,
         progress: !args.quiet,
+        strict: false,
     };
     let code = run::run(scene, &plan, stop)?;
     if stop.load(Ordering::SeqCst) {

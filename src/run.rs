@@ -36,6 +36,8 @@ pub struct RunPlan<'a> {
     pub record: RecordOptions,
     /// Show a progress bar (on a terminal only).
     pub progress: bool,
+    /// Refuse to run a scene whose explicit springs are past their stability limit.
+    pub strict: bool,
 }
 
 /// Every file `scene` read, as paths: the scene file and its meshes (relative to its directory).
@@ -87,6 +89,11 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
     let dump = plan.dump_final.map(Output::create).transpose()?;
     let name = scene.name.clone();
     let mut sim = Simulation::new(scene)?;
+    if crate::stability::warn(&sim.groups) > 0 && plan.strict {
+        anyhow::bail!(
+            "--strict: a cloth's springs are past their stability limit; nothing was run"
+        );
+    }
     sim.set_stop(Arc::clone(stop));
     // From here a signal raises the flag: the loop below stops and closes the log.
     let _polling = crate::stop::Polling::start();

@@ -1,5 +1,7 @@
-//! Each cloth's explicit-spring stability limit, in words, for `weft check` and the viewer.
+//! Each cloth's explicit-spring stability limit, in words, for `weft check`, the viewer's
+//! panel, and the warning `run`, `view`, `render` and `experiments` print before they start.
 
+use weft_scene::SolverGroup;
 use weft_solver::Solver;
 
 /// One cloth's stability verdict.
@@ -63,5 +65,54 @@ fn millis(s: f64) -> String {
         format!("{:.3} ms", s * 1e3)
     } else {
         "∞".to_owned()
+    }
+}
+
+/// The verdict lines of every cloth in `groups` that will or may explode.
+pub fn warnings(groups: &[SolverGroup]) -> Vec<String> {
+    groups
+        .iter()
+        .flat_map(|g| (0..g.solver.cloths().len()).filter_map(|i| verdict(&g.solver, i)))
+        .filter(|v| !v.ok)
+        .map(|v| v.text)
+        .collect()
+}
+
+/// Prints each of `groups`' warnings to standard error as `weft check` words them, before a
+/// command starts stepping; returns how many there were.
+pub fn warn(groups: &[SolverGroup]) -> usize {
+    let lines = warnings(groups);
+    for line in &lines {
+        eprintln!("weft: warning: {line}");
+    }
+    lines.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn groups(method: &str) -> Vec<SolverGroup> {
+        let set = weft_scene::Override {
+            key: "cloth.springs.method".into(),
+            value: format!("\"{method}\""),
+        };
+        weft_scene::load(std::path::Path::new("assets/scenes/explode.toml"), &[set])
+            .expect("scene loads")
+            .build()
+            .expect("solvers")
+    }
+
+    #[test]
+    fn explicit_springs_past_their_limit_are_warned_about() {
+        let lines = warnings(&groups("mass-spring"));
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        assert!(lines[0].contains("cloth `springs`"), "{}", lines[0]);
+        assert!(
+            lines[0].contains("will explode: use sim.substeps >="),
+            "{}",
+            lines[0]
+        );
+        assert!(warnings(&groups("implicit-mass-spring")).is_empty());
     }
 }

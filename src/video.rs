@@ -488,6 +488,7 @@ pub fn render(
         .with_context(|| format!("cannot create output directory {}", plan.out.display()))?;
     let gpu = Gpu::headless().context("cannot render")?;
     let mut sim = Simulation::new(scene)?;
+    crate::stability::warn(&sim.groups);
     // From here a signal raises the flag (the solver sees it within a substep) and the images
     // rendered so far are kept.
     sim.set_stop(Arc::clone(stop));

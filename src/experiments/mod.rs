@@ -268,7 +268,14 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                     let res = weft_scene::load_with(&scene_path, &r.overrides, &limits)
                         .map_err(|e| anyhow::anyhow!("{e}"))
                         .and_then(|scene| {
-                            execute(&spec, r, scene, &out, !args.no_mcap, gpu.as_ref(), stop)
+                            let sim = Simulation::new(scene)?;
+                            for line in crate::stability::warnings(&sim.groups) {
+                                bar.note(&format!(
+                                    "  run {:>3} {} {}: warning: {line}",
+                                    r.index, r.series, r.label
+                                ));
+                            }
+                            execute(&spec, r, sim, &out, !args.no_mcap, gpu.as_ref(), stop)
                         })
                         .and_then(|result| {
                             // Written as soon as the run ends, so a killed queue keeps what it did.
@@ -369,19 +376,18 @@ fn write_montages(
 fn execute(
     spec: &Spec,
     r: &PlannedRun,
-    scene: weft_scene::Scene,
+    mut sim: Simulation,
     out: &Path,
     mcap: bool,
     gpu: Option<&weft_render::Gpu>,
     stop: &Arc<AtomicBool>,
 ) -> anyhow::Result<RunResult> {
-    let dt = scene.settings.dt;
+    let dt = sim.scene.settings.dt;
     let frames = match (spec.frames, spec.duration) {
         (Some(f), _) => f,
         (None, Some(d)) => (d / dt).round().max(1.0) as u64,
         (None, None) => 1,
     };
-    let mut sim = Simulation::new(scene)?;
     sim.set_stop(Arc::clone(stop));
     let rel = format!("{}.mcap", run_dir(r));
     let log = mcap.then(|| Output::create(&out.join(&rel))).transpose()?;

@@ -28,13 +28,18 @@ impl QueueProgress {
 
     /// Counts one finished run and shows `line` above the bar.
     pub fn done(&self, line: &str) {
+        self.note(line);
+        self.bar.inc(1);
+    }
+
+    /// Shows `line` above the bar (a warning before a run starts).
+    pub fn note(&self, line: &str) {
         // A hidden bar prints nothing, so off a terminal the line goes to stderr directly.
         if self.bar.is_hidden() {
             eprintln!("{line}");
         } else {
             self.bar.println(line);
         }
-        self.bar.inc(1);
     }
 
     /// Removes the bar.

@@ -21,5 +21,6 @@ mod recover;
 mod render_video;
 mod replay;
 mod small_things;
+mod stability_warning;
 mod stops;
 mod viewer;
