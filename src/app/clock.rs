@@ -122,9 +122,14 @@ impl<T: TimeSource> FixedClock<T> {
         self.paused
     }
 
-    /// Frames dropped since the start.
+    /// Frames dropped since the start (or the last reset of the count).
     pub fn dropped_total(&self) -> u64 {
         self.dropped_total
+    }
+
+    /// Starts the count of dropped frames again (the scene was reset).
+    pub fn reset_dropped(&mut self) {
+        self.dropped_total = 0;
     }
 }
 

@@ -223,7 +223,7 @@ fn stats_section(ui: &mut Ui, session: &Session) {
         row("constraints", constraints.to_string());
         row("contacts", s.contacts.to_string());
         row("sim time", format!("{time:.3} s"));
-        row("frames", session.frames.to_string());
+        row("frames", session.sim.frame().to_string());
         let grabbed = session.grab.map_or_else(
             || "nothing (left-drag the cloth)".to_owned(),
             |g| {

@@ -168,6 +168,7 @@ impl Session {
         self.diverged = None;
         let paused = self.clock.paused();
         self.clock.set_paused(paused);
+        self.clock.reset_dropped();
         Ok(())
     }
 
@@ -251,13 +252,21 @@ mod tests {
         }
         assert_eq!(s.frames, 5);
         assert_ne!(s.sim.cloth_positions(0), &start[..]);
+        // A hitch of 10 frames' time, at most 4 stepped a displayed frame: some are dropped.
+        s.clock.tick(s.dt());
+        std::thread::sleep(std::time::Duration::from_secs_f64(10.0 * s.dt()));
+        s.advance(None).expect("steps");
+        assert!(s.clock.dropped_total() > 0);
+        assert_ne!(s.sim.frame(), 0);
         s.diverged = Some("test".into());
         s.reset().expect("resets");
         assert_eq!(s.sim.cloth_positions(0), &start[..]);
         assert_eq!(s.diverged, None);
         assert_eq!(s.sim.frame(), 0);
-        // The session's own count goes on (it numbers the log's frames).
-        assert_eq!(s.frames, 5);
+        // The session's own count goes on (it numbers the log's frames); the panel's counts
+        // (frames since the reset, frames dropped) start again.
+        assert!(s.frames > 5);
+        assert_eq!(s.clock.dropped_total(), 0);
     }
 
     #[test]
