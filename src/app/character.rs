@@ -106,13 +106,37 @@ impl Session {
     }
 }
 
-/// Whether the scene `source` has a character (its file holds a `[character]` table).
-pub fn has_character(source: &SceneSource) -> bool {
-    match source {
-        SceneSource::Default => false,
-        SceneSource::File(p) => std::fs::read_to_string(p)
-            .is_ok_and(|t| t.lines().any(|l| l.trim_start().starts_with("[character]"))),
-    }
+/// How the panel names the garment scene `source`: the stems of its cloths' garment files,
+/// followed by the scene's own when it differs (`tshirt (character)`); `None` for a scene
+/// without a `[character]` table (or one that does not parse).
+pub fn garment_label(source: &SceneSource) -> Option<String> {
+    let SceneSource::File(path) = source else {
+        return None;
+    };
+    let doc: toml_edit::DocumentMut = std::fs::read_to_string(path).ok()?.parse().ok()?;
+    doc.get("character")?;
+    let stem = |p: &str| {
+        std::path::Path::new(p)
+            .file_stem()
+            .map_or_else(|| p.to_owned(), |s| s.to_string_lossy().into_owned())
+    };
+    let garments: Vec<String> = doc
+        .get("cloth")
+        .and_then(|c| c.as_table_like())
+        .map(|cloths| {
+            cloths
+                .iter()
+                .filter_map(|(_, c)| c.get("garment")?.as_str().map(stem))
+                .collect()
+        })
+        .unwrap_or_default();
+    let scene = stem(&path.to_string_lossy());
+    let garments = garments.join(", ");
+    Some(if garments.is_empty() || garments == scene {
+        scene
+    } else {
+        format!("{garments} ({scene})")
+    })
 }
 
 #[cfg(test)]
@@ -228,6 +252,22 @@ mod tests {
     }
 
     #[test]
+    fn garments_are_named_by_their_garment_files() {
+        let label = |f: &str| garment_label(&SceneSource::File(PathBuf::from(f)));
+        assert_eq!(label("assets/scenes/skirt.toml").as_deref(), Some("skirt"));
+        assert_eq!(
+            label("assets/scenes/character.toml").as_deref(),
+            Some("tshirt (character)")
+        );
+        assert_eq!(
+            label("assets/scenes/glb_character.toml").as_deref(),
+            Some("cape (glb_character)")
+        );
+        assert_eq!(label("assets/scenes/hanging.toml"), None);
+        assert_eq!(garment_label(&SceneSource::Default), None);
+    }
+
+    #[test]
     fn clip_fabric_and_garment_reload_the_scene_with_overrides() {
         let mut s = skirt();
         s.step_once().expect("steps");
@@ -259,7 +299,7 @@ mod tests {
             .expect_err("no such preset");
         assert!(format!("{e:#}").contains("tinfoil"), "{e:#}");
         let cape = SceneSource::File(PathBuf::from("assets/scenes/cape.toml"));
-        assert!(has_character(&cape) && !has_character(&SceneSource::Default));
+        assert!(garment_label(&cape).is_some() && garment_label(&SceneSource::Default).is_none());
         // The cape hangs from the walker's Chest bone, which the CMU skeleton lacks: refused,
         // naming it, and the skirt stays.
         let e = s

@@ -25,8 +25,9 @@ pub struct PanelState {
     pub error: Option<String>,
     /// The scenes offered.
     pub scenes: Vec<SceneSource>,
-    /// Those of them with a character (the garments offered), found when first shown.
-    pub garments: Option<Vec<SceneSource>>,
+    /// Those of them with a character (the garments offered) and their labels, found when
+    /// first shown.
+    pub garments: Option<Vec<(SceneSource, String)>>,
 }
 
 /// What the window must do after the panel ran.
@@ -38,12 +39,17 @@ pub struct Outcome {
     pub command: Option<Command>,
 }
 
-/// The built-in scene, then every `*.toml` in `dir` (sorted).
+/// The built-in scene, then every `*.toml` in `dir` (sorted) but the file the built-in scene
+/// was compiled from (the same scene under the same name).
 pub fn list_scenes(dir: &Path) -> Vec<SceneSource> {
+    let builtin = |p: &Path| {
+        p.file_name() == Path::new(crate::default_scene::NAME).file_name()
+            && std::fs::read_to_string(p).is_ok_and(|t| t == crate::default_scene::HANGING)
+    };
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|d| {
             d.filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+                .filter(|p| p.extension().is_some_and(|e| e == "toml") && !builtin(p))
                 .collect()
         })
         .unwrap_or_default();
@@ -394,4 +400,19 @@ fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
             .small()
             .weak(),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shipped_scenes_list_the_hanging_cloth_once() {
+        let scenes = list_scenes(Path::new("assets/scenes"));
+        let labels: Vec<String> = scenes.iter().map(|s| short(&s.label())).collect();
+        let hanging = labels.iter().filter(|l| *l == "hanging.toml").count();
+        assert_eq!(hanging, 1, "{labels:?}");
+        assert_eq!(scenes[0], SceneSource::Default);
+        assert!(labels.iter().any(|l| l == "compare.toml"), "{labels:?}");
+    }
 }

@@ -4,7 +4,7 @@
 
 use egui::{ComboBox, RichText, Ui};
 
-use crate::app::character::{CLIPS, current_clip, has_character};
+use crate::app::character::{CLIPS, current_clip, garment_label};
 use crate::app::panel::{Outcome, PanelState, short};
 use crate::app::session::Session;
 
@@ -32,22 +32,22 @@ pub fn section(ui: &mut Ui, session: &mut Session, state: &mut PanelState, out: 
             state
                 .scenes
                 .iter()
-                .filter(|s| has_character(s))
-                .cloned()
+                .filter_map(|s| Some((s.clone(), garment_label(s)?)))
                 .collect(),
         );
     }
     let garments = state.garments.clone().unwrap_or_default();
+    let current = garments
+        .iter()
+        .find(|(s, _)| *s == session.source)
+        .map_or_else(|| short(&session.source.label()), |(_, l)| l.clone());
     let mut chosen_garment = None;
     ComboBox::from_label("garment")
-        .selected_text(short(&session.source.label()))
+        .selected_text(current)
         .width(190.0)
         .show_ui(ui, |ui| {
-            for g in &garments {
-                if ui
-                    .selectable_label(*g == session.source, short(&g.label()))
-                    .clicked()
-                {
+            for (g, label) in &garments {
+                if ui.selectable_label(*g == session.source, label).clicked() {
                     chosen_garment = Some(g.clone());
                 }
             }
