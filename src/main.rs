@@ -14,6 +14,7 @@ mod output;
 mod recover;
 mod replay;
 mod run;
+mod runtime_dir;
 mod stability;
 mod stop;
 mod video;
@@ -31,6 +32,12 @@ use run::RunPlan;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // First, while weft has one thread: the GPU commands may re-execute themselves.
+    runtime_dir::ensure(match &cli.command {
+        None | Some(Command::View(_) | Command::Render(_)) => true,
+        Some(Command::Experiments(a)) => a.render,
+        Some(_) => false,
+    });
     // SIGINT and SIGTERM end the process at once unless a loop polls the flag (see stop.rs):
     // runs then close their logs, the solver stops within a substep.
     let stop = stop::install();

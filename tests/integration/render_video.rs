@@ -291,3 +291,26 @@ fn a_failing_frame_write_names_the_path_and_leaves_no_frame() {
         "no frame, GIF or partial passed off as whole: {names:?}"
     );
 }
+
+/// `weft render SCENE-LESS ARGS` into `dir/<name>` with XDG_RUNTIME_DIR unset (as in a
+/// container or CI).
+fn render_without_runtime_dir(dir: &Path, name: &str, extra: &[&str]) -> std::process::Output {
+    let out_dir = dir.join(name).to_string_lossy().into_owned();
+    weft()
+        .args([
+            "render", "--frames", "20", "--size", "64x48", "--out", &out_dir,
+        ])
+        .args(extra)
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("weft starts")
+}
+
+#[test]
+fn render_without_a_runtime_dir_prints_no_error_about_it() {
+    let dir = temp_dir("render-runtime-dir");
+    let out = render_without_runtime_dir(&dir, "out", &["-q"]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(!e.contains("XDG_RUNTIME_DIR"), "{e}");
+}
