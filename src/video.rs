@@ -470,6 +470,43 @@ fn file_stem(name: &str) -> String {
     if s.is_empty() { "scene".into() } else { s }
 }
 
+/// Progress where standard error is not a terminal (a log file, CI): a line whenever a
+/// tenth more of the frames is done or a second has passed since the last line.
+struct ProgressLines {
+    total: u64,
+    start: std::time::Instant,
+    last: std::time::Instant,
+    tenths: u64,
+}
+
+impl ProgressLines {
+    fn new(total: u64) -> Self {
+        let now = std::time::Instant::now();
+        Self {
+            total: total.max(1),
+            start: now,
+            last: now,
+            tenths: 0,
+        }
+    }
+
+    /// The line to print after frame `done` at `now`, if one is due.
+    fn frame(&mut self, done: u64, now: std::time::Instant) -> Option<String> {
+        let tenths = done.min(self.total) * 10 / self.total;
+        if tenths <= self.tenths && now - self.last < std::time::Duration::from_secs(1) {
+            return None;
+        }
+        self.tenths = tenths;
+        self.last = now;
+        Some(format!(
+            "frame {done}/{} ({} %), {:.0} s",
+            self.total,
+            done.min(self.total) * 100 / self.total,
+            (now - self.start).as_secs_f64()
+        ))
+    }
+}
+
 /// Runs `weft render`.
 pub fn render(
     scene: Scene,
@@ -504,7 +541,9 @@ pub fn render(
         plan.every,
         plan.frames
     );
-    let bar = if plan.progress && std::io::stderr().is_terminal() {
+    let terminal = std::io::stderr().is_terminal();
+    let mut lines = (plan.progress && !terminal).then(|| ProgressLines::new(plan.frames));
+    let bar = if plan.progress && terminal {
         let bar = ProgressBar::with_draw_target(Some(plan.frames), ProgressDrawTarget::stderr());
         if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} frames  eta {eta}") {
             bar.set_style(style);
@@ -544,6 +583,11 @@ pub fn render(
             r => r?,
         }
         bar.inc(1);
+        if let Some(l) = lines.as_mut()
+            && let Some(line) = l.frame(sim.frame(), std::time::Instant::now())
+        {
+            eprintln!("weft: {line}");
+        }
     }
     bar.finish_and_clear();
     let images = rec.images();
@@ -604,5 +648,23 @@ mod tests {
         assert_eq!(file_stem("assets/scenes/sphere_drop.toml"), "sphere_drop");
         assert_eq!(file_stem("my scene (2).toml"), "my_scene__2_");
         assert_eq!(file_stem(""), "scene");
+    }
+
+    #[test]
+    fn off_a_terminal_a_line_comes_each_tenth_or_second() {
+        let mut p = ProgressLines::new(100);
+        let t0 = p.start;
+        let ms = |n: u64| t0 + std::time::Duration::from_millis(n);
+        assert_eq!(p.frame(5, ms(100)), None);
+        let line = p.frame(10, ms(200)).expect("a tenth done");
+        assert!(line.starts_with("frame 10/100 (10 %)"), "{line}");
+        assert_eq!(p.frame(12, ms(300)), None);
+        let line = p.frame(13, ms(1300)).expect("a second passed");
+        assert!(line.starts_with("frame 13/100 (13 %), 1 s"), "{line}");
+        assert_eq!(p.frame(19, ms(1400)), None);
+        assert!(
+            p.frame(100, ms(1500))
+                .is_some_and(|l| l.contains("(100 %)"))
+        );
     }
 }

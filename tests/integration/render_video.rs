@@ -314,3 +314,23 @@ fn render_without_a_runtime_dir_prints_no_error_about_it() {
     assert!(out.status.success(), "{o}{e}");
     assert!(!e.contains("XDG_RUNTIME_DIR"), "{e}");
 }
+
+#[test]
+fn render_off_a_terminal_prints_progress_lines() {
+    let dir = temp_dir("render-progress");
+    let out = render_without_runtime_dir(&dir, "loud", &[]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    let lines: Vec<&str> = e.lines().filter(|l| l.contains("frame ")).collect();
+    assert!(lines.len() >= 2, "{e}");
+    assert!(
+        lines
+            .last()
+            .is_some_and(|l| l.starts_with("weft: frame 20/20 (100 %)")),
+        "{e}"
+    );
+    let out = render_without_runtime_dir(&dir, "quiet", &["-q"]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    assert!(!e.contains("(100 %)"), "-q: no progress: {e}");
+}
