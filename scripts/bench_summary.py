@@ -540,6 +540,8 @@ SPEED_ROWS = [
     ("`weft run --out --log all`", "the same", "all",
      (LOGGING, "`--log all`: positions and the surface every frame", "128² reference ms/frame",
       None)),
+    ("`weft run --out --compression zstd`", "the same", "all",
+     (LOGGING, "`--log particles --compression zstd`", "128² reference ms/frame", None)),
     ("`weft run --out` (particles, the default)", "`character.toml`", "all",
      (LOGGING, "`--log particles` (the default): positions, no compression",
       "T-shirt ms/frame", None)),
