@@ -154,6 +154,16 @@ pub fn replay(args: &ReplayArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<ExitC
         p.push(".replay.mcap");
         PathBuf::from(p)
     });
+    eprintln!(
+        "weft: replaying {} into {}{}",
+        args.log.display(),
+        out.display(),
+        if args.out.is_none() {
+            " (--out FILE to choose)"
+        } else {
+            ""
+        }
+    );
     let plan = RunPlan {
         inputs: vec![("the log", args.log.clone())],
         frames,

@@ -152,3 +152,26 @@ fn an_interrupted_or_timed_log_matches_over_what_it_holds() {
         "{o}"
     );
 }
+
+#[test]
+fn replay_says_where_it_writes_before_it_starts() {
+    let dir = temp_dir("replay-where");
+    let log = logged_run(&dir, "s.toml", SMALL, 5, "a.mcap");
+    let out = run(&["replay", &log.to_string_lossy(), "-q"]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    let beside = dir.join("a.mcap.replay.mcap");
+    assert!(beside.exists());
+    let line = e
+        .lines()
+        .next()
+        .unwrap_or_else(|| panic!("nothing on stderr: {o}"));
+    assert_eq!(
+        line,
+        format!(
+            "weft: replaying {} into {} (--out FILE to choose)",
+            log.display(),
+            beside.display()
+        )
+    );
+}
