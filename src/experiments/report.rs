@@ -10,8 +10,11 @@ use crate::experiments::spec::{PlannedRun, Spec};
 use crate::experiments::{NOT_RUN, Row, RunResult, result_path};
 use crate::output::Output;
 
+/// A value for the Markdown table: whole numbers (frame counts) as integers, the rest to four
+/// decimals or in scientific notation.
 fn fmt(v: Option<f64>) -> String {
     match v {
+        Some(v) if v.fract() == 0.0 && v.abs() < 1e15 => format!("{v:.0}"),
         Some(v) if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e5) => format!("{v:.4e}"),
         Some(v) => format!("{v:.4}"),
         None => "—".into(),
@@ -130,4 +133,19 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
         say!("plot: {}", path.display())?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt;
+
+    #[test]
+    fn counts_are_integers_and_measures_keep_their_decimals() {
+        assert_eq!(fmt(Some(100.0)), "100");
+        assert_eq!(fmt(Some(0.0)), "0");
+        assert_eq!(fmt(Some(250_000.0)), "250000");
+        assert_eq!(fmt(Some(0.3)), "0.3000");
+        assert_eq!(fmt(Some(2.5e-4)), "2.5000e-4");
+        assert_eq!(fmt(None), "—");
+    }
 }
