@@ -150,14 +150,50 @@ pub fn draw(spec: &PlotSpec, rows: &[Row<'_>], path: &Path) -> anyhow::Result<()
                 .context("drawing the legend")?;
         }};
     }
+    // A log axis gets 1-2-5 ticks: plotters puts one only at each power of ten, so an axis
+    // within a decade (dt from 1/240 to 1/20 s) had a single tick.
+    let log_x = || (x0..x1).log_scale().with_key_points(log_ticks(x0, x1));
+    let log_y = || (y0..y1).log_scale().with_key_points(log_ticks(y0, y1));
     match (spec.log_x, spec.log_y) {
         (false, false) => finish!(builder.build_cartesian_2d(x0..x1, y0..y1)?),
-        (true, false) => finish!(builder.build_cartesian_2d((x0..x1).log_scale(), y0..y1)?),
-        (false, true) => finish!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?),
-        (true, true) => {
-            finish!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?)
-        }
+        (true, false) => finish!(builder.build_cartesian_2d(log_x(), y0..y1)?),
+        (false, true) => finish!(builder.build_cartesian_2d(x0..x1, log_y())?),
+        (true, true) => finish!(builder.build_cartesian_2d(log_x(), log_y())?),
     }
     root.present().context("writing the PNG")?;
     Ok(())
+}
+
+/// Ticks of a log axis from `lo` to `hi` (both > 0): 1, 2 and 5 times each power of ten
+/// within it, or every integer multiple when that gives fewer than three.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let ticks = |steps: &[f64]| -> Vec<f64> {
+        let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (first..=last)
+            .flat_map(|e| steps.iter().map(move |m| m * 10f64.powi(e)))
+            // Rounded to the power's digits, so 0.3 is 0.3 and not 0.30000000000000004.
+            .map(|v| format!("{v:.12e}").parse::<f64>().unwrap_or(v))
+            .filter(|v| *v >= lo && *v <= hi)
+            .collect()
+    };
+    let coarse = ticks(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 3 {
+        coarse
+    } else {
+        ticks(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_ticks;
+
+    #[test]
+    fn a_log_axis_within_a_decade_gets_several_ticks() {
+        // sag_vs_dt.png: dt from 1/240 to 1/20 s, padded by 1.3.
+        let t = log_ticks(1.0 / 240.0 / 1.3, 1.3 / 20.0);
+        assert_eq!(t, [0.005, 0.01, 0.02, 0.05]);
+        assert_eq!(log_ticks(1.0, 1000.0).len(), 10);
+        assert_eq!(log_ticks(0.25, 0.45), [0.3, 0.4]);
+    }
 }
