@@ -192,11 +192,18 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
             o.commit()?;
         }
     }
-    let lowest = (0..sim.scene.cloths.len())
-        .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y))
-        .fold(f64::INFINITY, f64::min);
+    // A diverged run's positions are the exploded ones: no lowest point worth printing.
+    let lowest = match status {
+        Status::Diverged(_) => "— (diverged)".to_owned(),
+        _ => format!(
+            "{:+.4} m",
+            (0..sim.scene.cloths.len())
+                .flat_map(|i| sim.cloth_positions(i).iter().map(|p| p.y))
+                .fold(f64::INFINITY, f64::min)
+        ),
+    };
     say!(
-        "{frames} frames, {:.3} s simulated, {wall:.3} s wall, {:.3} ms/frame; lowest point y = {lowest:+.4} m, stretch error max {:.2e} m, kinetic energy {:.3e} J",
+        "{frames} frames, {:.3} s simulated, {wall:.3} s wall, {:.3} ms/frame; lowest point y = {lowest}, stretch error max {:.2e} m, kinetic energy {:.3e} J",
         frames as f64 * sim.scene.settings.dt,
         if frames > 0 {
             1e3 * wall / frames as f64

@@ -145,3 +145,13 @@ vary = { "sim.substeps" = [4, 200] }
     assert_eq!(warned.len(), 1, "{o}{e}");
     assert!(warned[0].contains("run   0 springs"), "{e}");
 }
+
+#[test]
+fn a_diverged_run_prints_no_exploded_lowest_point() {
+    let (_, scene) = scene("diverged-summary");
+    let out = run(&["run", &scene, "--method", "mass-spring", "--frames", "3"]);
+    let (o, e) = texts(&out);
+    assert_eq!(out.status.code(), Some(2), "{o}{e}");
+    assert!(o.contains("lowest point y = — (diverged)"), "{o}");
+    assert!(e.contains("diverged at frame"), "{e}");
+}
