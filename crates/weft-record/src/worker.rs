@@ -16,8 +16,8 @@ use crate::error::{RecordError, Result};
 use crate::layout::{CHANNELS, Ids, LogWriter, channel, json_schema};
 use crate::messages;
 use crate::options::RecordOptions;
+use crate::status::Status;
 use crate::surface::SurfaceEncoder;
-use crate::writer::Status;
 
 /// One frame as the run handed it over: copies, so the run may step on at once.
 pub(crate) struct Frame {

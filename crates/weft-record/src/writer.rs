@@ -16,31 +16,10 @@ use crate::error::{RecordError, Result};
 use crate::layout::{self, Ids};
 use crate::options::RecordOptions;
 use crate::sink::Sink;
+use crate::status::Status;
 use crate::surface::SurfaceEncoder;
 use crate::worker::{Frame, Job, Worker};
 use crate::{body, collider_state, messages};
-
-/// How a run ended, written as the `weft.status` metadata record.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Status {
-    /// Every requested frame was simulated.
-    Complete,
-    /// SIGINT or SIGTERM stopped the run.
-    Interrupted,
-    /// The simulation diverged; the message says where.
-    Diverged(String),
-}
-
-impl Status {
-    /// The status's name in the log.
-    pub(crate) fn name(&self) -> &'static str {
-        match self {
-            Status::Complete => "complete",
-            Status::Interrupted => "interrupted",
-            Status::Diverged(_) => "diverged",
-        }
-    }
-}
 
 /// Most bytes of frame copies the queue holds: 64 MiB, at least 2 and at most 16 frames.
 pub const QUEUE_BYTES: usize = 64 << 20;
