@@ -20,35 +20,18 @@ pub struct LimitArgs {
 impl LimitArgs {
     /// The limits a load enforces.
     pub fn limits(&self) -> Limits {
-        let max_memory = match self.max_memory {
-            Some(b) => Some((b, "--max-memory".to_owned())),
-            None => available_memory().map(|b| (b, "the memory available, MemAvailable".into())),
-        };
+        let available = Limits::available();
         Limits {
             max_file_bytes: self.max_file_size,
-            max_memory,
+            max_memory: match self.max_memory {
+                Some(b) => Some((b, "--max-memory".to_owned())),
+                None => available.max_memory,
+            },
         }
     }
 }
 
-/// The `KEY:  N kB` line of a /proc file, in bytes (`None` where there is no such file or line).
-fn proc_kib(path: &str, key: &str) -> Option<u64> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let prefix = format!("{key}:");
-    let line = text.lines().find(|l| l.starts_with(&prefix))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
-/// This process's peak resident memory so far (`VmHWM` in /proc/self/status), in bytes.
-pub fn peak_memory() -> Option<u64> {
-    proc_kib("/proc/self/status", "VmHWM")
-}
-
-/// `MemAvailable` from /proc/meminfo, in bytes (`None` where there is no such file).
-pub fn available_memory() -> Option<u64> {
-    proc_kib("/proc/meminfo", "MemAvailable")
-}
+pub use weft_scene::peak_memory;
 
 /// A size in bytes: `123`, `64K`, `512M`, `8G`, `1T` (powers of 1024; `B`/`iB` suffixes
 /// accepted).

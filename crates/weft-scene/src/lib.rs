@@ -24,7 +24,7 @@ pub use collide::{DelayedSelfCollision, collider_desc};
 pub use error::{LONGEST_WORD, Origin, SceneError, SceneErrors, elide};
 pub use limits::{
     BASE_BYTES, BYTES_PER_PAIR, BYTES_PER_PARTICLE, Limits, Member, PER_PARTICLE_SELF_COLLISION,
-    estimate_bytes, human, self_collision_pairs,
+    available_memory, estimate_bytes, human, peak_memory, self_collision_pairs,
 };
 pub use load::{from_text, from_text_with, load, load_with};
 pub use overrides::{Override, parse_value};

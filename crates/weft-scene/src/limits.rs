@@ -23,6 +23,37 @@ impl Default for Limits {
     }
 }
 
+impl Limits {
+    /// The command line's defaults: files up to [`DEFAULT_MAX_FILE_BYTES`], and a scene no
+    /// larger than the memory available now ([`available_memory`]), where that is known.
+    pub fn available() -> Self {
+        Self {
+            max_file_bytes: DEFAULT_MAX_FILE_BYTES,
+            max_memory: available_memory()
+                .map(|b| (b, "the memory available, MemAvailable".to_owned())),
+        }
+    }
+}
+
+/// The `KEY:  N kB` line of a /proc file, in bytes (`None` where there is no such file or line).
+fn proc_kib(path: &str, key: &str) -> Option<u64> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let prefix = format!("{key}:");
+    let line = text.lines().find(|l| l.starts_with(&prefix))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// This process's peak resident memory so far (`VmHWM` in /proc/self/status), in bytes.
+pub fn peak_memory() -> Option<u64> {
+    proc_kib("/proc/self/status", "VmHWM")
+}
+
+/// `MemAvailable` from /proc/meminfo, in bytes (`None` where there is no such file).
+pub fn available_memory() -> Option<u64> {
+    proc_kib("/proc/meminfo", "MemAvailable")
+}
+
 /// Bytes one particle of a built scene needs: its mesh (positions, masses, triangles, stretch
 /// and shear edges), the solver's store, constraints, domains and scratch, and one frame of
 /// log messages with their encode and compression buffers. The peak resident set of
