@@ -1,5 +1,6 @@
-//! Grabbing a cloth particle with the mouse: pick it along the cursor ray, hold it with the
-//! solver's grab API and drag it in the camera-facing plane through the hit point.
+//! Grabbing a cloth particle with the mouse: pick it along the cursor ray, hold it with
+//! weft-sim's grab (the one Python's `Simulation.grab` uses) and drag it in the camera-facing
+//! plane through the hit point.
 
 use weft_solver::glam::DVec3;
 
@@ -28,15 +29,6 @@ pub struct Grab {
     pub target: DVec3,
 }
 
-/// The solver group and solver-global index of particle `particle` of scene cloth `cloth`.
-pub fn locate(sim: &Simulation, cloth: usize, particle: usize) -> Option<(usize, usize)> {
-    sim.groups.iter().enumerate().find_map(|(g, group)| {
-        let j = group.cloths.iter().position(|&c| c == cloth)?;
-        let range = &group.solver.cloths().get(j)?.particles;
-        (particle < range.len()).then_some((g, range.start + particle))
-    })
-}
-
 impl Grab {
     /// Casts `ray` at every cloth; on a hit, grabs the hit triangle's vertex nearest the hit
     /// point. `view_dir` is the camera's forward direction (the drag plane's normal).
@@ -47,8 +39,7 @@ impl Grab {
                 pick(ray, sim.cloth_positions(i), tris).map(|h| (i, h))
             })
             .min_by(|a, b| a.1.t.total_cmp(&b.1.t))?;
-        let (group, global) = locate(sim, cloth, hit.particle)?;
-        sim.groups[group].solver.grab(global).ok()?;
+        let (group, global) = sim.grab(cloth, hit.particle).ok()?;
         let at = sim.cloth_positions(cloth)[hit.particle];
         Some(Grab {
             cloth,
@@ -64,19 +55,17 @@ impl Grab {
 
     /// Moves the target to where `ray` meets the drag plane (kept if the ray misses it).
     pub fn drag(&mut self, sim: &mut Simulation, ray: &Ray) {
-        if let Some(p) = ray_plane(ray, self.plane_point, self.plane_normal)
-            && let Some(g) = sim.groups.get_mut(self.group)
-        {
-            self.target = p + self.offset;
-            g.solver.drag_to(self.target);
+        if let Some(p) = ray_plane(ray, self.plane_point, self.plane_normal) {
+            let target = p + self.offset;
+            if sim.drag_to(target).is_ok() {
+                self.target = target;
+            }
         }
     }
 
     /// Lets go: the particle gets its mass back and keeps its drag velocity.
     pub fn release(self, sim: &mut Simulation) {
-        if let Some(g) = sim.groups.get_mut(self.group) {
-            g.solver.release();
-        }
+        sim.release();
     }
 }
 
@@ -144,7 +133,7 @@ pins = ["top"]
             let mut s = sim(FLAT, method);
             let eye = DVec3::new(0.0, 1.5, 3.0);
             let start = s.cloth_positions(0)[12];
-            let (group, global) = locate(&s, 0, 12).expect("particle 12");
+            let (group, global) = s.locate(0, 12).expect("particle 12");
             let w = s.groups[group].solver.particles().inv_masses[global];
             assert!(w > 0.0);
             let mut g = Grab::start(&mut s, &towards(eye, start), -DVec3::Z).expect("hits");
@@ -185,7 +174,7 @@ pins = ["top"]
         )
         .expect("hits cloth b");
         assert_eq!((g.cloth, g.particle), (1, 6));
-        assert_eq!(locate(&s, 1, 6), Some((g.group, g.global)));
+        assert_eq!(s.locate(1, 6), Some((g.group, g.global)));
         assert_eq!(
             s.groups[g.group].solver.grabbed().map(|(i, _)| i),
             Some(g.global)

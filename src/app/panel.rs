@@ -300,24 +300,16 @@ fn solver_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
             .changed();
     });
     if changed {
-        for g in &mut session.sim.groups {
-            let s = weft_solver::Settings {
-                method: g.solver.settings().method,
-                ..settings
-            };
-            let r = g.solver.set_settings(s);
-            note(state, r);
-        }
+        let r = session.sim.set_settings(settings);
+        note(state, r);
     }
     let mut fchanged = drag_vec(ui, "gravity", &mut forces.gravity, 0.05);
     fchanged |= drag_vec(ui, "wind", &mut forces.wind.velocity, 0.05);
     fchanged |= drag_f64(ui, "wind drag (1/s)", &mut forces.wind.drag, 0.01);
     fchanged |= drag_f64(ui, "damping (1/s)", &mut forces.damping, 0.01);
     if fchanged {
-        for g in &mut session.sim.groups {
-            let r = g.solver.set_forces(forces);
-            note(state, r);
-        }
+        let r = session.sim.set_forces(forces);
+        note(state, r);
     }
 }
 
@@ -335,28 +327,15 @@ fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
                 ui.selectable_value(&mut state.cloth, i, n);
             }
         });
-    let Some((g, _)) = crate::app::grab::locate(&session.sim, state.cloth, 0) else {
+    let cloth = state.cloth;
+    let (Some(mut params), Some(mut thickness)) = (
+        session.sim.cloth_params(cloth),
+        session.sim.thickness(cloth),
+    ) else {
         return;
     };
-    let Some(local) = session.sim.groups[g]
-        .cloths
-        .iter()
-        .position(|&c| c == state.cloth)
-    else {
-        return;
-    };
-    let group = &mut session.sim.groups[g];
-    let Some(mut params) = group.solver.cloth_params(local) else {
-        return;
-    };
-    let mut thickness = group.solver.cloths()[local].thickness;
     if drag_f64(ui, "thickness (m)", &mut thickness, 0.0005) {
-        let r = group.solver.set_thickness(local, thickness);
-        if r.is_ok()
-            && let Some(w) = group.world.as_mut()
-        {
-            w.sync_thickness(&group.solver);
-        }
+        let r = session.sim.set_thickness(cloth, thickness);
         note(state, r);
     }
     let mut changed = false;
@@ -392,7 +371,7 @@ fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
             }
         });
     if changed {
-        let r = group.solver.set_cloth_params(local, params);
+        let r = session.sim.set_cloth_params(cloth, params);
         note(state, r);
     }
     ui.label(

@@ -199,15 +199,7 @@ impl Session {
     /// Switches every solver of the scene to `method` (parameters of every method are kept
     /// per cloth, so nothing else changes).
     pub fn set_method(&mut self, method: Method) -> Result<(), ParamError> {
-        for g in &mut self.sim.groups {
-            let s = weft_solver::Settings {
-                method,
-                ..*g.solver.settings()
-            };
-            g.solver.set_settings(s)?;
-            g.method = method;
-        }
-        Ok(())
+        self.sim.set_method(method)
     }
 
     /// Closes the log (if any) with the status of how the session ended.

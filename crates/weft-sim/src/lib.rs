@@ -1,8 +1,33 @@
 //! A Weft scene run: its solvers stepped in lockstep one frame at a time ([`Simulation`]),
-//! what each frame did ([`FrameStats`]), and a character's body posed for the renderer, the
-//! log and the export ([`body`]).
+//! what each frame did ([`FrameStats`]), a held particle dragged about ([`grab`]), the live
+//! controls the viewer and Python change between frames ([`control`]), and a character's body
+//! posed for the renderer, the log and the export ([`body`]).
 
 pub mod body;
+pub mod control;
+mod error;
+pub mod grab;
 mod simulation;
 
+pub use control::{Control, LIVE_KEYS, Value};
+pub use error::SimError;
 pub use simulation::{FrameStats, Simulation};
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use crate::Simulation;
+
+    /// A 5 × 5 vertical cloth `a` (1 m, x ∈ [−0.5, 0.5], y ∈ [1, 2], z = 0), pinned on its
+    /// top edge, under `gravity`, stepped by `method`.
+    pub fn sim(method: &str, gravity: &str) -> Simulation {
+        let text = format!(
+            "[sim]\nmethod = \"{method}\"\ndt = \"1/60\"\nsubsteps = 10\ngravity = {gravity}\n\n\
+             [cloth.a]\nresolution = [5, 5]\nsize = [1.0, 1.0]\ncenter = [0.0, 1.5, 0.0]\n\
+             mass = 0.25\npins = [\"top\"]\n"
+        );
+        let scene =
+            weft_scene::from_text("flat.toml", &text, &[], &weft_scene::DirFiles(".".into()))
+                .expect("scene");
+        Simulation::new(scene).expect("solvers")
+    }
+}

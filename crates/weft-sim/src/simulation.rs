@@ -9,6 +9,8 @@ use weft_scene::{Scene, SceneError, SolverGroup};
 use weft_solver::SolverError;
 use weft_solver::glam::DVec3;
 
+use crate::SimError;
+
 /// What one frame did, summed over the scene's solvers.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameStats {
@@ -37,6 +39,10 @@ pub struct Simulation {
     /// For each scene cloth: its solver and particle range.
     places: Vec<(usize, Range<usize>)>,
     frame: u64,
+    /// The frame time step in use (s): the scene's until a live change.
+    dt: f64,
+    /// Where the current time step took over: (frame, simulated time then).
+    epoch: (u64, f64),
 }
 
 impl Simulation {
@@ -49,11 +55,14 @@ impl Simulation {
                 places[i] = (g, group.solver.cloths()[j].particles.clone());
             }
         }
+        let dt = scene.settings.dt;
         Ok(Self {
             scene,
             groups,
             places,
             frame: 0,
+            dt,
+            epoch: (0, 0.0),
         })
     }
 
@@ -78,15 +87,72 @@ impl Simulation {
         self.frame
     }
 
-    /// Simulated time (s).
+    /// Simulated time (s): frames × the scene's time step, until a live change of the time
+    /// step (see [`Simulation::set_settings`]) starts a new epoch.
     pub fn time(&self) -> f64 {
-        self.frame as f64 * self.scene.settings.dt
+        let (frame, time) = self.epoch;
+        if frame == 0 {
+            self.frame as f64 * self.dt
+        } else {
+            time + (self.frame - frame) as f64 * self.dt
+        }
+    }
+
+    /// The frame time step in use (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// Takes `dt` as the time step from the current frame on.
+    pub(crate) fn new_epoch(&mut self, dt: f64) {
+        self.epoch = (self.frame, self.time());
+        self.dt = dt;
     }
 
     /// Positions of scene cloth `i`, in particle order.
     pub fn cloth_positions(&self, i: usize) -> &[DVec3] {
         let (g, range) = &self.places[i];
         &self.groups[*g].solver.particles().positions[range.clone()]
+    }
+
+    /// Velocities of scene cloth `i`, in particle order.
+    pub fn cloth_velocities(&self, i: usize) -> &[DVec3] {
+        let (g, range) = &self.places[i];
+        &self.groups[*g].solver.particles().velocities[range.clone()]
+    }
+
+    /// Places scene cloth `i`'s particles at `positions` (one per particle, finite), as the
+    /// start of the next frame; velocities are kept. A pin that follows a motion goes back
+    /// to its prescribed place in the next substep.
+    pub fn set_cloth_positions(&mut self, i: usize, positions: &[DVec3]) -> Result<(), SimError> {
+        let (g, range) = self
+            .places
+            .get(i)
+            .cloned()
+            .ok_or_else(|| SimError::BadValue {
+                key: "cloth".into(),
+                expected: format!("a cloth index below {}", self.places.len()),
+                got: i.to_string(),
+            })?;
+        let name = &self.scene.cloths[i].name;
+        if positions.len() != range.len() {
+            return Err(SimError::BadValue {
+                key: format!("positions of `{name}`"),
+                expected: format!("{} positions (one per particle)", range.len()),
+                got: format!("{}", positions.len()),
+            });
+        }
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(SimError::BadValue {
+                key: format!("positions of `{name}`"),
+                expected: "finite numbers".into(),
+                got: format!("{} at particle {k}", positions[k]),
+            });
+        }
+        let p = self.groups[g].solver.particles_mut();
+        p.positions[range.clone()].copy_from_slice(positions);
+        p.prev_positions[range].copy_from_slice(positions);
+        Ok(())
     }
 
     /// Statistics of the current state.
@@ -116,5 +182,34 @@ impl Simulation {
         }
         self.frame += 1;
         Ok(self.stats(start.elapsed().as_secs_f64() * 1e3, contacts))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tests::sim;
+
+    #[test]
+    fn positions_set_are_the_next_frames_start_and_bad_ones_are_refused() {
+        let mut s = sim("xpbd", "[0.0, 0.0, 0.0]");
+        let moved: Vec<DVec3> = s.cloth_positions(0).iter().map(|p| *p + DVec3::Z).collect();
+        s.set_cloth_positions(0, &moved)
+            .expect("25 finite positions");
+        assert_eq!(s.cloth_positions(0), &moved[..]);
+        assert!(s.cloth_velocities(0).iter().all(|v| *v == DVec3::ZERO));
+        let e = s.set_cloth_positions(0, &moved[1..]).expect_err("24");
+        assert!(e.to_string().contains("25 positions"), "{e}");
+        let mut nan = moved.clone();
+        nan[7].y = f64::NAN;
+        let e = s.set_cloth_positions(0, &nan).expect_err("NaN");
+        assert!(e.to_string().contains("particle 7"), "{e}");
+        assert!(s.set_cloth_positions(1, &moved).is_err(), "no cloth 1");
+        assert_eq!(s.cloth_positions(0), &moved[..], "refusals change nothing");
+        s.step().expect("steps");
+        assert!(
+            s.cloth_positions(0).iter().all(|p| p.z == 1.0),
+            "no gravity, no motion"
+        );
     }
 }
