@@ -5,7 +5,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use numpy::PyArray2;
-use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyIndexError, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use weft_record::{RecordOptions, Status};
@@ -218,16 +220,19 @@ impl Simulation {
         let i = self.cloth(name)?;
         let target = vec3(target, "target")?;
         let count = self.state.sim.cloth_positions(i).len();
-        let particle = usize::try_from(index)
-            .ok()
-            .filter(|&p| p < count)
-            .ok_or_else(|| {
-                sim_error(weft_sim::SimError::NoSuchParticle {
-                    cloth: name.to_owned(),
-                    index: index.unsigned_abs() as usize,
-                    count,
-                })
-            })?;
+        if index < 0 {
+            return Err(PyIndexError::new_err(format!(
+                "cloth `{name}` has {count} particles: index {index} is negative"
+            )));
+        }
+        let particle = usize::try_from(index).unwrap_or(usize::MAX);
+        if particle >= count {
+            return Err(sim_error(weft_sim::SimError::NoSuchParticle {
+                cloth: name.to_owned(),
+                index: particle,
+                count,
+            }));
+        }
         if !target.is_finite() {
             return Err(PyValueError::new_err(format!(
                 "target: expected three finite numbers (m), got {target}"

@@ -106,7 +106,7 @@ def test_positions_of_the_wrong_shape_dtype_or_value_are_refused(sim):
 def test_a_particle_out_of_range_or_a_bad_target_is_refused(sim):
     with pytest.raises(IndexError, match="1024 particles: there is no particle 1024"):
         sim.grab("cloth", 1024, [0.0, 1.0, 0.0])
-    with pytest.raises(IndexError):
+    with pytest.raises(IndexError, match="index -1 is negative"):
         sim.grab("cloth", -1, [0.0, 1.0, 0.0])
     with pytest.raises(ValueError, match="finite"):
         sim.grab("cloth", 3, [0.0, float("nan"), 0.0])
