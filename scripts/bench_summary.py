@@ -12,6 +12,8 @@ Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.
 - collisions (sphere, triangle mesh, self) with and without, and their exponents;
 - self-collision vs constraint solve at N = 128; triangle-mesh contact (static and
   deforming meshes); a character's body; MCAP logging overhead;
+- the Python package stepped frame by frame against `weft run`, from
+  `<criterion>/python_frame_by_frame.json` (written by python/bench/frame_by_frame.py);
 - and says which figures quoted elsewhere are not produced by a bench (the peer comparison,
   the self-collision clocks), pointing to where they are kept.
 
@@ -352,6 +354,33 @@ def logging(r, root):
           "(`logging_bytes.json`, written by the bench).\n")
 
 
+def python_frames(root):
+    """python/bench/frame_by_frame.py's figures, when it wrote them into the criterion folder."""
+    print("## Python, frame by frame, against weft run\n")
+    f = root / "python_frame_by_frame.json"
+    if not f.exists():
+        print("Not measured in this run: `python python/bench/frame_by_frame.py` (release builds "
+              "of `weft` and of the package) writes `python_frame_by_frame.json` into the "
+              "criterion folder.\n")
+        return
+    d = json.loads(f.read_text())
+    print(f"`{d['scene']}` at 128², {d['frames']} frames a run, {d['runs']} runs of each "
+          f"interleaved (`python/bench/frame_by_frame.py`, {d['date']}, commit {d['commit']}, "
+          f"{d['cpu']}, kernel path {d['kernel_path']}, Python {d['python']}, load average "
+          f"{d['load'][0]:g} before and {d['load'][1]:g} after): `weft run`'s "
+          f"ms/frame against `sim.step()` called once a frame, medians. The issue's bound is "
+          f"1.15.\n")
+    print("| `weft run` ms/frame | Python `sim.step()` ms/frame | ratio of the medians | "
+          "median of the paired ratios |")
+    print("|---|---|---|---|")
+    print(f"| {fmt(d['weft_run_ms'])} | {fmt(d['python_ms'])} | {d['ratio']:.3f} | "
+          f"{d['paired_ratio']:.3f} |")
+    print()
+    print(f"What a `sim.step()` call adds to its frame (the frames handed to the thread pool, the "
+          f"caller woken, the GIL taken back), measured on a 2 × 2 cloth: "
+          f"{d['per_call_us']:.1f} µs.\n")
+
+
 def cpu_model():
     """The CPU's model name from /proc/cpuinfo (or the platform's name)."""
     try:
@@ -445,6 +474,7 @@ def write_page(r, root, note):
     character(r)
     dressed(r)
     logging(r, root)
+    python_frames(root)
     not_benches()
 
 
