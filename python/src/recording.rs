@@ -96,6 +96,13 @@ impl Recording {
             .map_err(|e| LogError(format!("writing {}: {e}", self.target.display())))
     }
 
+    /// Logs the last frame stepped if `every` skipped it, as `weft run` ends its logs.
+    pub fn last_frame(&mut self, sim: &Simulation, stats: &FrameStats) -> Result<(), LogError> {
+        self.rec
+            .last_frame(sim, stats)
+            .map_err(|e| LogError(format!("writing {}: {e}", self.target.display())))
+    }
+
     /// Writes the status (`frames` whole frames simulated), closes the file and renames it
     /// into place; returns the final path.
     pub fn finish(self, status: &Status, frames: u64) -> Result<PathBuf, LogError> {

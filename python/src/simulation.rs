@@ -51,10 +51,17 @@ impl Simulation {
 
     /// Closes the recording (if any) with `status`; returns the final path.
     fn close(&mut self, status: &Status) -> PyResult<Option<PathBuf>> {
-        let Some(r) = self.state.recording.take() else {
+        let Some(mut r) = self.state.recording.take() else {
             return Ok(None);
         };
         let frames = self.state.sim.frame();
+        // A finished recording ends at the last frame stepped, as `weft run --every` does.
+        if *status == Status::Complete
+            && let Err(e) = r.last_frame(&self.state.sim, &self.state.last)
+        {
+            r.abandon();
+            return Err(PyOSError::new_err(e.0));
+        }
         r.finish(status, frames)
             .map(Some)
             .map_err(|e| PyOSError::new_err(e.0))
@@ -284,17 +291,35 @@ impl Simulation {
     /// Starts an MCAP log at `path`, as `weft run --out` writes it: the current state first,
     /// then every frame stepped, until `stop_recording()`. `frames` is the run's planned
     /// length, written in the log's metadata as `weft run --frames` writes it (`weft replay`
-    /// replays that many; without it the log says 0, as the viewer's do); `mesh_every` and
-    /// `timing` are `--mesh-every` and `--timing`. Recorded from frame 0 with neither live
-    /// changes nor grabs, the log is byte-for-byte `weft run`'s for the same frames.
-    #[pyo3(signature = (path, frames=None, mesh_every=1, timing=false))]
+    /// replays that many; without it the log says 0, as the viewer's do); `log`, `every`,
+    /// `mesh_every`, `precision`, `compression` and `timing` are `weft run`'s options of those
+    /// names. Recorded from frame 0 with neither live changes nor grabs, the log is
+    /// byte-for-byte `weft run`'s for the same frames and options.
+    #[pyo3(signature = (path, frames=None, log="particles", every=1, mesh_every=1, precision="f32", compression="none", timing=false))]
+    #[allow(clippy::too_many_arguments)]
     fn record(
         &mut self,
         path: PathBuf,
         frames: Option<u64>,
+        log: &str,
+        every: u64,
         mesh_every: u64,
+        precision: &str,
+        compression: &str,
         timing: bool,
     ) -> PyResult<()> {
+        let choice = |e: weft_record::UnknownChoice| PyValueError::new_err(e.to_string());
+        if every == 0 {
+            return Err(PyValueError::new_err("every must be at least 1"));
+        }
+        let options = RecordOptions {
+            channels: log.parse().map_err(choice)?,
+            every,
+            mesh_every,
+            precision: precision.parse().map_err(choice)?,
+            compression: compression.parse().map_err(choice)?,
+            timing,
+        };
         if self.state.recording.is_some() {
             return Err(PyRuntimeError::new_err(
                 "already recording: stop_recording() first",
@@ -309,7 +334,6 @@ impl Simulation {
                 path.display()
             )));
         }
-        let options = RecordOptions { mesh_every, timing };
         let state = &mut self.state;
         let r = Recording::start(&path, &state.sim, &state.last, frames.unwrap_or(0), options)
             .map_err(|e| PyOSError::new_err(e.0))?;

@@ -61,6 +61,22 @@ def test_a_recording_is_byte_identical_to_weft_runs_log(tmp_path, weft_bin, scen
     assert py.read_bytes() == cli.read_bytes()
 
 
+def test_a_recording_with_weft_runs_logging_choices_is_byte_identical(tmp_path, weft_bin):
+    scene = CASES[0][0]
+    cli = tmp_path / "cli.mcap"
+    run_weft(weft_bin, "run", scene, "--frames", 11, "--quiet", "--out", cli, "--log", "all",
+             "--every", 3, "--mesh-every", 2, "--precision", "f16", "--compression", "zstd")
+    sim = weft.Simulation(scene)
+    py = tmp_path / "py.mcap"
+    sim.record(py, frames=11, log="all", every=3, mesh_every=2, precision="f16",
+               compression="zstd")
+    sim.step(11)
+    sim.stop_recording()
+    assert py.read_bytes() == cli.read_bytes()
+    with pytest.raises(ValueError, match="not one of"):
+        sim.record(tmp_path / "bad.mcap", log="mesh")
+
+
 def test_weft_replay_reproduces_a_python_recording(tmp_path, weft_bin):
     log = tmp_path / "py.mcap"
     sim = weft.Simulation("assets/scenes/hanging.toml", overrides={"sim.substeps": 14})

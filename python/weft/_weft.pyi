@@ -67,7 +67,11 @@ class Simulation:
         self,
         path: Union[str, "os.PathLike[str]"],
         frames: Optional[int] = None,
+        log: str = "particles",
+        every: int = 1,
         mesh_every: int = 1,
+        precision: str = "f32",
+        compression: str = "none",
         timing: bool = False,
     ) -> None:
         """Starts an MCAP log at ``path``, as ``weft run --out`` writes it."""

@@ -3,9 +3,9 @@
 //! record is written on every way out.
 
 use std::fs::File;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, SyncSender};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -41,7 +41,8 @@ pub struct LogProgress {
 pub struct Recorder {
     jobs: Option<SyncSender<Job>>,
     worker: Option<JoinHandle<Result<()>>>,
-    spare: Receiver<Vec<DVec3>>,
+    /// Buffers the log's thread hands back (in a mutex only to make the recorder `Sync`).
+    spare: Mutex<Receiver<Vec<DVec3>>>,
     ids: Ids,
     moving_colliders: bool,
     options: RecordOptions,
@@ -97,7 +98,7 @@ impl Recorder {
         Ok(Self {
             jobs: Some(jobs),
             worker: Some(worker),
-            spare,
+            spare: Mutex::new(spare),
             ids,
             moving_colliders,
             options,
@@ -166,7 +167,8 @@ impl Recorder {
         let parts = weft_sim::body::parts(sim);
         let cloths = (0..sim.scene.cloths.len())
             .map(|i| {
-                let mut x = self.spare.try_recv().unwrap_or_default();
+                let spare = self.spare.get_mut().map(|r| r.try_recv().ok());
+                let mut x = spare.ok().flatten().unwrap_or_default();
                 x.clear();
                 x.extend_from_slice(sim.cloth_positions(i));
                 x
