@@ -23,7 +23,8 @@ vector path the CPU offers, or the one forced with WEFT_SIMD. Usage:
     python3 scripts/bench_summary.py [CRITERION_DIR] [--out docs/benchmarks.md] [--note TEXT]
                                      [--readme README.md]
     python3 scripts/bench_summary.py --from docs/benchmarks.md --readme README.md
---note adds a line to the header (e.g. the machine's load average during the run). CRITERION_DIR
+--note adds a line to the header (e.g. the machine's load average during the run); a note
+`other rows: …` says which rows were not rerun, and the README's line repeats it. CRITERION_DIR
 defaults to $CRITERION_HOME, else $CARGO_TARGET_DIR/criterion, else
 target/criterion. Without --out the page goes to standard output.
 
@@ -570,8 +571,6 @@ SPEED_ROWS = [
     ("`weft run --out --log all`", "the same", "all",
      (LOGGING, "`--log all`: positions and the surface every frame", "128² reference ms/frame",
       None)),
-    ("`weft run --out --compression zstd`", "the same", "all",
-     (LOGGING, "`--log particles --compression zstd`", "128² reference ms/frame", None)),
     ("`weft run --out` (particles, the default)", "`character.toml`", "all",
      (LOGGING, "`--log particles` (the default): positions, no compression",
       "T-shirt ms/frame", None)),
@@ -611,8 +610,11 @@ def speed_block(page, source):
         lines.append(f"| {what} | {scene} | {threads} | {v} |")
     cpu = bullets.get("CPU", "unknown CPU")
     lines.append("")
+    # A page whose benches were not all rerun says so in a `- other rows: …` note.
+    other = bullets.get("other rows")
+    other = f" (rows not rerun then: {other})" if other else ""
     lines.append(f"Measured {bullets.get('date', 'on an unknown date')} at commit "
-                 f"{bullets.get('commit', 'unknown')} on {cpu}, kernel path "
+                 f"{bullets.get('commit', 'unknown')}{other} on {cpu}, kernel path "
                  f"{bullets.get('kernel path', 'unknown')}; criterion medians, threads \"all\" "
                  f"meaning every logical CPU. Generated from [{source}]({source}) by "
                  f"`python3 scripts/bench_summary.py --from {source} --readme README.md`; every "
