@@ -68,6 +68,8 @@ pub struct VideoRecorder<'g> {
     gpu: &'g Gpu,
     renderer: Renderer,
     target: Offscreen,
+    /// The image's size (px); the target holds one tile of it.
+    size: UVec2,
     camera: Camera,
     options: RenderOptions,
     dir: PathBuf,
@@ -116,7 +118,8 @@ impl<'g> VideoRecorder<'g> {
         Ok(Self {
             gpu,
             renderer,
-            target: Offscreen::new(&gpu.device, size),
+            target: Offscreen::for_image(&gpu.device, size),
+            size,
             camera,
             options,
             dir: dir.to_owned(),
@@ -224,22 +227,20 @@ impl<'g> VideoRecorder<'g> {
                 drag_target: None,
             },
         );
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("weft render frame"),
-            });
-        self.renderer.render(
-            &self.gpu.device,
-            &mut encoder,
-            self.target.view(),
-            self.target.size(),
-            &self.camera,
-            &self.options,
-        );
-        self.gpu.queue.submit([encoder.finish()]);
-        Ok(self.target.read(self.gpu)?)
+        // Drawn a tile at a time: an 8192² image is seconds of software rasterising, and a
+        // stop between its tiles is honoured within a tile's time.
+        let stop = self.stop.clone();
+        let stopped = move || stop.as_ref().is_some_and(|f| f.load(Ordering::Relaxed));
+        self.target
+            .capture(
+                self.gpu,
+                &mut self.renderer,
+                &self.camera,
+                &self.options,
+                self.size,
+                &stopped,
+            )?
+            .ok_or_else(|| Stopped.into())
     }
 
     /// Completes the GIF (renamed from its temporary name) and the MP4; returns the files.

@@ -157,3 +157,58 @@ fn sigint_while_self_collision_lists_a_thick_cloth_stops_within_a_second() {
         "interrupted"
     );
 }
+
+/// Names of the files in `dir`.
+fn names(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Renders the default scene at 8192², signals once `ready` says so, and checks the stop.
+fn stop_a_big_render(name: &str, ready: impl Fn(&[String]) -> bool) {
+    let dir = temp_dir(name);
+    let out = dir.join("out");
+    let child = weft()
+        .args(["render", "--frames", "3", "--size", "8192x8192", "--out"])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starts");
+    assert!(
+        wait_for(Duration::from_secs(120), || ready(&names(&out))),
+        "{name}: never got there: {:?}",
+        names(&out)
+    );
+    signal(child.id(), "INT");
+    let (done, took) = exits_within(child, Duration::from_secs(120));
+    let (o, e) = texts(&done);
+    assert!(took < PROMPT, "{name}: took {took:?} to stop: {o}{e}");
+    assert_eq!(done.status.code(), Some(130), "{name}: {o}{e}");
+    let left = names(&out);
+    assert!(
+        !left.iter().any(|n| n.starts_with("frame_")),
+        "{name}: an image was left: {left:?}"
+    );
+}
+
+#[test]
+fn sigint_while_drawing_an_8192_image_stops_within_a_second() {
+    // The GIF's partial file is opened before the first image is drawn; drawing 8192² on a
+    // software rasteriser takes seconds (a tile at a time, the stop looked at between tiles).
+    let started = std::cell::Cell::new(None);
+    stop_a_big_render("render-stop-drawing", |names| {
+        if names.iter().any(|n| n.ends_with(".gif")) {
+            let at = started.get().unwrap_or_else(std::time::Instant::now);
+            started.set(Some(at));
+            at.elapsed() > Duration::from_millis(1500)
+        } else {
+            false
+        }
+    });
+}

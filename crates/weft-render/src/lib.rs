@@ -13,14 +13,16 @@ mod offscreen;
 mod pipelines;
 mod renderer;
 mod scene;
+mod tile;
 mod uniforms;
 
 pub use camera::{Camera, Ray};
 pub use error::RenderError;
 pub use gpu::Gpu;
-pub use offscreen::{OFFSCREEN_FORMAT, Offscreen};
+pub use offscreen::{OFFSCREEN_FORMAT, Offscreen, TILE_MAX};
 pub use renderer::Renderer;
 pub use scene::{ClothTopology, FrameData, RenderOptions, SceneMeshes, TriMesh};
+pub use tile::Tile;
 pub use uniforms::sun_direction;
 
 /// Re-export of wgpu, so users name the same types.

@@ -2,8 +2,17 @@
 
 use glam::UVec2;
 
+use crate::camera::Camera;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::renderer::Renderer;
+use crate::scene::RenderOptions;
+use crate::tile::Tile;
+
+/// The largest tile [`Offscreen::capture`] draws at once (px a side): 1 Mpx, tens of
+/// milliseconds on a software rasteriser, so a stop between tiles is honoured well within a
+/// second even on a loaded machine.
+pub const TILE_MAX: u32 = 1024;
 
 /// The offscreen colour format: 8-bit sRGB, the same colour path as a window surface.
 pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -16,6 +25,53 @@ pub struct Offscreen {
 }
 
 impl Offscreen {
+    /// A target for [`capture`](Self::capture)s of images of `full` pixels: one tile's size.
+    pub fn for_image(device: &wgpu::Device, full: UVec2) -> Self {
+        Self::new(device, full.max(UVec2::ONE).min(UVec2::splat(TILE_MAX)))
+    }
+
+    /// Draws `renderer`'s last uploaded frame as an image of `full` pixels, a tile of this
+    /// target's size at a time, asking `stopped` before each tile: `Ok(None)` when it says
+    /// stop. The tiles' images are the one image's pixels (see [`Tile::clip_from_full`]).
+    pub fn capture(
+        &self,
+        gpu: &Gpu,
+        renderer: &mut Renderer,
+        camera: &Camera,
+        options: &RenderOptions,
+        full: UVec2,
+        stopped: &dyn Fn() -> bool,
+    ) -> Result<Option<image::RgbaImage>, RenderError> {
+        let full = full.max(UVec2::ONE);
+        if self.size != full.min(UVec2::splat(TILE_MAX)) {
+            return Err(RenderError::Image(format!(
+                "a {}x{} target cannot capture a {}x{} image",
+                self.size.x, self.size.y, full.x, full.y
+            )));
+        }
+        let mut image = image::RgbaImage::new(full.x, full.y);
+        for tile in Tile::cover(full, TILE_MAX) {
+            if stopped() {
+                return Ok(None);
+            }
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("weft tile"),
+                });
+            renderer.render_tile(&gpu.device, &mut encoder, &self.view, tile, camera, options);
+            gpu.queue.submit([encoder.finish()]);
+            let part = self.read(gpu)?;
+            image::imageops::replace(
+                &mut image,
+                &part,
+                i64::from(tile.origin.x),
+                i64::from(tile.origin.y),
+            );
+        }
+        Ok(Some(image))
+    }
+
     /// A target of `size` pixels (each side at least 1).
     pub fn new(device: &wgpu::Device, size: UVec2) -> Self {
         let size = size.max(UVec2::ONE);

@@ -1,10 +1,11 @@
 //! The uniform block shared by every main-pass shader, the material palette and the sun.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, UVec2, Vec3};
+use glam::{Mat4, Vec3};
 
 use crate::camera::Camera;
 use crate::geometry::Bounds;
+use crate::tile::Tile;
 
 /// Materials in the palette: cloths cycle through the first [`CLOTH_MATERIALS`].
 pub const CLOTH_MATERIALS: u32 = 6;
@@ -53,8 +54,8 @@ pub struct Globals {
 pub struct GlobalsInput<'a> {
     /// The camera.
     pub camera: &'a Camera,
-    /// Target size (px).
-    pub size: UVec2,
+    /// The part of the image the target holds (the whole image but for tiled renders).
+    pub tile: Tile,
     /// The sun's view-projection.
     pub light_view_proj: Mat4,
     /// Whether shadows are sampled.
@@ -72,7 +73,7 @@ pub struct GlobalsInput<'a> {
 impl Globals {
     /// Assembles the uniforms.
     pub fn new(i: &GlobalsInput) -> Self {
-        let view_proj = i.camera.view_proj(i.size);
+        let view_proj = i.tile.clip_from_full() * i.camera.view_proj(i.tile.full);
         let eye = i.camera.eye();
         let mut palette = [[0.0; 4]; 16];
         for (m, (front, back)) in CLOTH_COLOURS.iter().enumerate() {
@@ -106,8 +107,8 @@ impl Globals {
                 0.0,
             ],
             viewport: [
-                i.size.x as f32,
-                i.size.y as f32,
+                i.tile.size.x as f32,
+                i.tile.size.y as f32,
                 1.0 / SHADOW_SIZE as f32,
                 0.0,
             ],

@@ -8,6 +8,7 @@ use super::resources::copy_into;
 use super::staging::count;
 use crate::camera::Camera;
 use crate::scene::RenderOptions;
+use crate::tile::Tile;
 use crate::uniforms::{self, Globals, GlobalsInput};
 
 impl Renderer {
@@ -23,12 +24,25 @@ impl Renderer {
         camera: &Camera,
         options: &RenderOptions,
     ) {
-        let size = size.max(UVec2::ONE);
-        self.res.ensure_targets(device, size);
+        self.render_tile(device, encoder, target, Tile::whole(size), camera, options);
+    }
+
+    /// Draws `tile` of the image into `target` (`tile.size` pixels): the camera frames the
+    /// whole image, the target holds only its tile. `weft render` draws big images this way.
+    pub fn render_tile(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        tile: Tile,
+        camera: &Camera,
+        options: &RenderOptions,
+    ) {
+        self.res.ensure_targets(device, tile.size.max(UVec2::ONE));
         let light_view_proj = uniforms::light_view_proj(self.staging.focus, self.ground_height);
         let globals = Globals::new(&GlobalsInput {
             camera,
-            size,
+            tile,
             light_view_proj,
             shadows: options.shadows,
             grid: options.grid,
@@ -49,7 +63,9 @@ impl Renderer {
             &self.res.light,
             bytemuck::bytes_of(&light_view_proj.to_cols_array()),
         );
-        if options.shadows {
+        // The shadow map depends on the scene, not the tile: drawn with an image's first tile
+        // (a cover starts at the top left), kept for the rest.
+        if options.shadows && tile.origin == UVec2::ZERO {
             self.shadow_pass(encoder);
         }
         self.main_pass(encoder, target, options);

@@ -3,3 +3,4 @@
 //! One binary instead of one per file keeps the test build small on disk and quick to link.
 
 mod offscreen;
+mod tiles;
