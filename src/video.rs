@@ -405,36 +405,51 @@ impl<W: std::io::Write> std::io::Write for StopWriter<'_, W> {
     }
 }
 
+/// Rows of an image compressed between two looks at the stop flag: 64 rows of an 8192-pixel
+/// image are 2 MiB, tens of milliseconds of the strongest compression.
+const PNG_ROWS_PER_CHECK: usize = 64;
+
 /// Writes `image` as a PNG with the strongest compression (about half the default's size),
 /// to its partial file, renamed into place when whole; a raised `stop` abandons it (the
-/// partial file is removed) with [`Stopped`].
+/// partial file is removed) with [`Stopped`]. The rows are streamed through the compressor
+/// a few at a time: compressing a whole 8192² image before writing takes seconds no stop
+/// could cut short.
 fn save_png(
     image: &image::RgbaImage,
     path: &Path,
     stop: Option<&AtomicBool>,
 ) -> anyhow::Result<()> {
-    use image::ImageEncoder;
-    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use std::io::Write;
+    let stopped = || stop.is_some_and(|f| f.load(Ordering::Relaxed));
     let out = Output::create(path)?;
     let mut file = StopWriter {
         inner: BufWriter::new(out.handle()?),
         stop,
     };
-    PngEncoder::new_with_quality(&mut file, CompressionType::Best, FilterType::Adaptive)
-        .write_image(
-            image.as_raw(),
-            image.width(),
-            image.height(),
-            image::ExtendedColorType::Rgba8,
-        )
-        .map_err(|e| {
-            if stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
-                anyhow::Error::new(Stopped)
-            } else {
-                e.into()
+    let encoded: anyhow::Result<()> = (|| {
+        let mut encoder = png::Encoder::new(&mut file, image.width(), image.height());
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::High);
+        encoder.set_filter(png::Filter::Adaptive);
+        let mut writer = encoder.write_header()?;
+        let mut stream = writer.stream_writer()?;
+        let row = 4 * image.width() as usize;
+        for rows in image.as_raw().chunks(row * PNG_ROWS_PER_CHECK) {
+            if stopped() {
+                return Err(Stopped.into());
             }
-        })?;
-    std::io::Write::flush(&mut file)?;
+            stream.write_all(rows)?;
+        }
+        stream.finish()?;
+        writer.finish()?;
+        Ok(())
+    })();
+    if stopped() {
+        return Err(Stopped.into());
+    }
+    encoded?;
+    file.flush()?;
     drop(file);
     out.commit()
 }

@@ -212,3 +212,12 @@ fn sigint_while_drawing_an_8192_image_stops_within_a_second() {
         }
     });
 }
+
+#[test]
+fn sigint_while_writing_an_8192_png_stops_within_a_second() {
+    // Compressing 256 MB of pixels at the strongest level takes seconds: rows are streamed
+    // through the compressor a few at a time, the stop looked at between them.
+    stop_a_big_render("render-stop-png", |names| {
+        names.iter().any(|n| n.starts_with("frame_00000.partial"))
+    });
+}
