@@ -80,12 +80,25 @@ impl Camera {
         c
     }
 
-    /// A camera that fits the box `min..max` in view from a 3/4 angle, slightly from above.
+    /// A camera that fits the box `min..max` in view from a 3/4 angle, slightly from above,
+    /// in an image at least as wide as tall.
     pub fn framing(min: Vec3, max: Vec3) -> Self {
+        Self::framing_for(min, max, 1.0)
+    }
+
+    /// A camera that fits the box `min..max` in view from a 3/4 angle, slightly from above,
+    /// in an image of width/height `aspect` (a tall image is taken as it is; a wide one as
+    /// square, so the box also fits when part of the width is covered, e.g. by a panel).
+    pub fn framing_for(min: Vec3, max: Vec3, aspect: f32) -> Self {
         let (min, max) = if min.is_finite() && max.is_finite() && min.cmple(max).all() {
             (min, max)
         } else {
             (Vec3::splat(-1.0), Vec3::splat(1.0))
+        };
+        let aspect = if aspect.is_finite() && aspect > 0.0 {
+            aspect.min(1.0)
+        } else {
+            1.0
         };
         let center = 0.5 * (min + max);
         let radius = (0.5 * (max - min).length()).max(0.05);
@@ -98,10 +111,10 @@ impl Camera {
             near: 0.01,
             far: 100.0,
         };
-        // The nearest distance at which every corner of the box is inside the view cone of
-        // half-angle fov/2, both vertically and horizontally (for targets at least as wide as
-        // tall), with a 6% margin: a corner at (x, y, z) in view axes around the target needs
-        // D ≥ z + max(|x|, |y|) / tan(fov/2).
+        // The nearest distance at which every corner of the box is inside the view frustum
+        // (vertical half-angle fov/2, horizontal tan scaled by the aspect), with a 6% margin:
+        // a corner at (x, y, z) in view axes around the target needs
+        // D ≥ z + max(|x| / aspect, |y|) / tan(fov/2).
         let (right, up) = c.right_up();
         let back = c.back();
         let t = (0.5 * c.fov_y).tan();
@@ -114,7 +127,7 @@ impl Camera {
                 if i & 4 == 0 { -half.z } else { half.z },
             );
             let (x, y, z) = (corner.dot(right), corner.dot(up), corner.dot(back));
-            distance = distance.max(z + x.abs().max(y.abs()) / (0.94 * t));
+            distance = distance.max(z + (x.abs() / aspect).max(y.abs()) / (0.94 * t));
         }
         c.distance = distance;
         c.fit_clip_planes(radius);
@@ -397,5 +410,25 @@ mod tests {
             let depth = (p - c.eye()).dot(c.forward());
             assert!(depth > c.near && depth < c.far);
         }
+    }
+
+    #[test]
+    fn framing_a_tall_image_sees_every_corner_of_a_wide_box() {
+        let (min, max) = (Vec3::new(-2.0, 0.0, -0.5), Vec3::new(2.0, 1.0, 0.5));
+        let tall = UVec2::new(300, 800);
+        let fits = |c: &Camera| {
+            (0..8).all(|i| {
+                let p = Vec3::new(
+                    if i & 1 == 0 { min.x } else { max.x },
+                    if i & 2 == 0 { min.y } else { max.y },
+                    if i & 4 == 0 { min.z } else { max.z },
+                );
+                let px = c.project(p, tall).expect("in front");
+                px.x > 0.0 && px.y > 0.0 && px.x < 300.0 && px.y < 800.0
+            })
+        };
+        assert!(fits(&Camera::framing_for(min, max, 300.0 / 800.0)));
+        // Framed as if square, the box's ends fall outside the tall image.
+        assert!(!fits(&Camera::framing(min, max)));
     }
 }

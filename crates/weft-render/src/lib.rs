@@ -23,7 +23,7 @@ pub use offscreen::{OFFSCREEN_FORMAT, Offscreen, TILE_MAX};
 pub use renderer::Renderer;
 pub use scene::{ClothTopology, FrameData, RenderOptions, SceneMeshes, TriMesh};
 pub use tile::Tile;
-pub use uniforms::sun_direction;
+pub use uniforms::{cloth_colour, sun_direction};
 
 /// Re-export of wgpu, so users name the same types.
 pub use wgpu;

@@ -24,6 +24,12 @@ const CLOTH_COLOURS: [([f32; 3], [f32; 3]); CLOTH_MATERIALS as usize] = [
 /// Linear colour of colliders: a cool steel grey.
 const COLLIDER_COLOUR: [f32; 3] = [0.42, 0.45, 0.50];
 
+/// The linear RGB front colour the renderer gives the cloth at index `i` of a scene (cloths
+/// cycle through the palette in scene order), for legends and labels that name it.
+pub fn cloth_colour(i: usize) -> [f32; 3] {
+    CLOTH_COLOURS[i % CLOTH_COLOURS.len()].0
+}
+
 /// Direction towards the sun (normalised on use): 46° up, from the front left.
 const SUN_DIR: Vec3 = Vec3::new(-0.55, 0.85, 0.6);
 
