@@ -418,6 +418,22 @@ pub struct RenderArgs {
     /// Draw the particles.
     #[arg(long)]
     pub particles: bool,
+    /// Camera position `X,Y,Z` (m) instead of the automatic framing (with --target).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "target",
+        allow_hyphen_values = true
+    )]
+    pub eye: Option<Point>,
+    /// Point the camera looks at, `X,Y,Z` (m) (with --eye).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "eye",
+        allow_hyphen_values = true
+    )]
+    pub target: Option<Point>,
     /// No shadows.
     #[arg(long)]
     pub no_shadows: bool,

@@ -9,6 +9,7 @@ mod cli;
 mod default_scene;
 mod experiments;
 mod export;
+mod framing;
 mod limits;
 mod output;
 mod recover;
@@ -132,6 +133,10 @@ fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Res
             shadows: !args.no_shadows,
         },
         progress: !args.quiet,
+        camera: args
+            .eye
+            .zip(args.target)
+            .map(|(e, t)| (glam::Vec3::from(e.0), glam::Vec3::from(t.0))),
     };
     if let Some(scene_file) = &args.scene {
         // Neither --out itself nor any file the render writes into it may be an input.

@@ -46,6 +46,11 @@ pub fn parse_size(s: &str) -> Result<UVec2, String> {
     Ok(UVec2::new(dim(w)?, dim(h)?))
 }
 
+/// Width over height of an image of `size` pixels.
+fn aspect(size: UVec2) -> f32 {
+    size.x.max(1) as f32 / size.y.max(1) as f32
+}
+
 /// Options of `weft render`.
 pub struct VideoPlan<'a> {
     /// Frames to simulate.
@@ -58,6 +63,8 @@ pub struct VideoPlan<'a> {
     pub size: UVec2,
     /// Layers to draw.
     pub options: RenderOptions,
+    /// A fixed camera `(eye, target)` instead of the automatic framing.
+    pub camera: Option<(glam::Vec3, glam::Vec3)>,
     /// Show a progress bar (on a terminal only).
     pub progress: bool,
 }
@@ -114,7 +121,8 @@ impl<'g> VideoRecorder<'g> {
         let gif_stride = (GIF_MIN_DELAY_MS / period_ms).ceil().max(1.0) as u64;
         let gif_delay_ms = (period_ms * gif_stride as f64).round().max(1.0) as u32;
 
-        let (renderer, camera) = view::renderer_for(&gpu.device, OFFSCREEN_FORMAT, sim);
+        let (renderer, scene_view) = view::renderer_for(&gpu.device, OFFSCREEN_FORMAT, sim);
+        let camera = crate::framing::framing_camera(sim, &scene_view, aspect(size), 0.0);
         Ok(Self {
             gpu,
             renderer,
@@ -134,6 +142,18 @@ impl<'g> VideoRecorder<'g> {
             stop: None,
             last: None,
         })
+    }
+
+    /// Frames what `sim` contains now and, for its character, over the next `span` seconds
+    /// (a character that jumps or walks stays in the picture).
+    pub fn frame_span(&mut self, sim: &Simulation, span: f64) {
+        let view = view::scene_meshes(sim);
+        self.camera = crate::framing::framing_camera(sim, &view, aspect(self.target.size()), span);
+    }
+
+    /// Looks from `eye` at `target` instead of the automatic framing.
+    pub fn set_camera(&mut self, eye: glam::Vec3, target: glam::Vec3) {
+        self.camera = Camera::looking_at(eye, target);
     }
 
     /// A flag polled while an image is written: once raised, the PNG being compressed is
@@ -547,6 +567,10 @@ pub fn render(
     sim.set_stop(Arc::clone(stop));
     let _polling = crate::stop::Polling::start();
     let mut rec = VideoRecorder::new(&gpu, &sim, plan.out, plan.size, plan.every, plan.options)?;
+    match plan.camera {
+        Some((eye, target)) => rec.set_camera(eye, target),
+        None => rec.frame_span(&sim, plan.frames as f64 * sim.scene.settings.dt),
+    }
     rec.set_stop(Arc::clone(stop));
     eprintln!(
         "weft: rendering {} on {} at {}x{}, every {} frame(s) of {}",

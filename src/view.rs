@@ -1,9 +1,9 @@
 //! What the renderer is shown of a simulation, for the window and `weft render` alike: the
-//! cloth and collider meshes, the collider poses, the floor, and the camera that frames the
-//! scene.
+//! cloth and collider meshes, the collider poses and the floor (`framing.rs` places the
+//! camera).
 
-use glam::{Mat4, Vec3};
-use weft_render::{Camera, ClothTopology, Renderer, SceneMeshes, TriMesh};
+use glam::Mat4;
+use weft_render::{ClothTopology, Renderer, SceneMeshes, TriMesh};
 
 use weft_sim::Simulation;
 
@@ -108,65 +108,17 @@ pub fn floor_height(sim: &Simulation, view: &SceneView) -> f32 {
     })
 }
 
-/// A camera that frames the cloths and bounded colliders of `sim` as they are now, and the
-/// floor under them when it is near (so shadows and the drop are in view).
-pub fn framing_camera(sim: &Simulation, view: &SceneView) -> Camera {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for i in 0..sim.scene.cloths.len() {
-        for p in sim.cloth_positions(i) {
-            lo = lo.min(p.as_vec3());
-            hi = hi.max(p.as_vec3());
-        }
-    }
-    for (mesh, pose) in view.meshes.colliders.iter().zip(frame_poses(sim)) {
-        let (mut a, mut b) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for p in &mesh.positions {
-            let w = pose.transform_point3(*p);
-            a = a.min(w);
-            b = b.max(w);
-        }
-        // Large walls (half-spaces) would shrink everything else to a dot.
-        if (b - a).length() < 20.0 {
-            lo = lo.min(a);
-            hi = hi.max(b);
-        }
-    }
-    let floor = floor_height(sim, view);
-    if lo.is_finite() && hi.is_finite() && floor < lo.y && lo.y - floor < 2.0 * (hi - lo).length() {
-        // Take in the floor and the shadow of the box's underside on it (its corners carried
-        // down along the sunlight), so hanging things show where their shadow falls.
-        let sun = weft_render::sun_direction();
-        let (a, b) = (lo, hi);
-        for i in 0..4 {
-            let c = Vec3::new(
-                if i & 1 == 0 { a.x } else { b.x },
-                a.y,
-                if i & 2 == 0 { a.z } else { b.z },
-            );
-            let shadow = c - sun * ((c.y - floor) / sun.y.max(0.1));
-            lo = lo.min(shadow);
-            hi = hi.max(shadow);
-        }
-    }
-    Camera::framing(lo, hi)
-}
-
 /// A renderer drawing `sim` into targets of `format`, with its floor (see [`floor_height`]),
-/// and the camera framing the scene now.
+/// and what it was made from (for [`crate::framing`]).
 pub fn renderer_for(
     device: &wgpu::Device,
     format: wgpu::TextureFormat,
     sim: &Simulation,
-) -> (Renderer, Camera) {
+) -> (Renderer, SceneView) {
     let view = scene_meshes(sim);
     let mut renderer = Renderer::new(device, format, &view.meshes);
     renderer.set_ground_height(floor_height(sim, &view));
-    (renderer, framing_camera(sim, &view))
-}
-
-/// The camera that frames the scene now ([`framing_camera`]).
-pub fn initial_camera(sim: &Simulation) -> Camera {
-    framing_camera(sim, &scene_meshes(sim))
+    (renderer, view)
 }
 
 #[cfg(test)]

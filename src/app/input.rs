@@ -18,6 +18,12 @@ pub enum Action {
     ToggleHelp,
     /// Show or hide the side panel.
     TogglePanel,
+    /// Frame what the scene contains (cloths, colliders, character) from the default angle.
+    FrameScene,
+    /// Follow the character with the camera, or stop following it.
+    ToggleFollow,
+    /// Show or hide the cloths' labels in the 3-D view.
+    ToggleLabels,
     /// Quit (the log, if any, is finished first).
     Quit,
 }
@@ -29,6 +35,9 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("R", "reset the scene"),
     ("W", "wireframe on / off"),
     ("P", "particles on / off"),
+    ("F or Home", "frame the scene (reset the camera)"),
+    ("C", "follow the character on / off"),
+    ("L", "cloth labels on / off"),
     ("Tab", "side panel on / off"),
     ("H or F1", "this help"),
     ("Esc or Q", "quit"),
@@ -50,11 +59,15 @@ pub fn action_for(key: &Key) -> Option<Action> {
         Key::Named(NamedKey::Escape) => Some(Action::Quit),
         Key::Named(NamedKey::Tab) => Some(Action::TogglePanel),
         Key::Named(NamedKey::F1) => Some(Action::ToggleHelp),
+        Key::Named(NamedKey::Home) => Some(Action::FrameScene),
         Key::Character(c) => match c.to_lowercase().as_str() {
             "s" => Some(Action::Command(Command::Step)),
             "r" => Some(Action::Command(Command::Reset)),
             "w" => Some(Action::ToggleWireframe),
             "p" => Some(Action::ToggleParticles),
+            "f" => Some(Action::FrameScene),
+            "c" => Some(Action::ToggleFollow),
+            "l" => Some(Action::ToggleLabels),
             "h" => Some(Action::ToggleHelp),
             "q" => Some(Action::Quit),
             _ => None,
@@ -114,6 +127,13 @@ mod tests {
             Some(Action::TogglePanel)
         );
         assert_eq!(action_for(&key("q")), Some(Action::Quit));
+        assert_eq!(action_for(&key("F")), Some(Action::FrameScene));
+        assert_eq!(
+            action_for(&Key::Named(NamedKey::Home)),
+            Some(Action::FrameScene)
+        );
+        assert_eq!(action_for(&key("c")), Some(Action::ToggleFollow));
+        assert_eq!(action_for(&key("L")), Some(Action::ToggleLabels));
         assert_eq!(
             action_for(&Key::Named(NamedKey::Escape)),
             Some(Action::Quit)

@@ -8,15 +8,19 @@
 //! | `clock.rs` | fixed simulation step decoupled from the display rate |
 //! | `picking.rs`, `grab.rs` | ray–cloth picking; grabbing and dragging through the solver |
 //! | `command.rs` | pause, step and reset, as the keys and the panel both ask for them |
+//! | `camera.rs` | the camera's framing (F, Home) and following a character |
+//! | `labels.rs` | the cloths' labels in the 3-D view and their legend colours |
 //! | `input.rs` | key and mouse-button bindings |
 //! | `panel.rs` | the egui side panel |
 //! | `recording.rs` | `--record`: the MCAP log and its `/interaction` channel |
 
+pub mod camera;
 pub mod character;
 pub mod clock;
 pub mod command;
 pub mod grab;
 pub mod input;
+pub mod labels;
 pub mod panel;
 pub mod picking;
 pub mod recording;

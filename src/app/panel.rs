@@ -7,11 +7,14 @@
 use std::path::{Path, PathBuf};
 
 use egui::{ComboBox, DragValue, RichText, Ui};
-use weft_render::RenderOptions;
+use weft_solver::Method;
 use weft_solver::glam::DVec3;
-use weft_solver::{Family, Method};
 
 mod character;
+mod families;
+mod view;
+
+pub use view::ViewControls;
 
 use crate::app::command::Command;
 use crate::app::session::{SceneSource, Session};
@@ -37,6 +40,8 @@ pub struct Outcome {
     pub scene_changed: bool,
     /// The pause, step or reset button that was pressed (one per frame).
     pub command: Option<Command>,
+    /// The "frame scene" button was pressed.
+    pub frame: bool,
 }
 
 /// The built-in scene, then every `*.toml` in `dir` (sorted) but the file the built-in scene
@@ -65,15 +70,15 @@ fn note(state: &mut PanelState, r: Result<(), impl std::fmt::Display>) {
     }
 }
 
-/// Draws the panel's contents.
+/// Draws the panel's contents, scrolling when they are taller or wider than the panel.
 pub fn show(
     ui: &mut Ui,
     session: &mut Session,
     state: &mut PanelState,
-    options: &mut RenderOptions,
+    controls: &mut ViewControls<'_>,
 ) -> Outcome {
     let mut out = Outcome::default();
-    egui::ScrollArea::vertical().show(ui, |ui| {
+    egui::ScrollArea::both().show(ui, |ui| {
         ui.heading("Weft");
         scene_section(ui, session, state, &mut out);
         ui.separator();
@@ -87,13 +92,7 @@ pub fn show(
         ui.separator();
         cloth_section(ui, session, state);
         ui.separator();
-        ui.label(RichText::new("View").strong());
-        ui.horizontal_wrapped(|ui| {
-            ui.checkbox(&mut options.wireframe, "wireframe");
-            ui.checkbox(&mut options.particles, "particles");
-            ui.checkbox(&mut options.grid, "grid");
-            ui.checkbox(&mut options.shadows, "shadows");
-        });
+        view::section(ui, session, controls, &mut out);
         if let Some(e) = &state.error {
             ui.separator();
             ui.colored_label(egui::Color32::from_rgb(255, 110, 110), e);
@@ -338,46 +337,19 @@ fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
         let r = session.sim.set_thickness(cloth, thickness);
         note(state, r);
     }
-    let mut changed = false;
-    egui::Grid::new("families")
-        .num_columns(4)
-        .striped(true)
-        .show(ui, |ui| {
-            ui.label("family");
-            ui.label("XPBD α");
-            ui.label("PBD k");
-            ui.label("spring k");
-            ui.end_row();
-            for f in Family::ALL {
-                let p = params.get_mut(f);
-                if !p.enabled {
-                    continue;
-                }
-                ui.label(f.name());
-                changed |= ui
-                    .add(
-                        DragValue::new(&mut p.compliance)
-                            .speed(1e-6)
-                            .max_decimals(9),
-                    )
-                    .changed();
-                changed |= ui
-                    .add(DragValue::new(&mut p.pbd_stiffness).speed(0.01))
-                    .changed();
-                changed |= ui
-                    .add(DragValue::new(&mut p.spring_stiffness).speed(10.0))
-                    .changed();
-                ui.end_row();
-            }
-        });
+    let method = crate::app::labels::method(&session.sim, cloth);
+    let changed = families::grid(ui, method, &mut params);
     if changed {
         let r = session.sim.set_cloth_params(cloth, params);
         note(state, r);
     }
     ui.label(
-        RichText::new("families off in the scene have no constraints and are not listed")
-            .small()
-            .weak(),
+        RichText::new(format!(
+            "{} values; families off in the scene are not listed",
+            method.name()
+        ))
+        .small()
+        .weak(),
     );
 }
 

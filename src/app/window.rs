@@ -14,15 +14,23 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow};
 use winit::window::{Window, WindowId};
 
+use crate::app::camera::ViewCamera;
 use crate::app::input::{self, Action, DragMode};
+use crate::app::labels;
 use crate::app::panel::{self, PanelState};
 use crate::app::picking::Ray;
 use crate::app::session::Session;
 use crate::app::surface::WindowSurface;
 use crate::view;
 
-/// Width of the side panel (points).
+/// Width of the side panel (points) in a window wide enough for it.
 pub const PANEL_WIDTH: f32 = 300.0;
+
+/// The side panel's width in a window `window` points wide: [`PANEL_WIDTH`], but never
+/// more than 60% of the window (the 3-D view keeps the rest).
+pub fn panel_width(window: f32) -> f32 {
+    PANEL_WIDTH.min(0.6 * window).max(0.0)
+}
 
 /// How the window opens and when it closes by itself.
 #[derive(Clone, Debug)]
@@ -54,8 +62,10 @@ pub struct App {
     stop: Arc<AtomicBool>,
     gfx: Option<Gfx>,
     egui: egui::Context,
-    camera: Camera,
+    cam: ViewCamera,
     options: RenderOptions,
+    /// Whether the cloths' labels are drawn in the 3-D view.
+    labels: bool,
     panel: PanelState,
     show_panel: bool,
     show_help: bool,
@@ -88,15 +98,18 @@ impl App {
     ) -> Self {
         let camera = match config.camera {
             Some((eye, target)) => Camera::looking_at(eye, target),
-            None => view::initial_camera(&session.sim),
+            None => Camera::default(),
         };
+        let cam = ViewCamera::new(camera, &session.sim);
+        let labels = session.sim.scene.cloths.len() > 1;
         Self {
             session,
             config,
             stop,
             gfx: None,
             egui: egui::Context::default(),
-            camera,
+            cam,
+            labels,
             options: RenderOptions {
                 wireframe: false,
                 particles: false,
@@ -136,11 +149,10 @@ impl App {
         let window = Arc::new(event_loop.create_window(attrs)?);
         let (surface, gpu) = WindowSurface::new(event_loop, Arc::clone(&window))?;
         let (format, size) = (surface.format(), surface.size());
-        let (renderer, framing) = view::renderer_for(&gpu.device, format, &self.session.sim);
-        self.camera = match self.config.camera {
-            Some((eye, target)) => Camera::looking_at(eye, target),
-            None => framing,
-        };
+        let (renderer, _) = view::renderer_for(&gpu.device, format, &self.session.sim);
+        if self.config.camera.is_none() {
+            self.cam.frame(&self.session.sim, size);
+        }
         let egui_state = egui_winit::State::new(
             self.egui.clone(),
             egui::ViewportId::ROOT,
@@ -177,7 +189,7 @@ impl App {
     }
 
     fn ray(&self, cursor: Vec2) -> Ray {
-        let r = self.camera.ray(cursor, self.size());
+        let r = self.cam.camera.ray(cursor, self.size());
         Ray {
             origin: r.origin.as_dvec3(),
             dir: r.dir.as_dvec3(),
@@ -195,17 +207,22 @@ impl App {
             Action::ToggleParticles => self.options.particles = !self.options.particles,
             Action::ToggleHelp => self.show_help = !self.show_help,
             Action::TogglePanel => self.show_panel = !self.show_panel,
+            Action::FrameScene => self.cam.frame(&self.session.sim, self.size()),
+            Action::ToggleFollow => self.cam.follow = !self.cam.follow && self.cam.can_follow(),
+            Action::ToggleLabels => self.labels = !self.labels,
             Action::Quit => event_loop.exit(),
         }
     }
 
     fn rebuild_scene(&mut self) {
-        self.camera = view::initial_camera(&self.session.sim);
+        let size = self.size();
+        self.cam = ViewCamera::new(self.cam.camera, &self.session.sim);
+        self.cam.frame(&self.session.sim, size);
+        self.labels = self.session.sim.scene.cloths.len() > 1;
         if let Some(g) = self.gfx.as_mut() {
-            let (renderer, camera) =
+            let (renderer, _) =
                 view::renderer_for(&g.gpu.device, g.surface.format(), &self.session.sim);
             g.renderer = renderer;
-            self.camera = camera;
             g.window
                 .set_title(&format!("Weft — {}", self.session.sim.scene.name));
         }
@@ -223,7 +240,7 @@ impl App {
                 if mode == DragMode::Grab {
                     let Some(c) = self.cursor else { return };
                     let ray = self.ray(c);
-                    let forward = self.camera.forward().as_dvec3();
+                    let forward = self.cam.camera.forward().as_dvec3();
                     if !self.session.grab(&ray, forward) {
                         return;
                     }
@@ -251,8 +268,8 @@ impl App {
                 let ray = self.ray(to);
                 self.session.drag(&ray);
             }
-            Some(DragMode::Orbit) => self.camera.orbit(d.x, d.y),
-            Some(DragMode::Pan) => self.camera.pan(d.x, d.y, self.size()),
+            Some(DragMode::Orbit) => self.cam.camera.orbit(d.x, d.y),
+            Some(DragMode::Pan) => self.cam.camera.pan(d.x, d.y, self.size()),
             None => {}
         }
     }
@@ -266,6 +283,7 @@ impl App {
         if let Err(e) = self.session.advance(self.config.exit_after_frames) {
             return self.fail(event_loop, e);
         }
+        self.cam.track(&self.session.sim);
         if let Some(n) = self.config.exit_after_frames
             && self.session.frames >= n
         {
@@ -284,17 +302,27 @@ impl App {
         let raw = g.egui_state.take_egui_input(&g.window);
         let session = &mut self.session;
         let panel_state = &mut self.panel;
-        let options = &mut self.options;
+        let mut controls = panel::ViewControls {
+            options: &mut self.options,
+            camera: &mut self.cam,
+            labels: &mut self.labels,
+        };
         let (show_panel, show_help) = (self.show_panel, self.show_help);
+        let size = g.surface.size();
         let mut outcome = panel::Outcome::default();
         let output = self.egui.run_ui(raw, |ui| {
             if show_panel {
                 egui::Panel::right("weft-panel")
-                    .exact_size(PANEL_WIDTH)
+                    .exact_size(panel_width(ui.ctx().content_rect().width()))
                     .resizable(false)
                     .show(ui, |ui| {
-                        outcome = panel::show(ui, session, panel_state, options);
+                        outcome = panel::show(ui, session, panel_state, &mut controls);
                     });
+            }
+            if *controls.labels {
+                let painter = ui.painter_at(ui.available_rect_before_wrap());
+                let ppp = ui.ctx().pixels_per_point();
+                labels::paint(&painter, &session.sim, &controls.camera.camera, size, ppp);
             }
             help_overlay(ui.ctx(), show_help);
         });
@@ -332,6 +360,9 @@ impl App {
         }
         if outcome.scene_changed {
             self.rebuild_scene();
+        } else if outcome.frame {
+            let size = self.size();
+            self.cam.frame(&self.session.sim, size);
         }
         let Some(g) = self.gfx.as_mut() else {
             return Ok(());
@@ -370,7 +401,7 @@ impl App {
             &mut encoder,
             &view,
             size,
-            &self.camera,
+            &self.cam.camera,
             &self.options,
         );
         let screen = egui_wgpu::ScreenDescriptor {
@@ -504,7 +535,7 @@ impl ApplicationHandler for App {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                self.camera.zoom(steps);
+                self.cam.camera.zoom(steps);
             }
             _ => {}
         }

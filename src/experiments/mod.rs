@@ -416,6 +416,7 @@ fn execute(
     // The video starts with the initial state, so a run that diverges in its first frame still
     // has a frame to hold and mark.
     if let Some(v) = video.as_mut() {
+        v.frame_span(&sim, frames as f64 * dt);
         v.frame(&sim)?;
     }
     let mut meter = Meter::new(&sim);
