@@ -41,10 +41,14 @@ impl ViewCamera {
     }
 
     /// Frames what `sim` contains now (cloths, bounded colliders, and the character over the
-    /// next [`CHARACTER_SPAN`]) in a view of `size` pixels, from the default 3/4 angle.
-    pub fn frame(&mut self, sim: &Simulation, size: UVec2) {
-        let aspect = size.x.max(1) as f32 / size.y.max(1) as f32;
+    /// next [`CHARACTER_SPAN`]) from the default 3/4 angle, in a view of `size` pixels whose
+    /// right `covered` pixels are under the side panel: the scene is centred in the rest.
+    pub fn frame(&mut self, sim: &Simulation, size: UVec2, covered: f32) {
+        let covered = covered.clamp(0.0, 0.8 * size.x as f32);
+        let aspect = (size.x as f32 - covered).max(1.0) / size.y.max(1) as f32;
         self.camera = framing::framing_camera(sim, &scene_meshes(sim), aspect, CHARACTER_SPAN);
+        // Slide the picture left by half the covered width.
+        self.camera.pan(-0.5 * covered, 0.0, size);
         self.anchor = framing::character_anchor(sim);
     }
 
@@ -81,7 +85,7 @@ mod tests {
             on.follow && on.can_follow(),
             "on by default for a character"
         );
-        on.frame(&s, size);
+        on.frame(&s, size, 0.0);
         let mut off = on.clone();
         off.follow = false;
         let framed = off.camera;
@@ -108,13 +112,23 @@ mod tests {
         let size = UVec2::new(1280, 800);
         let mut c = ViewCamera::new(Camera::default(), &s);
         assert!(!c.follow && !c.can_follow(), "nothing to follow");
-        c.frame(&s, size);
+        c.frame(&s, size, 300.0);
         let framed = c.camera;
         c.camera.orbit(200.0, -50.0);
         c.camera.pan(30.0, 10.0, size);
         c.camera.zoom(3.0);
         assert_ne!(c.camera, framed);
-        c.frame(&s, size);
+        c.frame(&s, size, 300.0);
         assert_eq!(c.camera, framed);
+        // The scene is centred left of the panel: the framed box's centre is in the middle of
+        // the 980 pixels the panel leaves.
+        let centre = framing::framing_camera(&s, &scene_meshes(&s), 1.0, 0.0).target;
+        let at = c.camera.project(centre, size).expect("in view");
+        assert!(
+            (at.x - 490.0).abs() < 1.0 && (at.y - 400.0).abs() < 1.0,
+            "{at}"
+        );
+        c.frame(&s, size, 0.0);
+        assert_ne!(c.camera, framed);
     }
 }

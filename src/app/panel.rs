@@ -34,7 +34,7 @@ pub struct PanelState {
 }
 
 /// What the window must do after the panel ran.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Outcome {
     /// The scene (and its meshes) changed: rebuild the renderer and re-frame the camera.
     pub scene_changed: bool,
@@ -42,6 +42,8 @@ pub struct Outcome {
     pub command: Option<Command>,
     /// The "frame scene" button was pressed.
     pub frame: bool,
+    /// How much wider than the panel its contents are (points; 0 or less when they fit).
+    pub overflow: f32,
 }
 
 /// The built-in scene, then every `*.toml` in `dir` (sorted) but the file the built-in scene
@@ -78,7 +80,10 @@ pub fn show(
     controls: &mut ViewControls<'_>,
 ) -> Outcome {
     let mut out = Outcome::default();
-    egui::ScrollArea::both().show(ui, |ui| {
+    // Solid scroll bars take their own room: egui's default floating ones are drawn over the
+    // contents, a thin line through the text whenever the pointer is on the panel.
+    ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+    let scrolled = egui::ScrollArea::both().show(ui, |ui| {
         ui.heading("Weft");
         scene_section(ui, session, state, &mut out);
         ui.separator();
@@ -101,6 +106,7 @@ pub fn show(
             }
         }
     });
+    out.overflow = scrolled.content_size.x - scrolled.inner_rect.width();
     out
 }
 
@@ -356,6 +362,77 @@ fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::app::camera::ViewCamera;
+    use crate::app::window::panel_width;
+
+    /// Lays the panel out for `scene` in a window of `w`×`h` points, as the window does;
+    /// returns what the panel reported and the panel's rectangle.
+    fn lay_out(scene: &str, w: f32, h: f32) -> (Outcome, egui::Rect) {
+        let source = SceneSource::File(PathBuf::from(scene));
+        let sim =
+            weft_sim::Simulation::new(source.load(&[]).expect("the scene loads")).expect("solvers");
+        let mut session = Session::new(sim, source, 4);
+        let mut state = PanelState {
+            scenes: list_scenes(Path::new("assets/scenes")),
+            ..Default::default()
+        };
+        let mut options = weft_render::RenderOptions::default();
+        let mut camera = ViewCamera::new(weft_render::Camera::default(), &session.sim);
+        let mut labels = true;
+        let ctx = egui::Context::default();
+        let mut result = (Outcome::default(), egui::Rect::NOTHING);
+        // Twice: egui settles some sizes on its first pass.
+        for _ in 0..2 {
+            let input = egui::RawInput {
+                screen_rect: Some(egui::Rect::from_min_size(
+                    egui::Pos2::ZERO,
+                    egui::vec2(w, h),
+                )),
+                ..Default::default()
+            };
+            let output = ctx.run_ui(input, |ui| {
+                let mut controls = ViewControls {
+                    options: &mut options,
+                    camera: &mut camera,
+                    labels: &mut labels,
+                };
+                let r = egui::Panel::right("weft-panel")
+                    .exact_size(panel_width(w))
+                    .resizable(false)
+                    .show(ui, |ui| show(ui, &mut session, &mut state, &mut controls));
+                result = (r.inner, r.response.rect);
+            });
+            output.drop_without_applying_deltas();
+        }
+        result
+    }
+
+    /// At 1280×800 the panel's contents fit its width on every shipped scene (the character,
+    /// glTF and flag scenes once had their "spring k" column cut off), and the panel lies
+    /// inside its window.
+    #[test]
+    fn the_panel_fits_its_window_on_every_shipped_scene() {
+        for source in list_scenes(Path::new("assets/scenes")) {
+            let SceneSource::File(path) = source else {
+                continue;
+            };
+            let scene = path.to_string_lossy();
+            let (out, rect) = lay_out(&scene, 1280.0, 800.0);
+            assert!(
+                out.overflow <= 0.0,
+                "{scene}: {} points too wide",
+                out.overflow
+            );
+            assert!(
+                rect.min.x >= 0.0 && rect.max.x <= 1280.0,
+                "{scene}: {rect:?}"
+            );
+            assert!(rect.width() <= 300.5, "{scene}: {rect:?}");
+        }
+        // A narrow window keeps most of its width for the 3-D view.
+        let (_, rect) = lay_out("assets/scenes/character.toml", 400.0, 600.0);
+        assert!(rect.width() <= 240.5 && rect.max.x <= 400.0, "{rect:?}");
+    }
 
     #[test]
     fn the_shipped_scenes_list_the_hanging_cloth_once() {

@@ -151,7 +151,13 @@ impl App {
         let (format, size) = (surface.format(), surface.size());
         let (renderer, _) = view::renderer_for(&gpu.device, format, &self.session.sim);
         if self.config.camera.is_none() {
-            self.cam.frame(&self.session.sim, size);
+            let scale = window.scale_factor() as f32;
+            let covered = if self.show_panel {
+                panel_width(size.x as f32 / scale) * scale
+            } else {
+                0.0
+            };
+            self.cam.frame(&self.session.sim, size, covered);
         }
         let egui_state = egui_winit::State::new(
             self.egui.clone(),
@@ -188,6 +194,19 @@ impl App {
             })
     }
 
+    /// Pixels at the window's right that the side panel covers (0 when it is hidden).
+    fn covered(&self) -> f32 {
+        let scale = self
+            .gfx
+            .as_ref()
+            .map_or(1.0, |g| g.window.scale_factor() as f32);
+        if self.show_panel {
+            panel_width(self.size().x as f32 / scale) * scale
+        } else {
+            0.0
+        }
+    }
+
     fn ray(&self, cursor: Vec2) -> Ray {
         let r = self.cam.camera.ray(cursor, self.size());
         Ray {
@@ -207,7 +226,10 @@ impl App {
             Action::ToggleParticles => self.options.particles = !self.options.particles,
             Action::ToggleHelp => self.show_help = !self.show_help,
             Action::TogglePanel => self.show_panel = !self.show_panel,
-            Action::FrameScene => self.cam.frame(&self.session.sim, self.size()),
+            Action::FrameScene => {
+                let (size, covered) = (self.size(), self.covered());
+                self.cam.frame(&self.session.sim, size, covered);
+            }
             Action::ToggleFollow => self.cam.follow = !self.cam.follow && self.cam.can_follow(),
             Action::ToggleLabels => self.labels = !self.labels,
             Action::Quit => event_loop.exit(),
@@ -217,7 +239,8 @@ impl App {
     fn rebuild_scene(&mut self) {
         let size = self.size();
         self.cam = ViewCamera::new(self.cam.camera, &self.session.sim);
-        self.cam.frame(&self.session.sim, size);
+        let covered = self.covered();
+        self.cam.frame(&self.session.sim, size, covered);
         self.labels = self.session.sim.scene.cloths.len() > 1;
         if let Some(g) = self.gfx.as_mut() {
             let (renderer, _) =
@@ -361,8 +384,8 @@ impl App {
         if outcome.scene_changed {
             self.rebuild_scene();
         } else if outcome.frame {
-            let size = self.size();
-            self.cam.frame(&self.session.sim, size);
+            let (size, covered) = (self.size(), self.covered());
+            self.cam.frame(&self.session.sim, size, covered);
         }
         let Some(g) = self.gfx.as_mut() else {
             return Ok(());

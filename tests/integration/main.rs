@@ -8,6 +8,7 @@ mod bad_input;
 mod collider_state;
 mod e2e_drag;
 mod e2e_keys;
+mod e2e_view;
 mod experiments;
 mod export;
 mod export_body;

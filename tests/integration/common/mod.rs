@@ -9,6 +9,7 @@ use std::time::Duration;
 use foxglove::Decode;
 use foxglove::messages::PointCloud;
 
+pub mod screen;
 pub mod x11;
 
 /// The binary under test.

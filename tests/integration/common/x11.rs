@@ -62,12 +62,17 @@ pub fn start_xvfb(offset: u32) -> (String, Guard) {
         {
             continue;
         }
+        // The screen is kept in a file there (XWD), for screenshots (`screen.rs`).
+        let fbdir = super::screen::fb_dir(&format!(":{n}"));
+        let _ = std::fs::create_dir_all(&fbdir);
         let child = Command::new("Xvfb")
             .args([
                 format!(":{n}"),
                 "-screen".into(),
                 "0".into(),
                 "1280x1024x24".into(),
+                "-fbdir".into(),
+                fbdir.to_string_lossy().into_owned(),
                 "-nolisten".into(),
                 "tcp".into(),
                 // No server reset when the last client leaves (the readiness check below is
