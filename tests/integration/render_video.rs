@@ -334,3 +334,38 @@ fn render_off_a_terminal_prints_progress_lines() {
     assert!(out.status.success(), "{o}{e}");
     assert!(!e.contains("(100 %)"), "-q: no progress: {e}");
 }
+
+/// The centre pixel of `weft render SMALL` with `camera` (extra arguments), 1 frame.
+fn centre_pixel(dir: &Path, name: &str, camera: &[&str]) -> image::Rgba<u8> {
+    let scene = write(dir, "small.toml", SMALL);
+    let out_dir = dir.join(name);
+    let mut args = vec![
+        "render", &scene, "--frames", "1", "--size", "80x60", "-q", "--out",
+    ];
+    let out_str = out_dir.to_string_lossy().into_owned();
+    args.push(&out_str);
+    args.extend_from_slice(camera);
+    let out = run(&args);
+    assert!(out.status.success(), "{:?}", texts(&out));
+    let img = image::open(out_dir.join("frame_00000.png")).expect("a frame");
+    img.to_rgba8().get_pixel(40, 30).to_owned()
+}
+
+#[test]
+fn render_looks_from_eye_at_target() {
+    let dir = temp_dir("render-eye");
+    // The cloth hangs at y = 1 around x = z = 0: looking at it, the centre is cloth-coloured
+    // (red front or blue back); looking away, it is the grey sky.
+    let coloured = |p: image::Rgba<u8>| {
+        let (hi, lo) = (p[0].max(p[1]).max(p[2]), p[0].min(p[1]).min(p[2]));
+        hi - lo > 40
+    };
+    let at = centre_pixel(&dir, "at", &["--eye", "0,1,2", "--target", "0,1,0"]);
+    assert!(coloured(at), "looking at the cloth: {at:?}");
+    let away = centre_pixel(&dir, "away", &["--eye", "0,1,2", "--target", "0,1.3,4"]);
+    assert!(!coloured(away), "looking away: {away:?}");
+    let out = run(&["render", "--out", &dir.to_string_lossy(), "--eye", "0,1,2"]);
+    let (_, err) = texts(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--target"), "{err}");
+}
