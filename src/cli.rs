@@ -324,6 +324,10 @@ pub struct CheckArgs {
     /// Shorthand for `--set sim.method=…` (xpbd, pbd, mass-spring or implicit-mass-spring).
     #[arg(long)]
     pub method: Option<Method>,
+    /// Print the scene as it will run, as TOML with every default filled in (each cloth's
+    /// method, grid, mass, thickness and 36 constraint-family keys), instead of the summary.
+    #[arg(long)]
+    pub explain: bool,
     /// Memory and file-size limits.
     #[command(flatten)]
     pub limits: LimitArgs,

@@ -8,6 +8,7 @@ mod app;
 mod cli;
 mod default_scene;
 mod experiments;
+mod explain;
 mod export;
 mod framing;
 mod limits;
@@ -164,6 +165,10 @@ fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
                 Ok(g) => g,
                 Err(e) => return Ok(report(&e.into())),
             };
+            if args.explain {
+                say!("{}", explain::resolved(&scene))?;
+                return Ok(ExitCode::SUCCESS);
+            }
             let methods: Vec<&str> = scene.methods().iter().map(|m| m.name()).collect();
             say!(
                 "{}: ok ({} cloth(s), {} collider(s), methods: {})",

@@ -260,3 +260,23 @@ fn unwritable_output_fails_before_the_run() {
     assert!(err.contains("cannot write /no/such/dir/run.mcap"), "{err}");
     assert!(!o.contains("frames,"), "simulated anyway: {o}");
 }
+
+#[test]
+fn check_explain_prints_the_scene_with_every_default() {
+    let out = run(&["check", "--explain", "assets/scenes/minimal.toml"]);
+    let (o, e) = texts(&out);
+    assert!(out.status.success(), "{o}{e}");
+    for key in [
+        "[cloth.flag]",
+        "iterations = 1",
+        "thickness = 0.005",
+        "bend_isometric_compliance = ",
+        "rotation_deg = [0.0, 0.0, 0.0]",
+    ] {
+        assert!(o.contains(key), "{key} missing from:\n{o}");
+    }
+    assert!(
+        !o.contains("memory:"),
+        "the summary instead of the scene:\n{o}"
+    );
+}
