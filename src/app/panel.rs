@@ -223,18 +223,46 @@ fn stats_section(ui: &mut Ui, session: &Session) {
         .sum();
     let time: f64 = session.sim.groups.first().map_or(0.0, |g| g.solver.time());
     egui::Grid::new("stats").num_columns(2).show(ui, |ui| {
-        let mut row = |k: &str, v: String| {
-            ui.label(k);
-            ui.label(v);
+        let mut row = |k: &str, v: String, tip: &str| {
+            ui.label(k).on_hover_text(tip);
+            ui.label(v).on_hover_text(tip);
             ui.end_row();
         };
-        row("step", format!("{:.2} ms", s.step_ms));
-        row("frame", format!("{:.1} ms", s.frame_ms));
-        row("particles", particles.to_string());
-        row("constraints", constraints.to_string());
-        row("contacts", s.contacts.to_string());
-        row("sim time", format!("{time:.3} s"));
-        row("frames", session.sim.frame().to_string());
+        row(
+            "step",
+            format!("{:.2} ms", s.step_ms),
+            "wall-clock time of the last simulation frame",
+        );
+        row(
+            "frame",
+            format!("{:.1} ms", s.frame_ms),
+            "wall-clock time between drawn frames",
+        );
+        row(
+            "particles",
+            particles.to_string(),
+            "particles of every cloth",
+        );
+        row(
+            "constraints",
+            constraints.to_string(),
+            "constraints of every family and cloth",
+        );
+        row(
+            "contacts",
+            s.contacts.to_string(),
+            "cloth–collider contacts in the last frame",
+        );
+        row(
+            "sim time",
+            format!("{time:.3} s"),
+            "simulated time since the start or the last reset",
+        );
+        row(
+            "frames",
+            session.sim.frame().to_string(),
+            "simulated frames since the start or the last reset",
+        );
         let grabbed = session.grab.map_or_else(
             || "nothing (left-drag the cloth)".to_owned(),
             |g| {
@@ -247,7 +275,7 @@ fn stats_section(ui: &mut Ui, session: &Session) {
                 format!("{name} particle {}", g.particle)
             },
         );
-        row("grabbed", grabbed);
+        row("grabbed", grabbed, "the particle the mouse holds");
         let dropped = session.clock.dropped_total();
         row(
             "dropped",
@@ -256,25 +284,30 @@ fn stats_section(ui: &mut Ui, session: &Session) {
             } else {
                 "0".into()
             },
+            "frames of real time the simulation skipped to keep up (--max-steps-per-frame)",
         );
     });
 }
 
-fn drag_f64(ui: &mut Ui, label: &str, v: &mut f64, speed: f64) -> bool {
+fn drag_f64(ui: &mut Ui, label: &str, v: &mut f64, speed: f64, tip: &str) -> bool {
     ui.horizontal(|ui| {
-        ui.label(label);
+        ui.label(label).on_hover_text(tip);
         ui.add(DragValue::new(v).speed(speed).max_decimals(9))
+            .on_hover_text(tip)
             .changed()
     })
     .inner
 }
 
-fn drag_vec(ui: &mut Ui, label: &str, v: &mut DVec3, speed: f64) -> bool {
+fn drag_vec(ui: &mut Ui, label: &str, v: &mut DVec3, speed: f64, tip: &str) -> bool {
     ui.horizontal(|ui| {
-        ui.label(label);
+        ui.label(label).on_hover_text(tip);
         let mut changed = false;
-        for c in [&mut v.x, &mut v.y, &mut v.z] {
-            changed |= ui.add(DragValue::new(c).speed(speed)).changed();
+        for (c, axis) in [(&mut v.x, "x"), (&mut v.y, "y"), (&mut v.z, "z")] {
+            changed |= ui
+                .add(DragValue::new(c).speed(speed))
+                .on_hover_text(format!("{tip}: its {axis} component"))
+                .changed();
         }
         changed
     })
@@ -290,7 +323,13 @@ fn solver_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
     let mut forces = *first.solver.forces();
     let mut changed = false;
     let mut dt_ms = settings.dt * 1e3;
-    if drag_f64(ui, "time step (ms)", &mut dt_ms, 0.1) {
+    if drag_f64(
+        ui,
+        "time step (ms)",
+        &mut dt_ms,
+        0.1,
+        "the simulated time of one frame, ms (sim.dt)",
+    ) {
         settings.dt = dt_ms * 1e-3;
         changed = true;
     }
@@ -298,20 +337,46 @@ fn solver_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
         ui.label("substeps");
         changed |= ui
             .add(DragValue::new(&mut settings.substeps).speed(0.2))
+            .on_hover_text("solver substeps per frame (sim.substeps)")
             .changed();
         ui.label("iterations");
         changed |= ui
             .add(DragValue::new(&mut settings.iterations).speed(0.2))
+            .on_hover_text("constraint sweeps per substep (sim.iterations)")
             .changed();
     });
     if changed {
         let r = session.sim.set_settings(settings);
         note(state, r);
     }
-    let mut fchanged = drag_vec(ui, "gravity", &mut forces.gravity, 0.05);
-    fchanged |= drag_vec(ui, "wind", &mut forces.wind.velocity, 0.05);
-    fchanged |= drag_f64(ui, "wind drag (1/s)", &mut forces.wind.drag, 0.01);
-    fchanged |= drag_f64(ui, "damping (1/s)", &mut forces.damping, 0.01);
+    let mut fchanged = drag_vec(
+        ui,
+        "gravity",
+        &mut forces.gravity,
+        0.05,
+        "gravity, m/s² (sim.gravity)",
+    );
+    fchanged |= drag_vec(
+        ui,
+        "wind",
+        &mut forces.wind.velocity,
+        0.05,
+        "wind velocity, m/s (wind.velocity)",
+    );
+    fchanged |= drag_f64(
+        ui,
+        "wind drag (1/s)",
+        &mut forces.wind.drag,
+        0.01,
+        "how fast each particle is pulled towards the wind's velocity, 1/s (wind.drag)",
+    );
+    fchanged |= drag_f64(
+        ui,
+        "damping (1/s)",
+        &mut forces.damping,
+        0.01,
+        "global velocity damping, 1/s (sim.damping)",
+    );
     if fchanged {
         let r = session.sim.set_forces(forces);
         note(state, r);
@@ -339,7 +404,13 @@ fn cloth_section(ui: &mut Ui, session: &mut Session, state: &mut PanelState) {
     ) else {
         return;
     };
-    if drag_f64(ui, "thickness (m)", &mut thickness, 0.0005) {
+    if drag_f64(
+        ui,
+        "thickness (m)",
+        &mut thickness,
+        0.0005,
+        "collision thickness: how far the cloth keeps from colliders and itself, m",
+    ) {
         let r = session.sim.set_thickness(cloth, thickness);
         note(state, r);
     }
