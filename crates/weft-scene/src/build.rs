@@ -85,7 +85,13 @@ impl Scene {
                 }
                 let key = format!("cloth.{}", c.name);
                 let idx = b
-                    .add_cloth(c.name.clone(), &c.mesh, c.params, c.thickness)
+                    .add_cloth_with_topology(
+                        c.name.clone(),
+                        &c.mesh,
+                        &c.topology,
+                        c.params,
+                        c.thickness,
+                    )
                     .map_err(|e| err(key.clone(), &e))?;
                 if !c.seams.is_empty() {
                     let stretch = c.params.get(Family::Stretch);

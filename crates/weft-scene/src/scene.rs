@@ -2,10 +2,11 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use weft_collide::ShapeDesc;
 use weft_solver::glam::{DQuat, DVec3};
-use weft_solver::{ClothMesh, ClothParams, Forces, Method, Motion, Settings};
+use weft_solver::{ClothMesh, ClothParams, Forces, Method, Motion, Settings, Topology};
 
 use crate::overrides::Override;
 use crate::schema::SceneFile;
@@ -96,6 +97,9 @@ pub struct ClothSpec {
     pub method: Method,
     /// Geometry, masses and pins.
     pub mesh: ClothMesh,
+    /// The mesh's edges and wings, built once at load for the spring defaults and the build
+    /// (`Topology::new(&mesh.triangles)`: replace both together).
+    pub topology: Arc<Topology>,
     /// Per-family parameters.
     pub params: ClothParams,
     /// Collision thickness (m).

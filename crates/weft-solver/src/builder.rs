@@ -75,6 +75,21 @@ impl SolverBuilder {
         params: ClothParams,
         thickness: f64,
     ) -> Result<usize, BuildError> {
+        let topology = Topology::new(&mesh.triangles);
+        self.add_cloth_with_topology(name, mesh, &topology, params, thickness)
+    }
+
+    /// [`add_cloth`](Self::add_cloth) with the mesh's topology already built
+    /// (`Topology::new(&mesh.triangles)`): a loader that also worked out the spring defaults
+    /// builds it once for both (a second of a million-particle cloth's load).
+    pub fn add_cloth_with_topology(
+        &mut self,
+        name: impl Into<String>,
+        mesh: &ClothMesh,
+        topo: &Topology,
+        params: ClothParams,
+        thickness: f64,
+    ) -> Result<usize, BuildError> {
         let name = name.into();
         params.validate()?;
         check_thickness(thickness)?;
@@ -112,7 +127,6 @@ impl SolverBuilder {
                 }
             }
         }
-        let topo = Topology::new(&mesh.triangles);
         if params.get(Family::BendDistance).enabled {
             // Two edges can share a wing pair (on a grid with alternating diagonals, the pair
             // two apart across a vertex); each pair gets one constraint, not one per edge.

@@ -13,6 +13,7 @@ use crate::error::BuildError;
 use crate::forces::Forces;
 use crate::params::{ClothParams, Family};
 use crate::settings::Settings;
+use crate::topology::Topology;
 
 /// The substep the default spring constants are chosen for (s): dt = 1/60 s in 10 substeps.
 pub const DEFAULT_SPRING_SUBSTEP: f64 = 1.0 / 600.0;
@@ -32,9 +33,12 @@ fn weight(family: Family, mean_edge: f64) -> f64 {
 }
 
 /// `params` with the spring stiffness of each of `families` replaced by the stable default for
-/// `mesh` (see the module documentation); the other families are left as they are.
+/// `mesh` (see the module documentation); the other families are left as they are. `topology`
+/// is the mesh's (`Topology::new(&mesh.triangles)`), built once by a loader for this and the
+/// solver's build.
 pub fn stable_spring_defaults(
     mesh: &ClothMesh,
+    topology: &Topology,
     params: &ClothParams,
     families: &[Family],
 ) -> Result<ClothParams, BuildError> {
@@ -57,7 +61,7 @@ pub fn stable_spring_defaults(
             0.0
         };
     }
-    let omega = probe_omega(mesh, probe)?;
+    let omega = probe_omega(mesh, topology, probe)?;
     let mut out = *params;
     if omega > 0.0 {
         let scale = (DEFAULT_SPRING_HW / (DEFAULT_SPRING_SUBSTEP * omega)).powi(2);
@@ -69,9 +73,13 @@ pub fn stable_spring_defaults(
 }
 
 /// The Gershgorin bound on ω of `mesh` with `params` alone in a solver.
-fn probe_omega(mesh: &ClothMesh, params: ClothParams) -> Result<f64, BuildError> {
+fn probe_omega(
+    mesh: &ClothMesh,
+    topology: &Topology,
+    params: ClothParams,
+) -> Result<f64, BuildError> {
     let mut b = SolverBuilder::new(Settings::default(), Forces::default())?;
-    let cloth = b.add_cloth("probe", mesh, params, 0.0)?;
+    let cloth = b.add_cloth_with_topology("probe", mesh, topology, params, 0.0)?;
     Ok(b.spring_omega(cloth))
 }
 
@@ -92,22 +100,27 @@ mod tests {
 
     const FAMILIES: [Family; 3] = [Family::Stretch, Family::Shear, Family::BendDistance];
 
+    fn defaults(mesh: &ClothMesh) -> ClothParams {
+        let topo = Topology::new(&mesh.triangles);
+        stable_spring_defaults(mesh, &topo, &ClothParams::default(), &FAMILIES).expect("ok")
+    }
+
     #[test]
     fn defaults_put_the_bound_at_the_chosen_substep_and_grow_with_mass() {
         let mesh = grid(24, 0.5);
-        let p = stable_spring_defaults(&mesh, &ClothParams::default(), &FAMILIES).expect("ok");
-        let omega = probe_omega(&mesh, p).expect("ok");
+        let topo = Topology::new(&mesh.triangles);
+        let p =
+            stable_spring_defaults(&mesh, &topo, &ClothParams::default(), &FAMILIES).expect("ok");
+        let omega = probe_omega(&mesh, &topo, p).expect("ok");
         assert!((DEFAULT_SPRING_SUBSTEP * omega - DEFAULT_SPRING_HW).abs() < 1e-9);
-        let heavy =
-            stable_spring_defaults(&grid(24, 2.0), &ClothParams::default(), &FAMILIES).expect("ok");
+        let heavy = defaults(&grid(24, 2.0));
         let (k, k4) = (
             p.get(Family::Stretch).spring_stiffness,
             heavy.get(Family::Stretch).spring_stiffness,
         );
         assert!((k4 / k - 4.0).abs() < 1e-9, "k ∝ m: {k} vs {k4}");
         // Same mass, 4× the particles: each is 4× lighter, so is each spring.
-        let fine =
-            stable_spring_defaults(&grid(47, 0.5), &ClothParams::default(), &FAMILIES).expect("ok");
+        let fine = defaults(&grid(47, 0.5));
         let ratio = k / fine.get(Family::Stretch).spring_stiffness;
         assert!((3.5..4.5).contains(&ratio), "{ratio}");
     }

@@ -8,7 +8,7 @@ use common::tube_garment;
 use weft_character::garment::{Garment, GarmentSpec, build_garment};
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    ClothParams, Family, FamilyParams, Forces, Method, Settings, Solver, SolverBuilder,
+    ClothParams, Family, FamilyParams, Forces, Method, Settings, Solver, SolverBuilder, Topology,
     stable_spring_defaults,
 };
 
@@ -36,6 +36,7 @@ fn solver(method: Method, g: &Garment) -> Solver {
     };
     let mut params = stable_spring_defaults(
         &g.mesh,
+        &Topology::new(&g.mesh.triangles),
         &ClothParams::default(),
         &[Family::Stretch, Family::Shear, Family::BendDistance],
     )

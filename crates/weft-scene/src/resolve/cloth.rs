@@ -228,8 +228,9 @@ pub(super) fn cloth(
                 .any(|&(g, setting)| g == f && matches!(setting, Setting::SpringStiffness(_)))
         })
         .collect();
+    let topology = std::sync::Arc::new(weft_solver::Topology::new(&mesh.triangles));
     if c.errors.len() == before && material.is_none() {
-        match weft_solver::stable_spring_defaults(&mesh, &params, &unset) {
+        match weft_solver::stable_spring_defaults(&mesh, &topology, &params, &unset) {
             Ok(p) => params = p,
             Err(e) => c.bad(&format!("cloth.{name}"), e.to_string()),
         }
@@ -238,6 +239,7 @@ pub(super) fn cloth(
         name: name.to_owned(),
         method,
         mesh,
+        topology,
         params,
         thickness,
         motion,
