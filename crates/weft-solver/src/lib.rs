@@ -15,6 +15,8 @@
 //! - `params`: constraint families and their per-method parameters, with their range checks.
 //! - `material`: fabrics in physical units, and the parameters every method derives from them.
 //! - `presets`: fabric presets from published Kawabata (KES-F) measurements.
+//! - `cantilever`: the cantilever bending test's strip, clamp and chord angle.
+//! - `elastica`: the heavy elastica, the exact shape of the cantilever bending test.
 //! - `spring_defaults`: spring constants scaled to the cloth, stable for the explicit springs.
 //! - `stability`: the explicit springs' highest mode and the largest stable substep.
 //! - `coloring`: greedy graph colouring of the constraints.
@@ -35,12 +37,14 @@
 #![warn(missing_docs)]
 
 mod builder;
+mod cantilever;
 mod chunk;
 mod cloth;
 mod coloring;
 pub mod constraints;
 mod domains;
 pub mod driver;
+mod elastica;
 mod error;
 mod forces;
 mod grid;
@@ -61,10 +65,12 @@ mod test_rand;
 mod topology;
 
 pub use builder::SolverBuilder;
+pub use cantilever::{Cantilever, STRIP_WIDTH};
 pub use cloth::{ClothMesh, Mass};
 pub use constraints::Residual;
 pub use domains::DomainStats;
 pub use driver::PinDriver;
+pub use elastica::{Elastica, MAX_LOAD as ELASTICA_MAX_LOAD, bending_length};
 pub use error::{BuildError, MeshError, ParamError, SolverError};
 pub use forces::{Aero, Forces, Wind};
 pub use grid::{Corner, Edge, GridDesc, Orientation, Pin};
