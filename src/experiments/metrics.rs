@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::experiments::cantilever::Strip;
 use weft_sim::{FrameStats, Simulation};
 
 /// A quantity reported per run.
@@ -24,6 +25,12 @@ pub enum Metric {
     Cost,
     /// Frames simulated.
     Frames,
+    /// Cantilever: the chord from clamp to tip, degrees below the horizontal.
+    ChordAngle,
+    /// Cantilever: the heavy elastica's chord angle for the strip (degrees).
+    ElasticaAngle,
+    /// Cantilever: chord angle minus the elastica's (degrees).
+    AngleError,
 }
 
 impl Metric {
@@ -38,6 +45,9 @@ impl Metric {
             Metric::MsPerFrame => "ms_per_frame",
             Metric::Cost => "cost",
             Metric::Frames => "frames",
+            Metric::ChordAngle => "chord_angle",
+            Metric::ElasticaAngle => "elastica_angle",
+            Metric::AngleError => "angle_error",
         }
     }
 
@@ -50,11 +60,12 @@ impl Metric {
             Metric::MsPerFrame => "ms",
             Metric::Cost => "sweeps/frame",
             Metric::Frames => "frames",
+            Metric::ChordAngle | Metric::ElasticaAngle | Metric::AngleError => "°",
         }
     }
 
     /// Every metric.
-    pub const ALL: [Metric; 8] = [
+    pub const ALL: [Metric; 11] = [
         Metric::Sag,
         Metric::StretchErrorMax,
         Metric::StretchErrorRms,
@@ -63,6 +74,9 @@ impl Metric {
         Metric::MsPerFrame,
         Metric::Cost,
         Metric::Frames,
+        Metric::ChordAngle,
+        Metric::ElasticaAngle,
+        Metric::AngleError,
     ];
 
     /// The metric called `name`.
@@ -79,6 +93,7 @@ pub struct Meter {
     worst_rms: f64,
     last: FrameStats,
     wall_ms: f64,
+    strip: Option<Strip>,
 }
 
 fn lowest(sim: &Simulation) -> f64 {
@@ -88,10 +103,11 @@ fn lowest(sim: &Simulation) -> f64 {
 }
 
 impl Meter {
-    /// Starts at the initial state.
-    pub fn new(sim: &Simulation) -> Self {
+    /// Starts at the initial state; `strip` is the run's cantilever, if it has one.
+    pub fn new(sim: &Simulation, strip: Option<Strip>) -> Self {
         Self {
             rest_lowest: lowest(sim),
+            strip,
             ..Self::default()
         }
     }
@@ -108,6 +124,10 @@ impl Meter {
     pub fn values(&self, sim: &Simulation) -> Vec<(Metric, f64)> {
         let s = sim.scene.settings;
         let frames = self.last.frame;
+        let chord = self
+            .strip
+            .map_or(f64::NAN, |t| t.chord_angle(sim.cloth_positions(t.cloth)));
+        let elastica = self.strip.map_or(f64::NAN, |t| t.elastica_angle());
         Metric::ALL
             .into_iter()
             .map(|m| {
@@ -120,6 +140,9 @@ impl Meter {
                     Metric::MsPerFrame => self.wall_ms / frames.max(1) as f64,
                     Metric::Cost => f64::from(s.substeps * s.iterations),
                     Metric::Frames => frames as f64,
+                    Metric::ChordAngle => chord,
+                    Metric::ElasticaAngle => elastica,
+                    Metric::AngleError => chord - elastica,
                 };
                 (m, v)
             })

@@ -1,6 +1,7 @@
 //! `weft experiments`: the recorder. Runs a queue of scene variants in parallel (optionally one
 //! shard of it), logs each run to MCAP, and writes a summary table and plots.
 
+mod cantilever;
 mod metrics;
 mod montage;
 mod plot;
@@ -219,10 +220,20 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         // `jobs` at a time, as the runs will go (a scene loaded is less than its run needs).
         let limits = args.limits.limits();
         let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
-        let loaded: Vec<_> = pool.install(|| {
+        let prepared: Vec<_> = pool.install(|| {
             mine.par_iter()
-                .map(|r| {
-                    weft_scene::load_with(&scene_path, &r.overrides, &limits)
+                .map(|r| cantilever::prepare(spec.cantilever.as_ref(), &scene_path, r, &limits))
+                .collect()
+        });
+        let mut strips = Vec::with_capacity(mine.len());
+        for (r, p) in mine.iter().zip(prepared) {
+            strips.push(p.with_context(|| format!("run {} ({} {})", r.index, r.series, r.label))?);
+        }
+        let loaded: Vec<_> = pool.install(|| {
+            strips
+                .par_iter()
+                .map(|(overrides, _)| {
+                    weft_scene::load_with(&scene_path, overrides, &limits)
                         .map(|s| s.estimated_bytes())
                 })
                 .collect()
@@ -257,7 +268,8 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         let bar = progress::QueueProgress::new(mine.len());
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
-                .map(|r| {
+                .zip(&strips)
+                .map(|(r, (overrides, strip))| {
                     if stop.load(Ordering::SeqCst) {
                         bar.done(&format!(
                             "  run {:>3} {} {}: {NOT_RUN}",
@@ -265,7 +277,7 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                         ));
                         return Ok(RunResult::not_run(r));
                     }
-                    let res = weft_scene::load_with(&scene_path, &r.overrides, &limits)
+                    let res = weft_scene::load_with(&scene_path, overrides, &limits)
                         .map_err(|e| anyhow::anyhow!("{e}"))
                         .and_then(|scene| {
                             let sim = Simulation::new(scene)?;
@@ -275,7 +287,12 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                                     r.index, r.series, r.label
                                 ));
                             }
-                            execute(&spec, r, sim, &out, !args.no_mcap, gpu.as_ref(), stop)
+                            let run = Execute {
+                                spec: &spec,
+                                run: r,
+                                strip: *strip,
+                            };
+                            run.execute(sim, &out, !args.no_mcap, gpu.as_ref(), stop)
                         })
                         .and_then(|result| {
                             // Written as soon as the run ends, so a killed queue keeps what it did.
@@ -373,116 +390,125 @@ fn write_montages(
     Ok(())
 }
 
-fn execute(
-    spec: &Spec,
-    r: &PlannedRun,
-    mut sim: Simulation,
-    out: &Path,
-    mcap: bool,
-    gpu: Option<&weft_render::Gpu>,
-    stop: &Arc<AtomicBool>,
-) -> anyhow::Result<RunResult> {
-    let dt = sim.scene.settings.dt;
-    let frames = match (spec.frames, spec.duration) {
-        (Some(f), _) => f,
-        (None, Some(d)) => (d / dt).round().max(1.0) as u64,
-        (None, None) => 1,
-    };
-    sim.set_stop(Arc::clone(stop));
-    let rel = format!("{}.mcap", run_dir(r));
-    let log = mcap.then(|| Output::create(&out.join(&rel))).transpose()?;
-    let mut rec = match &log {
-        Some(o) => {
-            let options = RecordOptions {
-                mesh_every: 0,
-                ..RecordOptions::default()
-            };
-            let rec = Recorder::new(o.handle()?, &sim, frames, options)
-                .with_context(|| format!("writing {}", o.target().display()))?;
-            Some(rec)
-        }
-        None => None,
-    };
-    // With --render: about 30 images per simulated second, into the run's own directory.
-    let mut video = gpu
-        .map(|gpu| {
-            let dir = out.join(rel.trim_end_matches(".mcap"));
-            let every = (1.0 / (30.0 * dt)).round().max(1.0) as u64;
-            let size = glam::UVec2::new(640, 480);
-            let options = weft_render::RenderOptions::default();
-            crate::video::VideoRecorder::new(gpu, &sim, &dir, size, every, options)
-        })
-        .transpose()?;
-    // The video starts with the initial state, so a run that diverges in its first frame still
-    // has a frame to hold and mark.
-    if let Some(v) = video.as_mut() {
-        v.frame_span(&sim, frames as f64 * dt);
-        v.frame(&sim)?;
-    }
-    let mut meter = Meter::new(&sim);
-    let mut status = Status::Complete;
-    let mut first = sim.stats(0.0, 0);
-    first.frame = 0;
-    let logged = (|| -> anyhow::Result<()> {
-        if let Some(rec) = rec.as_mut() {
-            rec.frame(&sim, &first)?;
-        }
-        for _ in 0..frames {
-            if stop.load(Ordering::SeqCst) {
-                status = Status::Interrupted;
-                break;
+/// One run to execute: its plan, and its cantilever strip if the file has one.
+struct Execute<'a> {
+    spec: &'a Spec,
+    run: &'a PlannedRun,
+    strip: Option<cantilever::Strip>,
+}
+
+impl Execute<'_> {
+    fn execute(
+        &self,
+        mut sim: Simulation,
+        out: &Path,
+        mcap: bool,
+        gpu: Option<&weft_render::Gpu>,
+        stop: &Arc<AtomicBool>,
+    ) -> anyhow::Result<RunResult> {
+        let (spec, r) = (self.spec, self.run);
+        let dt = sim.scene.settings.dt;
+        let frames = match (spec.frames, spec.duration) {
+            (Some(f), _) => f,
+            (None, Some(d)) => (d / dt).round().max(1.0) as u64,
+            (None, None) => 1,
+        };
+        sim.set_stop(Arc::clone(stop));
+        let rel = format!("{}.mcap", run_dir(r));
+        let log = mcap.then(|| Output::create(&out.join(&rel))).transpose()?;
+        let mut rec = match &log {
+            Some(o) => {
+                let options = RecordOptions {
+                    mesh_every: 0,
+                    ..RecordOptions::default()
+                };
+                let rec = Recorder::new(o.handle()?, &sim, frames, options)
+                    .with_context(|| format!("writing {}", o.target().display()))?;
+                Some(rec)
             }
-            match sim.step() {
-                Ok(stats) => {
-                    meter.frame(&stats);
-                    if let Some(rec) = rec.as_mut() {
-                        rec.frame(&sim, &stats)?;
-                    }
-                    if let Some(v) = video.as_mut() {
-                        v.frame(&sim)?;
-                    }
-                }
-                Err(e) if sim.interrupted(&e) => {
+            None => None,
+        };
+        // With --render: about 30 images per simulated second, into the run's own directory.
+        let mut video = gpu
+            .map(|gpu| {
+                let dir = out.join(rel.trim_end_matches(".mcap"));
+                let every = (1.0 / (30.0 * dt)).round().max(1.0) as u64;
+                let size = glam::UVec2::new(640, 480);
+                let options = weft_render::RenderOptions::default();
+                crate::video::VideoRecorder::new(gpu, &sim, &dir, size, every, options)
+            })
+            .transpose()?;
+        // The video starts with the initial state, so a run that diverges in its first frame still
+        // has a frame to hold and mark.
+        if let Some(v) = video.as_mut() {
+            v.frame_span(&sim, frames as f64 * dt);
+            v.frame(&sim)?;
+        }
+        let mut meter = Meter::new(&sim, self.strip);
+        let mut status = Status::Complete;
+        let mut first = sim.stats(0.0, 0);
+        first.frame = 0;
+        let logged = (|| -> anyhow::Result<()> {
+            if let Some(rec) = rec.as_mut() {
+                rec.frame(&sim, &first)?;
+            }
+            for _ in 0..frames {
+                if stop.load(Ordering::SeqCst) {
                     status = Status::Interrupted;
                     break;
                 }
-                Err(e) => {
-                    status = Status::Diverged(e.to_string());
-                    break;
+                match sim.step() {
+                    Ok(stats) => {
+                        meter.frame(&stats);
+                        if let Some(rec) = rec.as_mut() {
+                            rec.frame(&sim, &stats)?;
+                        }
+                        if let Some(v) = video.as_mut() {
+                            v.frame(&sim)?;
+                        }
+                    }
+                    Err(e) if sim.interrupted(&e) => {
+                        status = Status::Interrupted;
+                        break;
+                    }
+                    Err(e) => {
+                        status = Status::Diverged(e.to_string());
+                        break;
+                    }
                 }
             }
+            Ok(())
+        })();
+        if let (Some(rec), Some(log)) = (rec, log) {
+            rec.finish(&status, sim.frame())?;
+            logged?;
+            log.commit()?;
+        } else {
+            logged?;
         }
-        Ok(())
-    })();
-    if let (Some(rec), Some(log)) = (rec, log) {
-        rec.finish(&status, sim.frame())?;
-        logged?;
-        log.commit()?;
-    } else {
-        logged?;
+        // A run that diverged keeps its frames up to the divergence, marked.
+        if let Some(v) = video {
+            match &status {
+                Status::Diverged(m) => v.finish_diverged(m)?,
+                _ => v.finish()?,
+            };
+        }
+        let metrics = meter
+            .values(&sim)
+            .into_iter()
+            .map(|(m, v)| (m.name().to_owned(), v.is_finite().then_some(v)))
+            .collect();
+        Ok(RunResult {
+            index: r.index,
+            series: r.series.clone(),
+            label: r.label.clone(),
+            status: match status {
+                Status::Complete => "complete".into(),
+                Status::Interrupted => "interrupted".into(),
+                Status::Diverged(m) => format!("diverged: {m}"),
+            },
+            metrics,
+            mcap: mcap.then_some(rel),
+        })
     }
-    // A run that diverged keeps its frames up to the divergence, marked.
-    if let Some(v) = video {
-        match &status {
-            Status::Diverged(m) => v.finish_diverged(m)?,
-            _ => v.finish()?,
-        };
-    }
-    let metrics = meter
-        .values(&sim)
-        .into_iter()
-        .map(|(m, v)| (m.name().to_owned(), v.is_finite().then_some(v)))
-        .collect();
-    Ok(RunResult {
-        index: r.index,
-        series: r.series.clone(),
-        label: r.label.clone(),
-        status: match status {
-            Status::Complete => "complete".into(),
-            Status::Interrupted => "interrupted".into(),
-            Status::Diverged(m) => format!("diverged: {m}"),
-        },
-        metrics,
-        mcap: mcap.then_some(rel),
-    })
 }

@@ -36,6 +36,9 @@ pub struct Spec {
     /// Plots.
     #[serde(default)]
     pub plot: Vec<PlotSpec>,
+    /// The cantilever bending test: the strip cloth shaped from its material per run.
+    #[serde(default)]
+    pub cantilever: Option<crate::experiments::cantilever::CantileverSpec>,
 }
 
 /// A series: fixed overrides plus a sweep.

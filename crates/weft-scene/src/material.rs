@@ -63,7 +63,7 @@ impl<'de> Deserialize<'de> for MaterialSpec {
 }
 
 /// The material a spec names, or `(field, message)` for the first thing wrong with it.
-pub(crate) fn resolve(spec: &MaterialSpec) -> Result<Material, (String, String)> {
+pub fn resolve(spec: &MaterialSpec) -> Result<Material, (String, String)> {
     let unknown = |n: &str| {
         (
             "material".to_owned(),
