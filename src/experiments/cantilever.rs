@@ -11,8 +11,6 @@ use serde::Deserialize;
 use weft_scene::Override;
 use weft_solver::{Cantilever, Material};
 
-use crate::experiments::spec::{PlannedRun, numeric};
-
 /// The key that sets the segments along the overhang (swept, or in `set`).
 pub const SEGMENTS_KEY: &str = "cantilever.segments";
 
@@ -58,17 +56,17 @@ impl Strip {
     }
 }
 
-/// `run`'s overrides with the strip shaped from its material: `cantilever.segments` taken out,
-/// the strip's resolution, size, centre, orientation and clamp put in; and the strip. Without
-/// a `[cantilever]` table, the run's overrides as they are.
+/// A run's `overrides` with the strip shaped from its material: `cantilever.segments` taken
+/// out, the strip's resolution, size, centre, orientation and clamp put in; and the strip.
+/// Without a `[cantilever]` table, the overrides as they are.
 pub fn prepare(
     spec: Option<&CantileverSpec>,
     scene_path: &Path,
-    run: &PlannedRun,
+    run_overrides: &[Override],
     limits: &weft_scene::Limits,
 ) -> anyhow::Result<(Vec<Override>, Option<Strip>)> {
     let Some(spec) = spec else {
-        return Ok((run.overrides.clone(), None));
+        return Ok((run_overrides.to_vec(), None));
     };
     if !(spec.lengths.is_finite() && spec.lengths > 0.0) {
         bail!(
@@ -78,9 +76,13 @@ pub fn prepare(
     }
     let mut segments = None;
     let mut overrides = Vec::new();
-    for o in &run.overrides {
+    for o in run_overrides {
         if o.key == SEGMENTS_KEY {
-            let n = numeric(&serde_json::Value::String(o.value.clone()))
+            let n = o
+                .value
+                .trim()
+                .parse::<f64>()
+                .ok()
                 .filter(|n| n.fract() == 0.0 && (1.0..=4096.0).contains(n))
                 .with_context(|| {
                     format!(

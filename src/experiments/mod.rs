@@ -222,7 +222,14 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
         let prepared: Vec<_> = pool.install(|| {
             mine.par_iter()
-                .map(|r| cantilever::prepare(spec.cantilever.as_ref(), &scene_path, r, &limits))
+                .map(|r| {
+                    cantilever::prepare(
+                        spec.cantilever.as_ref(),
+                        &scene_path,
+                        &r.overrides,
+                        &limits,
+                    )
+                })
                 .collect()
         });
         let mut strips = Vec::with_capacity(mine.len());
