@@ -28,6 +28,10 @@ const DRESSED: &[&str] = &["cape.toml", "character.toml", "skirt.toml"];
 /// substep over 0.5 s, every method over a few frames): 300 frames of a 5,126-triangle
 /// deforming body under four methods would hold CI up for minutes.
 const SKINNED: &[&str] = &["glb_character.toml"];
+/// The cantilever test's strip, run by assets/experiments/cantilever.toml under the methods it
+/// is for: cotton on 2.3 mm cells needs 3,682 explicit mass-spring substeps (`weft check` says
+/// so), where every other method holds.
+const CANTILEVER: &[&str] = &["cantilever.toml"];
 
 #[test]
 fn every_shipped_scene_runs_300_frames_under_every_method() {
@@ -40,6 +44,7 @@ fn every_shipped_scene_runs_300_frames_under_every_method() {
             !BUILT_TO_EXPLODE.contains(&name)
                 && !DRESSED.contains(&name)
                 && !SKINNED.contains(&name)
+                && !CANTILEVER.contains(&name)
         })
         .collect();
     paths.sort();
