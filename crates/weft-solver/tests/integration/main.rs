@@ -4,7 +4,6 @@
 
 mod common;
 
-mod cantilever;
 mod determinism;
 mod dihedral_energy;
 mod driven_pins;
