@@ -174,6 +174,36 @@ fn overrides(method: Option<Method>, set: &[Override]) -> Vec<Override> {
     v
 }
 
+/// Where the camera stands and looks (`weft view`, `weft render`): both or neither.
+#[derive(Debug, Args)]
+pub struct CameraArgs {
+    /// Camera position `X,Y,Z` (m) instead of the automatic framing (with --target).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "target",
+        allow_hyphen_values = true
+    )]
+    pub eye: Option<Point>,
+    /// Point the camera looks at, `X,Y,Z` (m) (with --eye).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        requires = "eye",
+        allow_hyphen_values = true
+    )]
+    pub target: Option<Point>,
+}
+
+impl CameraArgs {
+    /// `(eye, target)` when both were given.
+    pub fn pair(&self) -> Option<(glam::Vec3, glam::Vec3)> {
+        self.eye
+            .zip(self.target)
+            .map(|(e, t)| (glam::Vec3::from(e.0), glam::Vec3::from(t.0)))
+    }
+}
+
 /// What a log carries (`weft run --out`, `weft view --record`).
 #[derive(Debug, Args)]
 pub struct LogArgs {
@@ -237,22 +267,9 @@ pub struct ViewArgs {
     /// Start paused (Space resumes).
     #[arg(long)]
     pub paused: bool,
-    /// Camera position `X,Y,Z` (m) instead of the automatic framing (with --target).
-    #[arg(
-        long,
-        value_name = "X,Y,Z",
-        requires = "target",
-        allow_hyphen_values = true
-    )]
-    pub eye: Option<Point>,
-    /// Point the camera looks at, `X,Y,Z` (m) (with --eye).
-    #[arg(
-        long,
-        value_name = "X,Y,Z",
-        requires = "eye",
-        allow_hyphen_values = true
-    )]
-    pub target: Option<Point>,
+    /// The camera, instead of the automatic framing.
+    #[command(flatten)]
+    pub camera: CameraArgs,
     /// At most this many simulation frames per displayed frame; real time beyond is dropped.
     #[arg(long, default_value_t = 4, value_name = "K")]
     pub max_steps_per_frame: u32,
@@ -422,22 +439,9 @@ pub struct RenderArgs {
     /// Draw the particles.
     #[arg(long)]
     pub particles: bool,
-    /// Camera position `X,Y,Z` (m) instead of the automatic framing (with --target).
-    #[arg(
-        long,
-        value_name = "X,Y,Z",
-        requires = "target",
-        allow_hyphen_values = true
-    )]
-    pub eye: Option<Point>,
-    /// Point the camera looks at, `X,Y,Z` (m) (with --eye).
-    #[arg(
-        long,
-        value_name = "X,Y,Z",
-        requires = "eye",
-        allow_hyphen_values = true
-    )]
-    pub target: Option<Point>,
+    /// The camera, instead of the automatic framing.
+    #[command(flatten)]
+    pub camera: CameraArgs,
     /// No shadows.
     #[arg(long)]
     pub no_shadows: bool,

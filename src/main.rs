@@ -134,10 +134,7 @@ fn render_command(args: &cli::RenderArgs, stop: &Arc<AtomicBool>) -> anyhow::Res
             shadows: !args.no_shadows,
         },
         progress: !args.quiet,
-        camera: args
-            .eye
-            .zip(args.target)
-            .map(|(e, t)| (glam::Vec3::from(e.0), glam::Vec3::from(t.0))),
+        camera: args.camera.pair(),
     };
     if let Some(scene_file) = &args.scene {
         // Neither --out itself nor any file the render writes into it may be an input.

@@ -118,10 +118,7 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
         size: (args.size.width, args.size.height),
         exit_after_frames: args.exit_after_frames,
         paused: args.paused,
-        camera: args
-            .eye
-            .zip(args.target)
-            .map(|(e, t)| (glam::Vec3::from(e.0), glam::Vec3::from(t.0))),
+        camera: args.camera.pair(),
     };
     let mut app = App::new(session, config, stop, panel);
     let ran = event_loop.run_app(&mut app);
