@@ -12,6 +12,7 @@
 //! - `mesh`: triangle meshes, and the checks that make them safe to collide with.
 //! - `surface`: the answer of a closest-point query.
 //! - `convert`: the one seam between weft's types and parry's.
+//! - `crossings`: an independent count of cloth crossings and the closest approach, to check contact.
 //! - `analytic`: spheres, half-spaces, cuboids and capsules in closed form in f64.
 //! - `closed_run`: a still half-space or ball against a run of particles, a block at a time.
 //! - `reach`: which particles a collider can touch in one projection.
@@ -38,6 +39,7 @@ mod chunk;
 mod closed_run;
 mod collider;
 mod convert;
+pub mod crossings;
 mod error;
 mod friction;
 mod grid;

@@ -1,0 +1,400 @@
+//! An independent measure of cloth interpenetration: how many mesh edges pass through a
+//! triangle they share no vertex with, and how close non-adjacent elements come.
+//!
+//! It measures contact and shares nothing with it: its own broad phase (triangles binned in a
+//! sorted list of grid cells) and exact-predicate style tests in f64 (signed volumes for the
+//! crossings, Ericson's closest points for the distances, "Real-Time Collision Detection"
+//! §5.1.5 and §5.1.9). A crossing is an edge whose two end points lie strictly on opposite
+//! sides of a triangle's plane and whose line passes strictly inside the triangle; touching
+//! and coplanar configurations are not crossings. Integer counts and a minimum: the answer does
+//! not depend on the thread count.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// What [`measure`] found.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Crossings {
+    /// Edge–triangle crossings between elements that share no vertex.
+    pub crossings: usize,
+    /// The closest approach between non-adjacent elements (vertex–triangle and edge–edge
+    /// pairs that share no vertex) when it is below the `reach` asked for (m).
+    pub closest: Option<f64>,
+}
+
+/// Counts the crossings of `triangles` (indices into `positions`) and the closest approach
+/// below `reach` between elements that share no vertex.
+pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Crossings {
+    let edges = unique_edges(triangles);
+    if edges.is_empty() {
+        return Crossings::default();
+    }
+    let longest = edges
+        .iter()
+        .map(|&[a, b]| positions[a as usize].distance(positions[b as usize]))
+        .fold(0.0_f64, f64::max);
+    let reach = if reach.is_finite() { reach.max(0.0) } else { 0.0 };
+    let bins = Bins::new(positions, triangles, longest.max(reach).max(1e-9));
+    let crossings = edges
+        .par_iter()
+        .map_init(Vec::new, |found, &e| bins.crossings_of(positions, triangles, e, found))
+        .sum();
+    let closest = if reach > 0.0 {
+        let vertex_face = (0..positions.len() as u32)
+            .into_par_iter()
+            .map_init(Vec::new, |found, v| {
+                bins.vertex_closest(positions, triangles, v, reach, found)
+            })
+            .min_by(f64::total_cmp)
+            .unwrap_or(f64::INFINITY);
+        let edge_edge = edges
+            .par_iter()
+            .map_init(Vec::new, |found, &e| {
+                bins.edge_closest(positions, triangles, e, reach, found)
+            })
+            .min_by(f64::total_cmp)
+            .unwrap_or(f64::INFINITY);
+        Some(vertex_face.min(edge_edge)).filter(|&d| d < reach)
+    } else {
+        None
+    };
+    Crossings { crossings, closest }
+}
+
+/// Every edge of the triangles once, as `[low, high]`, sorted.
+fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .filter(|[a, b]| a != b)
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// Triangles binned by the grid cells their boxes touch: `(cell key, triangle)` sorted.
+struct Bins {
+    cell: f64,
+    entries: Vec<(u64, u32)>,
+}
+
+impl Bins {
+    fn new(positions: &[DVec3], triangles: &[[u32; 3]], cell: f64) -> Self {
+        let mut entries = Vec::with_capacity(triangles.len() * 2);
+        for (t, tri) in triangles.iter().enumerate() {
+            let (lo, hi) = bounds(tri.iter().map(|&i| positions[i as usize]));
+            let b = Bins { cell, entries: Vec::new() };
+            b.for_cells(lo, hi, |key| entries.push((key, t as u32)));
+        }
+        entries.par_sort_unstable();
+        Bins { cell, entries }
+    }
+
+    /// Calls `f` with the key of every cell the box `lo..hi` touches.
+    fn for_cells(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(u64)) {
+        let (a, b) = ((lo / self.cell).floor(), (hi / self.cell).floor());
+        if !(a.is_finite() && b.is_finite()) {
+            return;
+        }
+        let (a, b) = (a.as_i64vec3(), b.as_i64vec3());
+        for x in a.x..=b.x {
+            for y in a.y..=b.y {
+                for z in a.z..=b.z {
+                    f(key(x, y, z));
+                }
+            }
+        }
+    }
+
+    /// The triangles binned in the cells the box touches, each once, into `found`.
+    fn near(&self, lo: DVec3, hi: DVec3, found: &mut Vec<u32>) {
+        found.clear();
+        self.for_cells(lo, hi, |k| {
+            let start = self.entries.partition_point(|&(c, _)| c < k);
+            found.extend(
+                self.entries[start..]
+                    .iter()
+                    .take_while(|&&(c, _)| c == k)
+                    .map(|&(_, t)| t),
+            );
+        });
+        found.sort_unstable();
+        found.dedup();
+    }
+
+    fn crossings_of(
+        &self,
+        x: &[DVec3],
+        triangles: &[[u32; 3]],
+        [a, b]: [u32; 2],
+        found: &mut Vec<u32>,
+    ) -> usize {
+        let (p, q) = (x[a as usize], x[b as usize]);
+        self.near(p.min(q), p.max(q), found);
+        found
+            .iter()
+            .map(|&t| triangles[t as usize])
+            .filter(|tri| !tri.contains(&a) && !tri.contains(&b))
+            .filter(|tri| segment_crosses(p, q, tri.map(|i| x[i as usize])))
+            .count()
+    }
+
+    fn vertex_closest(
+        &self,
+        x: &[DVec3],
+        triangles: &[[u32; 3]],
+        v: u32,
+        reach: f64,
+        found: &mut Vec<u32>,
+    ) -> f64 {
+        let p = x[v as usize];
+        self.near(p - reach, p + reach, found);
+        found
+            .iter()
+            .map(|&t| triangles[t as usize])
+            .filter(|tri| !tri.contains(&v))
+            .map(|tri| point_triangle_distance(p, tri.map(|i| x[i as usize])))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    fn edge_closest(
+        &self,
+        x: &[DVec3],
+        triangles: &[[u32; 3]],
+        [a, b]: [u32; 2],
+        reach: f64,
+        found: &mut Vec<u32>,
+    ) -> f64 {
+        let (p, q) = (x[a as usize], x[b as usize]);
+        self.near(p.min(q) - reach, p.max(q) + reach, found);
+        let mut best = f64::INFINITY;
+        for &t in found.iter() {
+            let tri = triangles[t as usize];
+            for k in 0..3 {
+                let (c, d) = (tri[k], tri[(k + 1) % 3]);
+                if c == a || c == b || d == a || d == b {
+                    continue;
+                }
+                best = best.min(segment_distance(p, q, x[c as usize], x[d as usize]));
+            }
+        }
+        best
+    }
+}
+
+/// A cell's key: the three coordinates' low 21 bits interleaved into one word (distinct cells
+/// may share a key far apart; they only add candidates).
+fn key(x: i64, y: i64, z: i64) -> u64 {
+    let m = |v: i64| (v as u64) & 0x1f_ffff;
+    (m(x) << 42) | (m(y) << 21) | m(z)
+}
+
+fn bounds(points: impl Iterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+        (lo.min(p), hi.max(p))
+    })
+}
+
+/// Six times the signed volume of the tetrahedron `a b c d`.
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    (b - a).cross(c - a).dot(d - a)
+}
+
+/// Whether the segment `p q` passes strictly through the triangle `t`.
+fn segment_crosses(p: DVec3, q: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
+    let (sp, sq) = (orient(a, b, c, p), orient(a, b, c, q));
+    if !(sp > 0.0 && sq < 0.0 || sp < 0.0 && sq > 0.0) {
+        return false;
+    }
+    // The line p q against the three edges: all the same strict sign means inside.
+    let (u, v, w) = (orient(p, q, a, b), orient(p, q, b, c), orient(p, q, c, a));
+    u > 0.0 && v > 0.0 && w > 0.0 || u < 0.0 && v < 0.0 && w < 0.0
+}
+
+/// The distance from `p` to the triangle `a b c` (Ericson §5.1.5).
+fn point_triangle_distance(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return p.distance(a);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return p.distance(b);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return p.distance(a + ab * (d1 / (d1 - d3)));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return p.distance(c);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return p.distance(a + ac * (d2 / (d2 - d6)));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return p.distance(b + (c - b) * t);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    p.distance(a + ab * (vb * denom) + ac * (vc * denom))
+}
+
+/// The distance between the segments `p1 q1` and `p2 q2` (Ericson §5.1.9).
+fn segment_distance(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> f64 {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    const EPS: f64 = 1e-30;
+    let (s, t) = if a <= EPS && e <= EPS {
+        (0.0, 0.0)
+    } else if a <= EPS {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(r);
+        if e <= EPS {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > EPS {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    (p1 + d1 * s).distance(p2 + d2 * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An n × n grid of squares of side `h` in the plane z = `z`, particle indices from `base`.
+    fn sheet(n: u32, h: f64, z: f64, base: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let mut x = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                x.push(DVec3::new(i as f64 * h, j as f64 * h, z));
+            }
+        }
+        let id = |i: u32, j: u32| base + j * (n + 1) + i;
+        let mut t = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        (x, t)
+    }
+
+    #[test]
+    fn a_flat_sheet_has_no_crossings_and_its_spacing_as_closest_approach() {
+        let (x, t) = sheet(8, 0.1, 0.0, 0);
+        let m = measure(&x, &t, 1.0);
+        assert_eq!(m.crossings, 0);
+        // A vertex's nearest triangle without it lies across one of its neighbours' far edges:
+        // the diagonal triangles put it h / √2 away (the square's half diagonal).
+        let d = m.closest.expect("within reach");
+        assert!((d - 0.1 / 2f64.sqrt()).abs() < 1e-12, "{d}");
+    }
+
+    #[test]
+    fn two_parallel_sheets_report_their_gap() {
+        let (mut x, mut t) = sheet(4, 0.1, 0.0, 0);
+        let (x2, t2) = sheet(4, 0.1, 0.002, x.len() as u32);
+        x.extend(x2);
+        t.extend(t2);
+        let m = measure(&x, &t, 0.01);
+        assert_eq!(m.crossings, 0);
+        assert!((m.closest.expect("within reach") - 0.002).abs() < 1e-12);
+        // Nothing within a reach smaller than the gap.
+        assert_eq!(measure(&x, &t, 0.001).closest, None);
+    }
+
+    #[test]
+    fn a_sheet_pushed_through_another_is_counted_edge_by_edge() {
+        let (mut x, mut t) = sheet(4, 0.1, 0.0, 0);
+        // A small vertical square (two triangles) in the plane y = 0.15, x in [0.12, 0.17],
+        // z in [-0.05, 0.05], through the first sheet's cell (1, 1).
+        let base = x.len() as u32;
+        x.extend([
+            DVec3::new(0.12, 0.15, -0.05),
+            DVec3::new(0.17, 0.15, -0.05),
+            DVec3::new(0.17, 0.15, 0.05),
+            DVec3::new(0.12, 0.15, 0.05),
+        ]);
+        t.push([base, base + 1, base + 2]);
+        t.push([base, base + 2, base + 3]);
+        // The square's two sides and its diagonal each pierce one of the cell's triangles (at
+        // x = 0.12, 0.17 and 0.145, none on the cell's diagonal y = x); the cell's diagonal
+        // (0.1, 0.1)–(0.2, 0.2) pierces the square at (0.15, 0.15, 0), inside its lower
+        // triangle (off the square's diagonal, which meets z = 0 at x = 0.145). No other edge
+        // of the sheet spans y = 0.15 within x in [0.12, 0.17].
+        let m = measure(&x, &t, 0.0);
+        assert_eq!(m.crossings, 4, "{m:?}");
+        // Lift the square clear: no crossings.
+        for p in &mut x[base as usize..] {
+            p.z += 0.2;
+        }
+        assert_eq!(measure(&x, &t, 0.0).crossings, 0);
+    }
+
+    #[test]
+    fn crossings_match_a_brute_force_count_on_a_crumpled_pair() {
+        let (mut x, mut t) = sheet(6, 0.1, 0.0, 0);
+        let (x2, t2) = sheet(6, 0.1, 0.0, x.len() as u32);
+        x.extend(x2);
+        t.extend(t2);
+        // Deterministic bumps, opposite in the two sheets, so they interpenetrate in patches.
+        let n = x.len() / 2;
+        for (i, p) in x.iter_mut().enumerate() {
+            let s = if i < n { 1.0 } else { -1.0 };
+            p.z = s * 0.03 * ((p.x * 17.0).sin() * (p.y * 13.0).cos()) + 0.01 * (i % 3) as f64;
+        }
+        let edges = unique_edges(&t);
+        let brute = edges
+            .iter()
+            .map(|&[a, b]| {
+                t.iter()
+                    .filter(|tri| !tri.contains(&a) && !tri.contains(&b))
+                    .filter(|tri| {
+                        segment_crosses(x[a as usize], x[b as usize], tri.map(|i| x[i as usize]))
+                    })
+                    .count()
+            })
+            .sum::<usize>();
+        assert!(brute > 10, "the pair must interpenetrate: {brute}");
+        assert_eq!(measure(&x, &t, 0.0).crossings, brute);
+    }
+
+    #[test]
+    fn segment_distance_matches_closed_forms() {
+        let d = segment_distance(
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, -1.0, 0.3),
+            DVec3::new(0.5, 1.0, 0.3),
+        );
+        assert!((d - 0.3).abs() < 1e-15);
+        let d = segment_distance(DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0), DVec3::new(3.0, 0.0, 0.0));
+        assert!((d - 1.0).abs() < 1e-15);
+    }
+}
