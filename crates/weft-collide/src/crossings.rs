@@ -18,12 +18,13 @@ pub struct Crossings {
     /// Edge–triangle crossings between elements that share no vertex.
     pub crossings: usize,
     /// The closest approach between non-adjacent elements (vertex–triangle and edge–edge
-    /// pairs that share no vertex) when it is below the `reach` asked for (m).
+    /// pairs that share no vertex) when it is below the `reach` asked for, capped at the
+    /// longest edge (m).
     pub closest: Option<f64>,
 }
 
 /// Counts the crossings of `triangles` (indices into `positions`) and the closest approach
-/// below `reach` between elements that share no vertex.
+/// below `reach` (at most the longest edge) between elements that share no vertex.
 pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Crossings {
     let edges = unique_edges(triangles);
     if edges.is_empty() {
@@ -33,8 +34,10 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
         .iter()
         .map(|&[a, b]| positions[a as usize].distance(positions[b as usize]))
         .fold(0.0_f64, f64::max);
+    // The reach is capped at the longest edge: beyond it every vertex would be near a whole
+    // neighbourhood of its own cloth, and the search would grow with the square of the mesh.
     let reach = if reach.is_finite() {
-        reach.max(0.0)
+        reach.clamp(0.0, longest)
     } else {
         0.0
     };
