@@ -90,6 +90,15 @@ pub(crate) const SCALE: Range = Range {
     why: "beyond, vertex positions under- or overflow",
 };
 
+/// `sim.cg_tolerance`: the implicit method's relative residual.
+pub(crate) const CG_TOLERANCE: Range = Range {
+    lo: 1e-14,
+    hi: 0.5,
+    unit: "",
+    why: "below 1e-14 rounding keeps the residual from getting there; above 0.5 the solve \
+          stops before it starts",
+};
+
 /// `sim.divergence_bound` (m).
 pub(crate) const DIVERGENCE_BOUND: Range = Range {
     lo: 1e-3,

@@ -1,6 +1,16 @@
 //! The cantilever bending test (ASTM D1388) as a grid: a level strip clamped by its first two
 //! columns of particles, overhanging by a multiple of the fabric's bending length, and the
 //! chord angle measured on it, to compare with the heavy elastica ([`crate::Elastica`]).
+//!
+//! Where a pinned boundary is clamped: a hinge on a grid line stands for the bending of the
+//! cloth within half a cell on either side of it (its fold θ ≈ κ L, the midpoint rule, as the
+//! grid lumps each particle's mass over the same half cells). The hinge on the last pinned
+//! column (column 1) therefore bends the half cell towards column 0 too, and the strip of
+//! pinned columns acts as a clamp whose edge lies midway between columns 0 and 1: the
+//! overhang is measured from there, N + ½ cells to the tip, and the discrete strip is then a
+//! second-order model of the clamped one. Measured from column 1 instead, every hinge is
+//! read half a cell early (a left Riemann sum of the decreasing curvature) and the strip
+//! looks softer by O(1/N): 0.69 B, 0.75 B, 0.78 B at 8, 16, 32 segments in a linear solve.
 
 use glam::DVec3;
 
@@ -13,12 +23,14 @@ use crate::material::Material;
 /// is per unit width, so the width does not change the angle).
 pub const STRIP_WIDTH: f64 = 0.02;
 
-/// A strip clamped level along its first two columns, overhanging along +x in the x–z plane.
+/// A strip clamped level along its first two columns, overhanging along +x in the x–z plane;
+/// the clamp's edge (midway between columns 0 and 1) at the origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cantilever {
-    /// The overhang L from the clamp's edge (column 1) to the tip (m).
+    /// The overhang L from the clamp's edge (midway between columns 0 and 1) to the tip (m).
     pub overhang: f64,
-    /// Grid segments along the overhang (≥ 1).
+    /// Grid cells from the last clamped column to the tip (≥ 1); the overhang is half a cell
+    /// more.
     pub segments: usize,
     /// Grid segments across the strip (≥ 1); the cells are square.
     pub across: usize,
@@ -32,7 +44,7 @@ impl Cantilever {
         let c = bending_length(material.bending, material.density * g);
         let overhang = lengths * c;
         let segments = segments.max(1);
-        let cell = overhang / segments as f64;
+        let cell = overhang / (segments as f64 + 0.5);
         let across = ((STRIP_WIDTH / cell).round() as usize).max(2);
         Self {
             overhang,
@@ -41,9 +53,9 @@ impl Cantilever {
         }
     }
 
-    /// The cell size (m).
+    /// The cell size (m): the overhang is `segments` + ½ cells (see the module documentation).
     pub fn cell(&self) -> f64 {
-        self.overhang / self.segments as f64
+        self.overhang / (self.segments as f64 + 0.5)
     }
 
     /// Particles along x (columns) and across (rows).
@@ -51,10 +63,10 @@ impl Cantilever {
         (self.segments + 2, self.across + 1)
     }
 
-    /// Size of the grid: the overhang plus the clamped cell, by the width (m).
+    /// Size of the grid: the overhang plus the clamped half cell, by the width (m).
     pub fn size(&self) -> (f64, f64) {
         let h = self.cell();
-        (self.overhang + h, self.across as f64 * h)
+        (self.overhang + 0.5 * h, self.across as f64 * h)
     }
 
     /// The clamped particles: every row's columns 0 and 1 (`row * columns + column`).
@@ -65,27 +77,28 @@ impl Cantilever {
             .collect()
     }
 
-    /// The strip as a horizontal grid of areal density `density` with its clamp at the origin
-    /// (column 1 at x = 0).
+    /// The strip as a horizontal grid of areal density `density` with its clamp's edge at the
+    /// origin (columns 0 and 1 at x = ∓ half a cell).
     pub fn grid(&self, density: f64) -> GridDesc {
         let size = self.size();
         GridDesc {
             resolution: self.resolution(),
             size,
-            center: DVec3::new(0.5 * size.0 - self.cell(), 0.0, 0.0),
+            center: DVec3::new(0.5 * size.0 - 0.5 * self.cell(), 0.0, 0.0),
             orientation: Orientation::Horizontal,
             mass: Mass::Density(density),
             pins: self.clamp().into_iter().map(Pin::Index).collect(),
         }
     }
 
-    /// Angle (rad) below the horizontal of the chord from the clamp's edge (column 1) to the
-    /// tip (the last column), each taken at its mean over the rows, for the grid's `positions`.
+    /// Angle (rad) below the horizontal of the chord from the clamp's edge (midway between
+    /// columns 0 and 1) to the tip (the last column), each taken at its mean over the rows, for
+    /// the grid's `positions`.
     pub fn chord_angle(&self, positions: &[DVec3]) -> f64 {
         let (cols, rows) = self.resolution();
         let mean =
             |c: usize| (0..rows).map(|r| positions[r * cols + c]).sum::<DVec3>() / rows as f64;
-        let (root, tip) = (mean(1), mean(cols - 1));
+        let (root, tip) = (0.5 * (mean(0) + mean(1)), mean(cols - 1));
         let d = tip - root;
         (-d.y).atan2(d.x.hypot(d.z))
     }
@@ -109,8 +122,10 @@ mod tests {
         assert!((t.overhang - 2.0 * c).abs() < 1e-15);
         let mesh = t.grid(m.density).build().expect("grid");
         let (cols, _) = t.resolution();
-        // Column 1 at x = 0, the tip at x = L, all level: chord angle 0.
-        assert!(mesh.positions[1].x.abs() < 1e-12);
+        // The clamp's edge at x = 0 midway between columns 0 and 1, the tip at x = L, all
+        // level: chord angle 0.
+        assert!((mesh.positions[0].x + mesh.positions[1].x).abs() < 1e-12);
+        assert!((mesh.positions[1].x - 0.5 * t.cell()).abs() < 1e-12);
         assert!((mesh.positions[cols - 1].x - t.overhang).abs() < 1e-12);
         assert_eq!(t.chord_angle(&mesh.positions), 0.0);
         assert_eq!(mesh.pinned.len(), 2 * t.resolution().1);

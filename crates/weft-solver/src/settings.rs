@@ -4,6 +4,7 @@ use glam::DVec3;
 
 use crate::error::ParamError;
 use crate::method::Method;
+use crate::sparse::CgLimits;
 use weft_simd::SimdPath;
 
 /// Whether position `x` is finite with no coordinate beyond `bound` in magnitude (the
@@ -14,6 +15,12 @@ pub(crate) fn within_bound(x: DVec3, bound: f64) -> bool {
     let fine = |c: f64| (c.abs() <= bound) & (c.abs() < f64::INFINITY);
     fine(x.x) & fine(x.y) & fine(x.z)
 }
+
+/// Default of [`Settings::cg_max_iterations`].
+pub const DEFAULT_CG_MAX_ITERATIONS: u32 = 200;
+
+/// Default of [`Settings::cg_tolerance`].
+pub const DEFAULT_CG_TOLERANCE: f64 = 1e-4;
 
 /// How the solver steps: method, frame time step, substeps and iterations.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +49,10 @@ pub struct Settings {
     /// `neon` or `scalar`, read once) or else the widest path the CPU runs; a path the CPU
     /// lacks falls back to the widest one it has. Changes the speed, never the result.
     pub simd: Option<SimdPath>,
+    /// Implicit mass-spring: conjugate-gradient iterations at most per substep (≥ 1).
+    pub cg_max_iterations: u32,
+    /// Implicit mass-spring: the linear solve stops at ‖b − A Δv‖ ≤ this · ‖b‖ (in (0, 1)).
+    pub cg_tolerance: f64,
 }
 
 impl Default for Settings {
@@ -54,6 +65,8 @@ impl Default for Settings {
             divergence_bound: 1.0e4,
             domain_size: 8192,
             simd: None,
+            cg_max_iterations: DEFAULT_CG_MAX_ITERATIONS,
+            cg_tolerance: DEFAULT_CG_TOLERANCE,
         }
     }
 }
@@ -85,6 +98,20 @@ impl Settings {
         if !(self.divergence_bound.is_finite() && self.divergence_bound > 0.0) {
             return bad("divergence_bound", self.divergence_bound, "finite and > 0");
         }
+        if self.cg_max_iterations == 0 {
+            return bad("cg_max_iterations", 0.0, ">= 1");
+        }
+        if !(self.cg_tolerance > 0.0 && self.cg_tolerance < 1.0) {
+            return bad("cg_tolerance", self.cg_tolerance, "in (0, 1)");
+        }
         Ok(())
+    }
+
+    /// The implicit method's linear-solve limits.
+    pub(crate) fn cg_limits(&self) -> CgLimits {
+        CgLimits {
+            max_iterations: self.cg_max_iterations,
+            tolerance: self.cg_tolerance,
+        }
     }
 }

@@ -56,12 +56,16 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
         sim.divergence_bound,
         &ranges::DIVERGENCE_BOUND,
     );
+    let cg_max_iterations = count(c, "sim.cg_max_iterations", sim.cg_max_iterations);
+    c.within("sim.cg_tolerance", sim.cg_tolerance, &ranges::CG_TOLERANCE);
     let settings = Settings {
         method: sim.method.into(),
         dt,
         substeps,
         iterations,
         divergence_bound: sim.divergence_bound,
+        cg_max_iterations,
+        cg_tolerance: sim.cg_tolerance,
         ..Settings::default()
     };
     let mut wind = Wind::default();

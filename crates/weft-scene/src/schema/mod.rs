@@ -139,6 +139,12 @@ pub struct SimSection {
     /// A particle farther than this from the origin (m) means divergence.
     #[serde(default = "default_bound")]
     pub divergence_bound: f64,
+    /// Implicit mass-spring: conjugate-gradient iterations at most per substep.
+    #[serde(default = "default_cg_max_iterations")]
+    pub cg_max_iterations: i64,
+    /// Implicit mass-spring: relative residual ‖b − A Δv‖ / ‖b‖ its linear solve stops at.
+    #[serde(default = "default_cg_tolerance")]
+    pub cg_tolerance: f64,
 }
 
 fn default_dt() -> Seconds {
@@ -156,6 +162,12 @@ fn default_gravity() -> [f64; 3] {
 fn default_bound() -> f64 {
     weft_solver::Settings::default().divergence_bound
 }
+fn default_cg_max_iterations() -> i64 {
+    weft_solver::DEFAULT_CG_MAX_ITERATIONS.into()
+}
+fn default_cg_tolerance() -> f64 {
+    weft_solver::DEFAULT_CG_TOLERANCE
+}
 
 impl Default for SimSection {
     fn default() -> Self {
@@ -167,6 +179,8 @@ impl Default for SimSection {
             gravity: default_gravity(),
             damping: 0.0,
             divergence_bound: default_bound(),
+            cg_max_iterations: default_cg_max_iterations(),
+            cg_tolerance: default_cg_tolerance(),
         }
     }
 }

@@ -16,6 +16,8 @@
 //!   constants.
 //! - `quad_sweep`: the symmetric Gauss–Seidel sweep of a four-particle block through its lane
 //!   kernel.
+//! - `quad_cg`: XPBD's bending step by conjugate gradients where one sweep leaves it soft, and
+//!   its residual.
 //! - `parts`: contiguous particle ranges that let one colour be projected in parallel.
 
 mod block;
@@ -26,7 +28,10 @@ mod isometric;
 mod isometric_lanes;
 pub(crate) mod lanes;
 mod linear;
+#[cfg(test)]
+pub(crate) use linear::tests as linear_tests;
 mod parts;
+mod quad_cg;
 mod quad_lanes;
 mod quad_sweep;
 mod seam;
@@ -36,7 +41,7 @@ pub(crate) use block::{Block, BlockBuilder, Rule};
 pub use dihedral::Dihedral;
 pub use distance::Distance;
 pub use isometric::Isometric;
-pub(crate) use linear::Springs;
+pub(crate) use linear::{SlotRhs, Springs, State as LinearState};
 pub use seam::Seam;
 pub use tether::Tether;
 
@@ -116,6 +121,13 @@ pub struct ConstraintSet {
     pub(crate) isometric_forward: bool,
     /// The isometric block's frame constants (see [`FrameConstants`]).
     pub(crate) isometric_constants: FrameConstants<isometric_lanes::Prepared>,
+    /// The substep of the last XPBD frame (s); 0 before any.
+    pub(crate) xpbd_h: f64,
+    /// Whether the dihedral and the isometric block are solved by conjugate gradients this
+    /// frame (see `quad_cg`).
+    pub(crate) bending_cg: [bool; 2],
+    /// The conjugate gradients' scratch of the dihedral and the isometric block.
+    pub(crate) cg: [quad_cg::CgScratch; 2],
 }
 
 /// Max and root-mean-square of |C| over a set of constraints.
@@ -183,10 +195,49 @@ impl ConstraintSet {
     /// Decides, once per frame, how the bending blocks sweep under `rule` with inverse masses
     /// `w` and parameters `params`: the isometric block forward only when it is soft per
     /// substep ([`Block::soft_per_substep`]).
-    pub(crate) fn prepare_sweeps(&mut self, w: &[f64], params: &[FamilyParams], rule: Rule) {
+    ///
+    /// Under XPBD, a bending block whose mean s/α̃ at `x` exceeds [`quad_cg::CG_ABOVE`] is
+    /// solved by conjugate gradients instead of swept (see `quad_cg`).
+    pub(crate) fn prepare_sweeps(
+        &mut self,
+        x: &[DVec3],
+        w: &[f64],
+        params: &[FamilyParams],
+        rule: Rule,
+    ) {
+        self.xpbd_h = 0.0;
+        self.bending_cg = [false; 2];
+        if let Rule::Xpbd { h } = rule {
+            self.xpbd_h = h;
+            self.bending_cg = [
+                self.dihedral.mean_stiffness_ratio(x, w, params, h) > quad_cg::CG_ABOVE,
+                self.isometric.mean_stiffness_ratio(x, w, params, h) > quad_cg::CG_ABOVE,
+            ];
+        }
         self.isometric_forward = self.isometric.soft_per_substep(w, params, rule);
         self.isometric
             .prepare_constants(&mut self.isometric_constants, w, params, rule);
+    }
+
+    /// How far the bending constraints are from XPBD's equation C + α̃ λ + γ ∇C·Δx = 0 with
+    /// the last substep's multipliers: ‖C + α̃ λ + γ ∇C·Δx‖ / ‖α̃ λ‖ over every enabled hinge
+    /// at `x` (previous positions `prev`), i.e. roughly how much softer than its compliance
+    /// the bending acts (0 converged; `None` before an XPBD substep or without bending
+    /// force).
+    pub fn bending_residual(
+        &self,
+        x: &[DVec3],
+        prev: &[DVec3],
+        params: &[FamilyParams],
+    ) -> Option<f64> {
+        let h = self.xpbd_h;
+        if h <= 0.0 {
+            return None;
+        }
+        let d = self.dihedral.residual_sums(x, prev, params, h);
+        let i = self.isometric.residual_sums(x, prev, params, h);
+        let reference = d.reference + i.reference;
+        (reference > 0.0).then(|| ((d.residual + i.residual) / reference).sqrt())
     }
 
     /// Clears the XPBD multipliers (at the start of each substep).
@@ -211,12 +262,23 @@ impl ConstraintSet {
         path: SimdPath,
     ) {
         let none = FrameConstants::default();
-        self.dihedral
-            .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
-        let forward = self.isometric_forward;
-        let constants = &self.isometric_constants;
-        self.isometric
-            .project_symmetric_lanes(x, prev, w, params, rule, path, forward, constants);
+        let h = self.xpbd_h;
+        if self.bending_cg[0] {
+            self.dihedral
+                .solve_cg(x, prev, w, params, h, &mut self.cg[0]);
+        } else {
+            self.dihedral
+                .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
+        }
+        if self.bending_cg[1] {
+            self.isometric
+                .solve_cg(x, prev, w, params, h, &mut self.cg[1]);
+        } else {
+            let forward = self.isometric_forward;
+            let constants = &self.isometric_constants;
+            self.isometric
+                .project_symmetric_lanes(x, prev, w, params, rule, path, forward, constants);
+        }
         self.tethers.project(x, prev, w, params, rule);
         self.seams.project(x, prev, w, &self.seam_params, rule);
     }

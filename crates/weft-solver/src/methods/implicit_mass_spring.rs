@@ -9,26 +9,55 @@
 //!
 //! with f the spring forces plus the external ones (gravity, wind; their Jacobians are left
 //! out) and the spring Jacobians of [`crate::constraints::Springs`]. The system is solved by
-//! preconditioned conjugate gradients (Jacobi), with Baraff & Witkin's constraint filter
-//! (§5.3) fixing Δv = 0 at pinned, kinematic and grabbed particles (inverse mass 0). The shared
-//! loop then applies v ← v + Δv, x ← x + h v. Every sum runs in particle or constraint order on
-//! one thread, so the result does not depend on the thread count.
+//! conjugate gradients preconditioned by A's 3×3 diagonal blocks (block Jacobi), from the last
+//! substep's Δv (warm start), down to ‖b − A Δv‖ ≤ `Settings::cg_tolerance` ‖b‖ or
+//! `Settings::cg_max_iterations`. Baraff & Witkin's constraint filter (§5.3) fixes Δv = 0 at
+//! pinned, kinematic and grabbed particles (inverse mass 0). The shared loop then applies
+//! v ← v + Δv, x ← x + h v.
+//!
+//! A is never assembled: each product runs spring by spring into slots, in parallel, and each
+//! particle sums its slots in a fixed order ([`crate::sparse::Rows`]); every sum across tasks is
+//! taken in a fixed order, so the result does not depend on the thread count.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
-use super::{ForcePass, Strategy};
-use crate::constraints::{ConstraintSet, Rule, Springs};
+use super::{ForcePass, SpringWork, Strategy};
+use crate::chunk::CHUNK;
+use crate::constraints::{ConstraintSet, LinearState, Rule, Springs};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
-
-/// Conjugate-gradient iterations at most per substep.
-pub(crate) const MAX_ITERATIONS: usize = 400;
-
-/// Relative residual (in the preconditioned norm) at which conjugate gradients stop.
-pub(crate) const TOLERANCE: f64 = 1e-8;
+use crate::sparse::{Operator, Rows, Sym3, solve};
 
 /// Springs integrated with backward Euler: unconditionally stable, numerically damped.
 pub(crate) struct ImplicitMassSpring;
+
+/// A = M + h D + h² K, filtered: zero on the rows of particles with inverse mass 0.
+struct System<'a> {
+    springs: &'a Springs,
+    rows: &'a Rows,
+    w: &'a [f64],
+    y: &'a mut Vec<DVec3>,
+}
+
+impl Operator for System<'_> {
+    fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64 {
+        self.springs.product(p, self.y);
+        let w = self.w;
+        self.rows.gather(
+            self.y,
+            q,
+            |i, s| {
+                if w[i] > 0.0 {
+                    p[i] / w[i] + s
+                } else {
+                    DVec3::ZERO
+                }
+            },
+            |i, q| p[i].dot(q),
+        )
+    }
+}
 
 impl Strategy for ImplicitMassSpring {
     fn has_internal_forces(&self) -> bool {
@@ -41,47 +70,88 @@ impl Strategy for ImplicitMassSpring {
         particles: &Particles,
         params: &[FamilyParams],
         pass: ForcePass<'_>,
-        force: &mut [DVec3],
+        work: &mut SpringWork,
+        _force: &mut [DVec3],
         accel: &mut [DVec3],
     ) {
         let h = pass.h;
         let n = particles.len();
-        let (w, v) = (&particles.inv_masses, &particles.velocities);
-        let mut springs = Springs::default();
-        constraints.linearize(&particles.positions, v, params, &mut springs);
-        force.fill(DVec3::ZERO);
-        springs.add_forces(force);
-        // b = h (f + h ∂f/∂x v) = h (M a_ext + f_springs) − h² K v, K = −∂f/∂x.
-        let mut kv = vec![DVec3::ZERO; n];
-        springs.add_product(1.0, 0.0, v, &mut kv);
-        let free = |i: usize| w[i] > 0.0;
-        let b: Vec<DVec3> = (0..n)
-            .map(|i| {
-                if free(i) {
-                    (accel[i] / w[i] + force[i]) * h - kv[i] * (h * h)
-                } else {
-                    DVec3::ZERO
+        let w = &particles.inv_masses;
+        work.ensure_rows(constraints, n);
+        let warm = work.dv.len() == n;
+        if !warm {
+            work.dv.clear();
+            work.dv.resize(n, DVec3::ZERO);
+        }
+        let st = LinearState {
+            x: &particles.positions,
+            v: &particles.velocities,
+            h,
+            x0: warm.then_some(&work.dv[..]),
+        };
+        constraints.linearize(params, st, &mut work.springs, &mut work.rhs);
+        let SpringWork {
+            rows,
+            springs,
+            rhs,
+            y,
+            pinv,
+            r,
+            dv,
+            scratch,
+            ..
+        } = work;
+        pinv.resize(n, Sym3::default());
+        r.resize(n, DVec3::ZERO);
+        // Per particle: b = h M a_ext + Σ slots' b, r = b − A x₀, the block-Jacobi inverse;
+        // filtered particles get zeros (Baraff & Witkin's S).
+        let (rows_ref, rhs_ref, accel_ref) = (&*rows, &*rhs, &*accel);
+        let partials: Vec<f64> = r
+            .par_chunks_mut(CHUNK)
+            .zip(pinv.par_chunks_mut(CHUNK))
+            .zip(dv.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(c, ((r, pinv), dv))| {
+                let mut bb = 0.0;
+                for j in 0..r.len() {
+                    let i = c * CHUNK + j;
+                    if w[i] <= 0.0 {
+                        (r[j], pinv[j], dv[j]) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
+                        continue;
+                    }
+                    let m = 1.0 / w[i];
+                    let (mut b, mut ax) = (accel_ref[i] * (m * h), dv[j] * m);
+                    let mut d = Sym3::scaled_identity(m);
+                    for &k in rows_ref.row(i) {
+                        let s = &rhs_ref[k as usize];
+                        b += s.b;
+                        ax += s.ax;
+                        d = d.add(s.d);
+                    }
+                    r[j] = b - ax;
+                    pinv[j] = d.inverse();
+                    bb += b.dot(b);
                 }
+                bb
             })
             .collect();
-        // A = M + h D + h² K (D = −∂f/∂v); Jacobi preconditioner from its diagonal.
-        let mut diag: Vec<f64> = (0..n)
-            .map(|i| if free(i) { 1.0 / w[i] } else { 1.0 })
-            .collect();
-        springs.add_diagonal(h * h, h, &mut diag);
-        let apply = |p: &[DVec3], out: &mut [DVec3]| {
-            for i in 0..n {
-                out[i] = if free(i) { p[i] / w[i] } else { DVec3::ZERO };
-            }
-            springs.add_product(h * h, h, p, out);
-            filter(w, out);
+        let b_norm2: f64 = partials.iter().sum();
+        let mut system = System {
+            springs,
+            rows,
+            w,
+            y,
         };
-        let dv = conjugate_gradients(&apply, &b, &diag, w, &|| pass.stopping());
-        for i in 0..n {
-            if free(i) {
-                accel[i] = dv[i] / h;
+        let outcome = solve(&mut system, pinv, b_norm2, dv, r, pass.cg, scratch, &|| {
+            pass.stopping()
+        });
+        for ((a, dv), &w) in accel.iter_mut().zip(dv.iter()).zip(w) {
+            if w > 0.0 {
+                *a = *dv / h;
             }
         }
+        work.iterations += outcome.iterations;
+        work.last = outcome;
     }
 
     fn rule(&self, _h: f64) -> Option<Rule> {
@@ -89,101 +159,91 @@ impl Strategy for ImplicitMassSpring {
     }
 }
 
-/// Baraff & Witkin's filter S for fully constrained particles: zero where w = 0.
-fn filter(w: &[f64], x: &mut [DVec3]) {
-    for (x, &w) in x.iter_mut().zip(w) {
-        if w <= 0.0 {
-            *x = DVec3::ZERO;
-        }
-    }
-}
-
-fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a.dot(*b)).sum()
-}
-
-/// Modified preconditioned conjugate gradients (Baraff & Witkin 1998, §5.3, with z = 0);
-/// cut short once `stopping()` (the frame is being abandoned: a 1024² cloth's solve takes
-/// seconds).
-fn conjugate_gradients(
-    apply: &dyn Fn(&[DVec3], &mut [DVec3]),
-    b: &[DVec3],
-    diag: &[f64],
-    w: &[f64],
-    stopping: &dyn Fn() -> bool,
-) -> Vec<DVec3> {
-    let n = b.len();
-    let mut x = vec![DVec3::ZERO; n];
-    let mut r = b.to_vec();
-    filter(w, &mut r);
-    let precondition = |r: &[DVec3], out: &mut [DVec3]| {
-        for i in 0..n {
-            out[i] = r[i] / diag[i];
-        }
-        filter(w, out);
-    };
-    let mut c = vec![DVec3::ZERO; n];
-    precondition(&r, &mut c);
-    let mut delta = dot(&r, &c);
-    let target = TOLERANCE * TOLERANCE * delta;
-    let mut q = vec![DVec3::ZERO; n];
-    let mut s = vec![DVec3::ZERO; n];
-    for _ in 0..MAX_ITERATIONS {
-        if delta <= target || delta <= 0.0 || stopping() {
-            break;
-        }
-        apply(&c, &mut q);
-        let cq = dot(&c, &q);
-        if cq <= 0.0 {
-            break;
-        }
-        let alpha = delta / cq;
-        for i in 0..n {
-            x[i] += c[i] * alpha;
-            r[i] -= q[i] * alpha;
-        }
-        precondition(&r, &mut s);
-        let next = dot(&r, &s);
-        let beta = next / delta;
-        delta = next;
-        for i in 0..n {
-            c[i] = s[i] + c[i] * beta;
-        }
-        filter(w, &mut c);
-    }
-    x
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::constraints::linear_tests::{crumpled, reference_all};
+    use crate::params::Family;
+    use crate::sparse::CgLimits;
+
+    /// ‖b − A Δv‖ / ‖b‖ over the free particles, A and b from the serial reference springs.
+    fn true_residual(
+        cs: &ConstraintSet,
+        params: &[FamilyParams],
+        p: &Particles,
+        g: DVec3,
+        h: f64,
+        dv: &[DVec3],
+    ) -> f64 {
+        let (x, v, w) = (&p.positions, &p.velocities, &p.inv_masses);
+        let (adv, f) = reference_all(cs, params, x, v, (h * h, h), dv);
+        let (kv, _) = reference_all(cs, params, x, v, (h * h, 0.0), v);
+        let (mut rr, mut bb) = (0.0, 0.0);
+        for i in 0..x.len() {
+            if w[i] > 0.0 {
+                let b = (g / w[i] + f[i]) * h - kv[i];
+                let r = b - (dv[i] / w[i] + adv[i]);
+                rr += r.dot(r);
+                bb += b.dot(b);
+            }
+        }
+        (rr / bb).sqrt()
+    }
 
     #[test]
-    fn a_raised_stop_cuts_the_solve_short() {
-        // A 1-D Laplacian-like system (diagonally dominant): CG needs many iterations.
-        let n = 200;
-        let apply = |p: &[DVec3], out: &mut [DVec3]| {
-            for i in 0..n {
-                let left = if i > 0 { p[i - 1] } else { DVec3::ZERO };
-                let right = if i + 1 < n { p[i + 1] } else { DVec3::ZERO };
-                out[i] = p[i] * 2.001 - left - right;
-            }
+    fn each_solve_reaches_its_tolerance_and_the_warm_start_pays() {
+        let (cs, params, x, v) = crumpled(Family::BendIsometric);
+        let n = x.len();
+        let mut w = vec![100.0; n];
+        w[0] = 0.0;
+        w[9] = 0.0;
+        let p = Particles {
+            prev_positions: x.clone(),
+            positions: x,
+            velocities: v,
+            inv_masses: w,
         };
-        let b = vec![DVec3::X; n];
-        let (diag, w) = (vec![2.001; n], vec![1.0; n]);
-        let polls = std::cell::Cell::new(0);
-        let full = conjugate_gradients(&apply, &b, &diag, &w, &|| false);
-        let cut = conjugate_gradients(&apply, &b, &diag, &w, &|| {
-            polls.set(polls.get() + 1);
-            polls.get() > 3
-        });
-        assert_eq!(
-            polls.get(),
-            4,
-            "polled once per iteration, stopped at the fourth"
+        let (h, g) = (1.0 / 600.0, DVec3::new(0.0, -9.81, 0.0));
+        let mut work = SpringWork::default();
+        let mut iterations = Vec::new();
+        for tolerance in [1e-4, 1e-8, 1e-8] {
+            let mut accel = vec![g; n];
+            let pass = ForcePass {
+                h,
+                cg: CgLimits {
+                    max_iterations: 500,
+                    tolerance,
+                },
+                stop: None,
+            };
+            let mut force = vec![DVec3::ZERO; n];
+            ImplicitMassSpring
+                .add_internal_forces(&cs, &p, &params, pass, &mut work, &mut force, &mut accel);
+            let dv: Vec<DVec3> = (0..n)
+                .map(|i| {
+                    if p.inv_masses[i] > 0.0 {
+                        accel[i] * h
+                    } else {
+                        DVec3::ZERO
+                    }
+                })
+                .collect();
+            let r = true_residual(&cs, &params, &p, g, h, &dv);
+            assert!(
+                r <= tolerance * 1.001,
+                "tolerance {tolerance}: residual {r}"
+            );
+            assert!(work.last.residual <= tolerance, "{:?}", work.last);
+            assert_eq!(
+                accel[0], g,
+                "a pinned particle's acceleration is left alone"
+            );
+            iterations.push(work.last.iterations);
+        }
+        assert!(iterations[1] > 3, "a real solve: {iterations:?}");
+        assert!(
+            iterations[2] < iterations[1],
+            "the same system from its own solution: {iterations:?}"
         );
-        assert_ne!(full, cut, "three iterations do not solve it");
-        let none = conjugate_gradients(&apply, &b, &diag, &w, &|| true);
-        assert!(none.iter().all(|v| *v == DVec3::ZERO), "no iteration ran");
     }
 }

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{ForcePass, Strategy};
+use super::{ForcePass, SpringWork, Strategy};
 use crate::constraints::{ConstraintSet, Rule};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
@@ -21,6 +21,7 @@ impl Strategy for MassSpring {
         particles: &Particles,
         params: &[FamilyParams],
         _pass: ForcePass<'_>,
+        _work: &mut SpringWork,
         force: &mut [DVec3],
         accel: &mut [DVec3],
     ) {

@@ -4,15 +4,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::DVec3;
 
+use super::spring_work::SpringWork;
 use crate::constraints::{ConstraintSet, Rule};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
+use crate::sparse::CgLimits;
 
-/// The substep a force pass is for: its length, and the flag that abandons the frame.
+/// The substep a force pass is for: its length, the linear solve's limits, and the flag that
+/// abandons the frame.
 #[derive(Clone, Copy)]
 pub(crate) struct ForcePass<'a> {
     /// The substep h (s).
     pub h: f64,
+    /// How far an implicit method's linear solve goes.
+    pub cg: CgLimits,
     /// Raised to abandon the frame: a long solve stops early (see `Solver::set_stop`).
     pub stop: Option<&'a AtomicBool>,
 }
@@ -27,13 +32,16 @@ impl ForcePass<'_> {
 /// What distinguishes one method inside the shared substep loop.
 pub(crate) trait Strategy: Sync {
     /// Adds internal (constraint) accelerations for the substep of `pass` before integration,
-    /// on top of the external ones in `accel`; `force` is scratch.
+    /// on top of the external ones in `accel`; `force` is scratch, `work` the state a method
+    /// keeps between substeps.
+    #[allow(clippy::too_many_arguments)]
     fn add_internal_forces(
         &self,
         _constraints: &ConstraintSet,
         _particles: &Particles,
         _params: &[FamilyParams],
         _pass: ForcePass<'_>,
+        _work: &mut SpringWork,
         _force: &mut [DVec3],
         _accel: &mut [DVec3],
     ) {

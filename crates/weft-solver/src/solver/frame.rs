@@ -181,11 +181,12 @@ impl Solver {
         let h = s.h();
         let strategy = s.method.strategy();
         let mut stats = StepStats::default();
+        self.spring_work.iterations = 0;
         let rule = strategy.rule(h);
         if let Some(rule) = rule {
             self.domains.prepare(&self.params, rule);
-            let w = &self.particles.inv_masses;
-            self.constraints.prepare_sweeps(w, &self.params, rule);
+            let (x, w) = (&self.particles.positions, &self.particles.inv_masses);
+            self.constraints.prepare_sweeps(x, w, &self.params, rule);
         }
         let path = self.domains.path();
         let mut whole = true;
@@ -223,6 +224,7 @@ impl Solver {
                     .accelerations(&self.particles, &self.all_triangles, &mut self.accel);
                 let pass = ForcePass {
                     h,
+                    cg: s.cg_limits(),
                     stop: self.stop.as_deref(),
                 };
                 strategy.add_internal_forces(
@@ -230,6 +232,7 @@ impl Solver {
                     &self.particles,
                     &self.params,
                     pass,
+                    &mut self.spring_work,
                     &mut self.force,
                     &mut self.accel,
                 );
@@ -306,6 +309,7 @@ impl Solver {
             self.finish_velocities(inv_h, keep);
             hook.end_substep(&ctx, &mut self.particles);
         }
+        stats.cg_iterations = self.spring_work.iterations;
         Frame {
             stats,
             whole,

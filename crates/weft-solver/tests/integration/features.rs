@@ -154,7 +154,9 @@ fn bending_stiffness_holds_a_cantilever_up() {
     let (lo, hi) = near
         .iter()
         .fold((f64::MAX, 0.0f64), |(a, b), &d| (a.min(d), b.max(d)));
-    assert!(hi < 1.5 * lo && hi < 0.1 * none, "{near:?}");
+    // (Rigid bending is now solved to a tolerance by conjugate gradients: the strip stays flat
+    // to rounding at every count, which the floor of 1e-9 m admits.)
+    assert!(hi < 1.5 * lo.max(1e-9) && hi < 0.1 * none, "{near:?}");
 }
 
 #[test]

@@ -4,6 +4,7 @@
 
 mod common;
 
+mod cantilever;
 mod determinism;
 mod dihedral_energy;
 mod driven_pins;

@@ -1,0 +1,217 @@
+//! Tests of the linearised springs: the curvature frames against the shapes' own Hessian
+//! products, and the slots summed by rows against a serial spring-by-spring reference (the
+//! method's first, single-threaded form).
+
+use glam::DVec3;
+
+use super::*;
+use crate::grid::{GridDesc, Orientation};
+use crate::params::{ClothParams, Family};
+use crate::settings::Settings;
+use crate::test_rand::rng;
+use crate::{Forces, SolverBuilder};
+
+/// A 10² grid with every family `bending` allows (tethers, both in-plane families, bend
+/// distance, and `bending`), crumpled and moving at random, with its state: constraints,
+/// family parameters, positions, velocities.
+pub(crate) fn crumpled(
+    bending: Family,
+) -> (ConstraintSet, Vec<FamilyParams>, Vec<DVec3>, Vec<DVec3>) {
+    let mesh = GridDesc {
+        resolution: (10, 10),
+        orientation: Orientation::Horizontal,
+        ..GridDesc::default()
+    }
+    .build()
+    .expect("grid");
+    let mut params = ClothParams::default();
+    for (j, f) in [
+        Family::Stretch,
+        Family::Shear,
+        Family::BendDistance,
+        Family::Tether,
+        bending,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let p = params.get_mut(f);
+        p.enabled = true;
+        p.spring_stiffness = 100.0 * (j + 1) as f64;
+        p.spring_damping = 0.5 * j as f64;
+    }
+    let settings = Settings {
+        method: crate::Method::ImplicitMassSpring,
+        ..Settings::default()
+    };
+    let mut b = SolverBuilder::new(settings, Forces::default()).expect("settings");
+    b.add_cloth("c", &mesh, params, 0.0).expect("cloth");
+    let solver = b.build();
+    let mut rnd = rng(0x3c6e_f372_fe94_f82b);
+    let x: Vec<DVec3> = solver
+        .particles()
+        .positions
+        .iter()
+        // Stretched by 30 % about the origin (tethers taut) and crumpled.
+        .map(|p| *p * 1.3 + DVec3::new(rnd(), rnd(), rnd()) * 0.02)
+        .collect();
+    let v: Vec<DVec3> = x.iter().map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
+    let params = solver.cloth_params(0).expect("one cloth").families.to_vec();
+    (solver.constraints().clone(), params, x, v)
+}
+
+/// Serial reference of a block: per spring, out += (a_k k + a_c c) ∇C(∇C·p) + a_k k C⁺ ∇²C p
+/// (through [`Shape::curvature_product`]), and f += −(k C + c Ċ) ∇C.
+#[allow(clippy::too_many_arguments)]
+fn reference<const N: usize, S: Shape<N>>(
+    block: &Block<N, S>,
+    params: &[FamilyParams],
+    x: &[DVec3],
+    v: &[DVec3],
+    (a_k, a_c): (f64, f64),
+    p: &[DVec3],
+    out: &mut [DVec3],
+    f: &mut [DVec3],
+) {
+    for s in 0..block.particles.len() {
+        let fp = &params[block.group[s] as usize];
+        let idx = block.particles[s];
+        let pos = idx.map(|i| x[i as usize]);
+        let Some((c, grad)) = fp.enabled.then(|| block.shapes[s].evaluate(&pos)).flatten() else {
+            continue;
+        };
+        let dp = idx.map(|i| p[i as usize]);
+        let g_dot: f64 = (0..N).map(|k| grad[k].dot(dp[k])).sum();
+        let c_dot: f64 = (0..N).map(|k| grad[k].dot(v[idx[k] as usize])).sum();
+        let sk = (a_k * fp.spring_stiffness + a_c * fp.spring_damping) * g_dot;
+        let hp = block.shapes[s].curvature_product(&pos, &dp);
+        let force = -(fp.spring_stiffness * c + fp.spring_damping * c_dot);
+        for k in 0..N {
+            let mut add = grad[k] * sk;
+            if c > 0.0 && fp.spring_stiffness > 0.0 {
+                add += hp[k] * (a_k * fp.spring_stiffness * c);
+            }
+            out[idx[k] as usize] += add;
+            f[idx[k] as usize] += grad[k] * force;
+        }
+    }
+}
+
+/// [`reference`] over every block: ((a_k K + a_c D) p, the spring forces).
+pub(crate) fn reference_all(
+    cs: &ConstraintSet,
+    params: &[FamilyParams],
+    x: &[DVec3],
+    v: &[DVec3],
+    a: (f64, f64),
+    p: &[DVec3],
+) -> (Vec<DVec3>, Vec<DVec3>) {
+    let mut out = vec![DVec3::ZERO; x.len()];
+    let mut f = vec![DVec3::ZERO; x.len()];
+    reference(&cs.distance, params, x, v, a, p, &mut out, &mut f);
+    reference(&cs.dihedral, params, x, v, a, p, &mut out, &mut f);
+    reference(&cs.isometric, params, x, v, a, p, &mut out, &mut f);
+    reference(&cs.tethers, params, x, v, a, p, &mut out, &mut f);
+    reference(&cs.seams, &cs.seam_params, x, v, a, p, &mut out, &mut f);
+    (out, f)
+}
+
+fn close(a: DVec3, b: DVec3, scale: f64) -> bool {
+    (a - b).length() <= 1e-11 * scale.max(1.0)
+}
+
+#[test]
+fn frames_apply_the_shapes_hessians() {
+    let mut rnd = rng(0x1234_5678_9abc_def1);
+    let mut r3 = || DVec3::new(rnd(), rnd(), rnd());
+    fn check<const N: usize, S: Curved<N>>(s: S, p: [DVec3; N], dp: [DVec3; N]) {
+        let want = s.curvature_product(&p, &dp);
+        let (a, n, inv_len) = s.frame(&p).expect("curved");
+        let u: DVec3 = (0..N).map(|m| dp[m] * a[m]).sum();
+        let t = (u - n * n.dot(u)) * inv_len;
+        for k in 0..N {
+            assert!(
+                (want[k] - t * a[k]).length() < 1e-12,
+                "{k}: {} {}",
+                want[k],
+                t * a[k]
+            );
+        }
+    }
+    for _ in 0..20 {
+        let p2 = [r3(), r3()];
+        let d2 = [r3(), r3()];
+        check(Distance { rest: 0.1 }, p2, d2);
+        check(Tether { max_length: 0.0 }, p2, d2);
+        let p4 = [r3(), r3(), r3(), r3()];
+        let d4 = [r3(), r3(), r3(), r3()];
+        let iso = Isometric {
+            weights: [1.0, 2.0, -1.25, -1.75],
+        };
+        check(iso, p4, d4);
+    }
+}
+
+#[test]
+fn slots_summed_by_rows_match_the_serial_springs() {
+    for bending in [Family::BendDihedral, Family::BendIsometric] {
+        let (cs, params, x, v) = crumpled(bending);
+        let n = x.len();
+        let h = 1e-3;
+        let mut rnd = rng(0x0bad_cafe_f00d_0001);
+        let x0: Vec<DVec3> = (0..n).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
+        let rows = cs.spring_rows(n);
+        let mut springs = Springs::default();
+        let mut rhs = Vec::new();
+        let st = State {
+            x: &x,
+            v: &v,
+            h,
+            x0: Some(&x0),
+        };
+        cs.linearize(&params, st, &mut springs, &mut rhs);
+        assert_eq!(rhs.len(), rows.slot_count());
+        // A − M applied to x₀, and to a fresh vector through the product pass.
+        let (want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
+        let (kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
+        let mut y = Vec::new();
+        springs.product(&x0, &mut y);
+        let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
+        let mut curved = 0;
+        for i in 0..n {
+            let ax = rows.sum(
+                i,
+                &rhs.iter().map(|r| r.ax).collect::<Vec<_>>(),
+                DVec3::ZERO,
+            );
+            assert!(
+                close(ax, want_ax[i], scale),
+                "{bending:?} row {i}: {ax} {}",
+                want_ax[i]
+            );
+            assert!(close(rows.sum(i, &y, DVec3::ZERO), want_ax[i], scale));
+            let b = rows.sum(i, &rhs.iter().map(|r| r.b).collect::<Vec<_>>(), DVec3::ZERO);
+            let want_b = f[i] * h - kv[i];
+            assert!(
+                close(b, want_b, scale),
+                "{bending:?} row {i}: b {b} {want_b}"
+            );
+            // The diagonal block: A − M applied to a vector at particle i alone, read at i.
+            let d = rows
+                .row(i)
+                .iter()
+                .fold(Sym3::default(), |s, &k| s.add(rhs[k as usize].d));
+            for e in [DVec3::X, DVec3::Y, DVec3::Z] {
+                let mut p = vec![DVec3::ZERO; n];
+                p[i] = e;
+                let (col, _) = reference_all(&cs, &params, &x, &v, (h * h, h), &p);
+                assert!(close(d.mul(e), col[i], scale), "{bending:?} diag {i}");
+            }
+            curved += usize::from(d.0[3] != 0.0);
+        }
+        assert!(curved > n / 2, "most rows have off-axis coupling: {curved}");
+        assert!(
+            springs.isometric.iter().any(|l| l.kappa > 0.0) || bending != Family::BendIsometric
+        );
+    }
+}

@@ -1,0 +1,136 @@
+//! The cantilever bending test (ASTM D1388) against the heavy elastica: a strip of a preset
+//! overhanging twice its bending length c = (B/w)^(1/3), clamped by two pinned columns, bends
+//! so that the chord from the clamp's edge to the tip falls at 41.49° (Peirce 1930). The
+//! strip's stiffness comes only from the material mapping (5/4 B per hinge, see
+//! `material.rs`), so a 10 % error in the bending constant moves the angle by about 2.3°.
+//! The strips are 8 segments long (a debug build runs them in seconds; 16 and 32 are in
+//! `assets/experiments/cantilever.toml` and `docs/validation.md`).
+
+use weft_solver::{
+    Cantilever, ClothParams, Forces, Material, Method, Settings, Solver, SolverBuilder, preset,
+};
+
+const G: f64 = 9.81;
+
+/// The strip of `material` at `segments`, stepped `frames` frames of `settings` with damping
+/// 3/s: the solver and the chord angle's difference from the elastica's (degrees).
+fn cantilever(
+    material: &Material,
+    segments: usize,
+    settings: Settings,
+    frames: usize,
+) -> (Solver, f64) {
+    off_by(material, 1.0, segments, settings, frames)
+}
+
+/// [`cantilever`] with the strip's bending constant scaled by `scale` in the material mapping
+/// (the strip and the elastica are still those of `material`).
+fn off_by(
+    material: &Material,
+    scale: f64,
+    segments: usize,
+    settings: Settings,
+    frames: usize,
+) -> (Solver, f64) {
+    let strip = Cantilever::of_material(material, G, 2.0, segments);
+    let mesh = strip.grid(material.density).build().expect("strip");
+    let mapped = Material {
+        bending: material.bending * scale,
+        ..*material
+    };
+    let params = mapped.params(&mesh, &settings, &ClothParams::default());
+    let forces = Forces {
+        damping: 3.0,
+        ..Forces::default()
+    };
+    let mut b = SolverBuilder::new(settings, forces).expect("settings");
+    b.add_cloth("strip", &mesh, params, 0.0).expect("strip");
+    let mut s = b.build();
+    for _ in 0..frames {
+        s.step().expect("finite");
+    }
+    let elastica = strip.elastica(material, G).expect("in range").chord_angle();
+    let error = (strip.chord_angle(&s.particles().positions) - elastica).to_degrees();
+    (s, error)
+}
+
+fn defaults(method: Method) -> Settings {
+    Settings {
+        method,
+        ..Settings::default()
+    }
+}
+
+#[test]
+fn xpbd_bends_a_strip_as_the_elastica_at_its_defaults() {
+    for name in ["cotton", "denim"] {
+        let m = preset(name).expect("preset");
+        // Settled by 4 s (the angle changes by < 0.01° after).
+        let (s, error) = cantilever(&m, 8, defaults(Method::Xpbd), 240);
+        let residual = s.bending_residual().expect("XPBD bending");
+        println!("{name}: chord angle {error:+.2}° from the elastica, residual {residual:.1e}");
+        // Within 2° as the issue asks, and within 1.4° so that a bending constant 10 % off
+        // either way fails (measured: +0.38° and +0.75°; 10 % off: +2.91° / −1.87° and
+        // +3.17° / −1.50°).
+        assert!(error.abs() < 1.4, "{name}: {error:+.2}°");
+        // The claim can fail: the bending constant 10 % off either way leaves the bound.
+        for scale in [0.9, 1.1] {
+            let (_, off) = off_by(&m, scale, 8, defaults(Method::Xpbd), 240);
+            println!("{name}, B × {scale}: {off:+.2}°");
+            assert!(off.abs() > 1.4, "{name}, B × {scale}: {off:+.2}°");
+        }
+        // The bending solve converged: its hinges act at their compliance.
+        assert!(residual < 0.01, "{name}: residual {residual}");
+    }
+}
+
+#[test]
+fn xpbd_bending_stiffness_does_not_depend_on_substeps_or_the_time_step() {
+    // The poster's claim: the compliance alone sets the stiffness. One sweep per substep
+    // (what XPBD did before its bending was solved to a tolerance) gave a hinge the
+    // compliance α + h² Σ w|∇C|² (cotton at 8 segments: 64° at 10 substeps, 52° at 20 × 20
+    // iterations). Now the bending equation holds at every substep count (residual < 1 %);
+    // the angles still spread by 2.6° (+0.4° at 10 substeps, −2.2° at 40): the stretch, which
+    // one sweep leaves soft in the same way, lengthens the strip less at smaller substeps.
+    let m = preset("cotton").expect("preset");
+    let angle = |substeps: u32, dt: f64| {
+        let settings = Settings {
+            substeps,
+            dt,
+            ..defaults(Method::Xpbd)
+        };
+        let frames = (4.0 / dt) as usize;
+        let (s, error) = cantilever(&m, 8, settings, frames);
+        let residual = s.bending_residual().expect("XPBD bending");
+        assert!(residual < 0.01, "{substeps} × {dt}: residual {residual}");
+        error
+    };
+    let base = angle(10, 1.0 / 60.0);
+    for (substeps, dt) in [(20, 1.0 / 60.0), (40, 1.0 / 60.0), (10, 1.0 / 120.0)] {
+        let e = angle(substeps, dt);
+        println!("{substeps} substeps, dt {dt:.4}: {e:+.2}° (10 substeps, 1/60: {base:+.2}°)");
+        assert!(
+            (e - base).abs() < 3.0,
+            "{substeps} × {dt}: {e:+.2}° vs {base:+.2}°"
+        );
+        assert!(
+            e.abs() < 2.5,
+            "{substeps} × {dt}: {e:+.2}° from the elastica"
+        );
+    }
+}
+
+#[test]
+fn implicit_mass_spring_bends_a_strip_as_the_elastica_at_its_defaults() {
+    // Settled by 2 s. Measured −1.92° (cotton): the strip at 8 segments is a little stiff,
+    // so a constant 10 % too stiff fails here (−4.04°) and one 10 % too soft does not (+0.2°
+    // at 16 segments, too slow for a debug test).
+    let m = preset("cotton").expect("preset");
+    let (s, error) = cantilever(&m, 8, defaults(Method::ImplicitMassSpring), 120);
+    println!("implicit mass-spring: chord angle {error:+.2}° from the elastica");
+    assert!(error.abs() < 2.0, "{error:+.2}°");
+    assert_eq!(s.bending_residual(), None, "no XPBD multipliers");
+    let (_, stiff) = off_by(&m, 1.1, 8, defaults(Method::ImplicitMassSpring), 120);
+    println!("implicit mass-spring, B × 1.1: {stiff:+.2}°");
+    assert!(stiff.abs() > 2.0, "B × 1.1: {stiff:+.2}°");
+}
