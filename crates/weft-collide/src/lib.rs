@@ -21,10 +21,12 @@
 //! - `chunk`: the fixed split of the particles into parallel tasks.
 //! - `friction`: Coulomb friction for position-based contacts.
 //! - `body`: kinematic bodies of round cones (an animated character's limbs).
+//! - `cloth_contact`: mesh-level cloth contact (vertex–triangle, edge–edge) that creates no crossing.
 //! - `self_collision`: particle–particle self-collision (and between cloths) with friction.
 //! - `grid`: points sorted by grid cell, for close pairs and neighbour searches.
 //! - `obj`: a tiny Wavefront OBJ reader.
 //! - `tessellate`: colliders as triangle meshes for drawing.
+//! - `layered`: scenes of thin cloth layers as code, for cloth contact's tests and benches.
 //! - `scenarios`: scenes as code, sized by parameter, for benches, examples and tests.
 //! - `error`: the crate's errors.
 //! - `analytic_vs_parry` (tests only): the closed-form queries against parry's answers.
@@ -37,12 +39,14 @@ mod analytic_vs_parry;
 pub mod body;
 mod chunk;
 mod closed_run;
+mod cloth_contact;
 mod collider;
 mod convert;
 pub mod crossings;
 mod error;
 mod friction;
 mod grid;
+pub mod layered;
 mod mesh;
 mod obj;
 mod reach;
@@ -58,6 +62,7 @@ mod trimesh;
 mod world;
 
 pub use body::{BodyPart, KinematicBody, RoundCone};
+pub use cloth_contact::{ClothContactParams, ClothContactStats, FailSafeStats};
 pub use collider::{Collider, ColliderDesc};
 pub use error::{CollideError, MeshError, ShapeError};
 pub use friction::Friction;

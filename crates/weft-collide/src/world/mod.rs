@@ -23,6 +23,7 @@ use crate::analytic::WorldPose;
 use crate::body::{BodyCollider, BodyPart, KinematicBody};
 use crate::chunk::{CHUNK, moving_views};
 use crate::closed_run::{Run, resolve_still, still_surface};
+use crate::cloth_contact::ClothContact;
 use crate::collider::{Collider, ColliderDesc};
 use crate::error::{CollideError, ShapeError};
 use crate::friction::Friction;
@@ -37,6 +38,7 @@ use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::grid_run::resolve_grid_run;
 use crate::trimesh::list_run::resolve_list_run;
 
+mod cloth;
 mod runs;
 
 /// What the last substep's contacts did.
@@ -66,6 +68,8 @@ pub struct CollisionWorld {
     time: f64,
     thickness: Vec<f64>,
     self_collision: Option<SelfCollision>,
+    /// Mesh-level cloth contact (`cloth_contact`), when on.
+    cloth_contact: Option<ClothContact>,
     /// Per collider, its world AABB at the current pose grown by [`Self::search_margin`], or
     /// `None` if unbounded; refreshed every substep.
     bounds: Vec<Option<Bounds>>,
@@ -105,6 +109,7 @@ impl CollisionWorld {
             time: solver.time(),
             thickness: Vec::new(),
             self_collision: None,
+            cloth_contact: None,
             bounds: Vec::new(),
             reach: Vec::new(),
             max_thickness: 0.0,
@@ -132,6 +137,9 @@ impl CollisionWorld {
         self.mesh_grids.clear();
         if let Some(sc) = &mut self.self_collision {
             sc.invalidate();
+        }
+        if let Some(cc) = &mut self.cloth_contact {
+            cc.set_thickness(&self.thickness);
         }
     }
 
@@ -631,17 +639,24 @@ fn query(c: &Collider, parry: bool, x: DVec3, max_dist: f64) -> Option<crate::Su
 }
 
 impl SubstepHook for CollisionWorld {
-    /// Contacts read positions and previous positions alone, and `end_substep` does nothing.
+    /// Contacts read positions and previous positions alone; `end_substep` does nothing
+    /// but cloth contact's continuous check, which must run after every substep.
     fn uses_velocities(&self) -> bool {
-        false
+        self.cloth_contact.is_some()
     }
 
     /// A world with no collider and no self-collision does nothing, so the solver may fuse.
     fn is_active(&self) -> bool {
-        !self.colliders.is_empty() || !self.bodies.is_empty() || self.self_collision.is_some()
+        !self.colliders.is_empty()
+            || !self.bodies.is_empty()
+            || self.self_collision.is_some()
+            || self.cloth_contact.is_some()
     }
 
-    fn begin_substep(&mut self, ctx: &SubstepContext, _particles: &Particles) {
+    fn begin_substep(&mut self, ctx: &SubstepContext, particles: &Particles) {
+        if let Some(cc) = &mut self.cloth_contact {
+            cc.begin_substep(particles);
+        }
         self.build_grids();
         let t0 = ctx.time - ctx.h;
         let margin = self.search_margin();
@@ -674,6 +689,7 @@ impl SubstepHook for CollisionWorld {
         // particle, and the others' lists per run (`RunLists`). Those through parry keep the
         // general loop.
         let per_particle = self.self_collision.is_none()
+            && self.cloth_contact.is_none()
             && self.bodies.is_empty()
             && !self.colliders.is_empty()
             && (self.colliders.iter()).all(|c| c.mesh().is_none() || self.own_mesh(c));
@@ -727,10 +743,27 @@ impl SubstepHook for CollisionWorld {
                 self.stats.body_planes += c.planes;
             }
         }
+        // Cloth contact last: the layers' proximity has the last word in each projection (a
+        // layer pushed slightly into a collider comes out at the next one), and the substep's
+        // continuous check (`end_substep`) judges the result.
+        let (self_contacts, self_depth) = match &mut self.cloth_contact {
+            Some(cc) => {
+                let (n, depth) = cc.project(particles);
+                (self_contacts + n, self_depth.max(depth))
+            }
+            None => (self_contacts, self_depth),
+        };
         self.stats.swept += swept;
         self.stats.collider_contacts = collider_contacts;
         self.stats.self_contacts = self_contacts;
         self.stats.max_self_depth = self.stats.max_self_depth.max(self_depth);
         collider_contacts + self_contacts
+    }
+
+    /// Cloth contact's continuous check over the substep's motion, and its fail-safe.
+    fn end_substep(&mut self, _ctx: &SubstepContext, particles: &mut Particles) {
+        if let Some(cc) = &mut self.cloth_contact {
+            cc.end_substep(particles);
+        }
     }
 }

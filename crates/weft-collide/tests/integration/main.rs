@@ -6,6 +6,7 @@ mod common;
 
 mod bad_meshes;
 mod body;
+mod cloth_contact;
 mod determinism;
 mod dihedral_drape;
 mod friction_slope;
