@@ -290,7 +290,8 @@ fn peak_memory_stays_within_the_estimate_on_every_shipped_scene_and_thick_cloths
              center = [0.0, {y}, 0.0]\nthickness = {t}\n\n"
         )
     };
-    let two = sheet("a", 48, 1.001, 10.0) + &sheet("b", 48, 1.0, 10.0) + "[self_collision]\n";
+    // 1 m thick, as thick as a 1 m sheet may be: every pair within reach.
+    let two = sheet("a", 48, 1.001, 1.0) + &sheet("b", 48, 1.0, 1.0) + "[self_collision]\n";
     scenes.push(write(&dir, "two.toml", &two));
     scenes.push(write(
         &dir,

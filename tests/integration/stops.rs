@@ -127,14 +127,15 @@ fn a_scene_file_that_is_a_device_is_refused() {
 
 #[test]
 fn sigint_while_self_collision_lists_a_thick_cloth_stops_within_a_second() {
-    // A 512² sheet 10 m thick: every particle lies within reach of every other, so the first
+    // A 512² sheet of 1 m, 1 m thick (as thick as a cloth may be: its own width): every
+    // particle lies within reach (at least twice the thickness) of every other, so the first
     // list build tests 3·10¹⁰ pairs (all exempt, so it takes no memory): minutes of work
     // inside the first substep, where the solver's own per-substep poll cannot see a stop.
     let dir = temp_dir("thick-self-collision");
     let scene = write(
         &dir,
         "s.toml",
-        "[cloth.c]\nresolution = [512, 512]\nthickness = 10.0\n\n[self_collision]\n",
+        "[cloth.c]\nresolution = [512, 512]\nthickness = 1.0\n\n[self_collision]\n",
     );
     let target = dir.join("a.mcap");
     let child = spawn_logging(

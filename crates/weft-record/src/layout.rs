@@ -32,9 +32,6 @@ pub const CHANNELS: &str = "weft.channels";
 /// 1.4× to 1.7× as fast as zstd's default (level 3) to within 1 % of its size.
 pub const ZSTD_LEVEL: u32 = 1;
 
-/// The JSON schema of `/stats` messages.
-pub const STATS_SCHEMA: &str = r#"{"title":"weft.FrameStats","type":"object","properties":{"frame":{"type":"integer"},"time":{"type":"number","description":"simulated time (s)"},"kinetic_energy":{"type":"number","description":"J"},"residual_max":{"type":"number","description":"largest |C| of distance-like constraints (m)"},"residual_rms":{"type":"number","description":"largest per-solver RMS |C| (m)"},"contacts":{"type":"integer"},"step_ms":{"type":"number","description":"wall-clock step time (ms); only with --timing"},"log_wait_ms":{"type":"number","description":"wall-clock time the run has waited for the log's queue before this frame (ms); only with --timing"}},"required":["frame","time","kinetic_energy","residual_max","residual_rms","contacts"]}"#;
-
 /// The data of the foxglove schema called `name` (as the recorder writes it), if it is one.
 pub fn foxglove_schema(name: &str) -> Option<Vec<u8>> {
     [PointCloud::get_schema(), SceneUpdate::get_schema()]
@@ -120,7 +117,7 @@ pub(crate) fn open(
         .create(BufWriter::new(sink))?;
     let pc = schema_of::<PointCloud>(&mut w)?;
     let su = schema_of::<SceneUpdate>(&mut w)?;
-    let st = json_schema(&mut w, "weft.FrameStats", STATS_SCHEMA)?;
+    let st = json_schema(&mut w, "weft.FrameStats", crate::stats::STATS_SCHEMA)?;
     let mut described = BTreeMap::new();
     let scene = &sim.scene;
     // A character's body is logged with the colliders, and moves every frame.
@@ -182,6 +179,7 @@ fn write_run(
         ("overrides", serde_json::to_string(&overrides)?),
         ("mesh_every", options.mesh_every.to_string()),
         ("timing", options.timing.to_string()),
+        ("crossings", sim.measures_crossings().to_string()),
         ("weft_version", env!("CARGO_PKG_VERSION").to_owned()),
         (
             "methods",

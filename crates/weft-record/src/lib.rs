@@ -10,6 +10,7 @@ mod layout;
 pub mod messages;
 mod options;
 mod sink;
+mod stats;
 mod status;
 mod surface;
 pub mod verify;
@@ -17,7 +18,8 @@ mod worker;
 mod writer;
 
 pub use error::{RecordError, Result};
-pub use layout::{CHANNELS, STATS_SCHEMA, ZSTD_LEVEL, foxglove_schema};
+pub use layout::{CHANNELS, ZSTD_LEVEL, foxglove_schema};
 pub use options::{Channels, Compression, Precision, RecordOptions, UnknownChoice};
+pub use stats::STATS_SCHEMA;
 pub use status::Status;
 pub use writer::{LogProgress, QUEUE_BYTES, Recorder};

@@ -164,19 +164,7 @@ impl Worker {
             self.buf = serde_json::to_vec(v)?;
             self.raw(ch, time)?;
         }
-        let s = &f.stats;
-        let mut json = serde_json::json!({
-            "frame": s.frame,
-            "time": s.time,
-            "kinetic_energy": s.kinetic_energy,
-            "residual_max": s.residual_max,
-            "residual_rms": s.residual_rms,
-            "contacts": s.contacts,
-        });
-        if self.options.timing {
-            json["step_ms"] = s.step_ms.into();
-            json["log_wait_ms"] = f.waited_ms.into();
-        }
+        let json = crate::stats::json(&f.stats, self.options.timing.then_some(f.waited_ms));
         self.buf = serde_json::to_vec(&json)?;
         self.raw(self.ids.stats, time)?;
         self.frames.fetch_add(1, Ordering::Relaxed);

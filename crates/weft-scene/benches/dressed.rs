@@ -6,7 +6,8 @@
 //! in its cape (assets/scenes/glb_character.toml: 2,374 particles, a 5,126-triangle body
 //! skinned once a frame, its vertices moved and faces recomputed every substep) split the
 //! same way, and again in the finer cape of assets/garments/cape_fine.toml (8,097 particles)
-//! at three points of the jump, each frame warm and from the same state.
+//! at three points of the jump, each frame warm and from the same state. Last, the walker's
+//! whole frame under each of the four methods.
 #![allow(clippy::unwrap_used)]
 
 use std::path::Path;
@@ -16,7 +17,7 @@ use criterion::measurement::WallTime;
 use criterion::{Bencher, Criterion, SamplingMode, criterion_group, criterion_main};
 use weft_collide::CollisionWorld;
 use weft_scene::{Override, SolverGroup};
-use weft_solver::{Particles, Solver, SubstepContext, SubstepHook};
+use weft_solver::{Method, Particles, Solver, SubstepContext, SubstepHook};
 
 /// An active hook that does nothing: the general step loop with no contact at all.
 struct Nothing;
@@ -173,5 +174,28 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// The whole walker frame (solve + body + self-collision) under each method, side by side
+/// (`cargo bench -p weft-scene --bench dressed -- "walker by method"`); a method that cannot
+/// run the scene is named and left out.
+fn by_method(c: &mut Criterion) {
+    let mut group = c.benchmark_group("walker by method");
+    group
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1));
+    for method in Method::ALL {
+        let set = format!("sim.method={}", method.name());
+        let mut g = match std::panic::catch_unwind(|| dressed(&[set.as_str()])) {
+            Ok(g) => g,
+            Err(_) => {
+                eprintln!("walker by method: {method} does not run the walker; left out");
+                continue;
+            }
+        };
+        group.bench_function(method.name(), |b| b.iter(|| g.step().unwrap()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, by_method);
 criterion_main!(benches);

@@ -5,11 +5,13 @@
 
 pub mod body;
 pub mod control;
+pub mod crossings;
 mod error;
 pub mod grab;
 mod simulation;
 
 pub use control::{Control, LIVE_KEYS, Value};
+pub use crossings::{CrossingStats, StartCrossing};
 pub use error::SimError;
 pub use simulation::{FrameStats, Simulation};
 

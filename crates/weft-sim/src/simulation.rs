@@ -10,6 +10,7 @@ use weft_solver::SolverError;
 use weft_solver::glam::DVec3;
 
 use crate::SimError;
+use crate::crossings::{self, CrossingStats, SolverMesh, StartCrossing};
 
 /// What one frame did, summed over the scene's solvers.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -26,8 +27,13 @@ pub struct FrameStats {
     pub residual_rms: f64,
     /// Contacts in the last substep.
     pub contacts: usize,
+    /// Conjugate-gradient iterations of the frame's implicit solves (0 without implicit springs).
+    pub cg_iterations: u64,
     /// Wall-clock time of the step (ms); not deterministic.
     pub step_ms: f64,
+    /// Cloth crossings and the closest approach, when measured (see
+    /// [`Simulation::set_measure_crossings`]).
+    pub crossings: Option<CrossingStats>,
 }
 
 /// A scene and its solvers.
@@ -43,6 +49,10 @@ pub struct Simulation {
     dt: f64,
     /// Where the current time step took over: (frame, simulated time then).
     epoch: (u64, f64),
+    /// Each solver's mesh as crossings are measured on it, when they are.
+    crossing_meshes: Option<Vec<SolverMesh>>,
+    /// Cloth crossing itself or another cloth at the start.
+    start_crossings: Vec<StartCrossing>,
 }
 
 impl Simulation {
@@ -56,14 +66,59 @@ impl Simulation {
             }
         }
         let dt = scene.settings.dt;
-        Ok(Self {
+        let start_crossings = crossings::start_crossings(&scene, &groups);
+        let mut sim = Self {
             scene,
             groups,
             places,
             frame: 0,
             dt,
             epoch: (0, 0.0),
-        })
+            crossing_meshes: None,
+            start_crossings,
+        };
+        sim.set_measure_crossings(crossings::cloth_meets_cloth(&sim.scene, &sim.groups));
+        Ok(sim)
+    }
+
+    /// Measures cloth crossings in every frame's statistics ([`FrameStats::crossings`]), or
+    /// stops. On by default where cloth can meet cloth (self-collision on, or two cloths in one
+    /// solver), off elsewhere: the measure costs about what a frame of contact does.
+    pub fn set_measure_crossings(&mut self, on: bool) {
+        self.crossing_meshes = on.then(|| {
+            self.groups
+                .iter()
+                .map(|g| SolverMesh::new(&self.scene, g))
+                .collect()
+        });
+    }
+
+    /// Whether crossings are measured.
+    pub fn measures_crossings(&self) -> bool {
+        self.crossing_meshes.is_some()
+    }
+
+    /// Cloth that crossed itself or another cloth of its solver when the scene was built: the
+    /// run goes on (contact cannot undo a crossing it did not cause), a warning is due.
+    pub fn start_crossings(&self) -> &[StartCrossing] {
+        &self.start_crossings
+    }
+
+    /// The crossings of the present state, measured whether or not frames measure them.
+    pub fn crossings_now(&self) -> CrossingStats {
+        let measure = |meshes: &[SolverMesh]| {
+            crossings::combine(self.groups.iter().zip(meshes).map(|(g, m)| m.measure(g)))
+        };
+        match &self.crossing_meshes {
+            Some(m) => measure(m),
+            None => measure(
+                &self
+                    .groups
+                    .iter()
+                    .map(|g| SolverMesh::new(&self.scene, g))
+                    .collect::<Vec<_>>(),
+            ),
+        }
     }
 
     /// Lets every solver poll `stop` once per substep (see `Solver::set_stop`), and its
@@ -170,18 +225,25 @@ impl Simulation {
             s.residual_max = s.residual_max.max(r.max);
             s.residual_rms = s.residual_rms.max(r.rms);
         }
+        if self.crossing_meshes.is_some() {
+            s.crossings = Some(self.crossings_now());
+        }
         s
     }
 
     /// Steps every solver one frame; on divergence the state is left as the solver left it.
     pub fn step(&mut self) -> Result<FrameStats, SolverError> {
         let start = Instant::now();
-        let mut contacts = 0;
+        let (mut contacts, mut cg) = (0, 0);
         for g in &mut self.groups {
-            contacts += g.step()?.contacts;
+            let st = g.step()?;
+            contacts += st.contacts;
+            cg += u64::from(st.cg_iterations);
         }
         self.frame += 1;
-        Ok(self.stats(start.elapsed().as_secs_f64() * 1e3, contacts))
+        let mut s = self.stats(start.elapsed().as_secs_f64() * 1e3, contacts);
+        s.cg_iterations = cg;
+        Ok(s)
     }
 }
 

@@ -98,7 +98,12 @@ pub(super) fn cloth(
         }
     }
     let thickness = s.thickness.unwrap_or(DEFAULT_THICKNESS);
-    c.within(&k("thickness"), thickness, &ranges::THICKNESS);
+    let thickness_ok = c.check(
+        &k("thickness"),
+        thickness,
+        thickness > 0.0,
+        "finite and > 0 m (contact keeps cloth this far from colliders and other cloth)",
+    ) && c.within(&k("thickness"), thickness, &ranges::THICKNESS);
     let motion = c.motion(&k("motion"), &s.motion);
     let seam_time = s.seam_time.unwrap_or(DEFAULT_SEAM_TIME);
     let mut seams = Vec::new();
@@ -214,6 +219,9 @@ pub(super) fn cloth(
         .map_err(|e| mesh_error(c, name, &e, false))
         .ok()?
     };
+    if thickness_ok {
+        thinner_than_the_cloth(c, &k("thickness"), thickness, &mesh);
+    }
     if let Some(m) = material {
         params = m.params(&mesh, settings, &params);
     }
@@ -259,4 +267,31 @@ fn mesh_error(c: &mut Checker<'_>, name: &str, e: &MeshError, is_mesh: bool) {
         _ => "mesh",
     };
     c.bad(&format!("cloth.{name}.{field}"), e.to_string());
+}
+
+/// A thickness larger than the cloth itself is no layer: the cloth's smallest dimension is the
+/// middle side of its bounding box at rest (a flat sheet's shorter side, however it lies; a
+/// garment's panels as placed around the body).
+fn thinner_than_the_cloth(c: &mut Checker<'_>, key: &str, thickness: f64, mesh: &ClothMesh) {
+    let (lo, hi) = mesh.positions.iter().fold(
+        (
+            weft_solver::glam::DVec3::INFINITY,
+            weft_solver::glam::DVec3::NEG_INFINITY,
+        ),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let mut sides = (hi - lo).to_array();
+    sides.sort_by(f64::total_cmp);
+    let smallest = sides[1];
+    if smallest.is_finite() && thickness > smallest {
+        c.bad(
+            key,
+            format!(
+                "must not exceed the cloth's smallest dimension ({} m, the middle side of its \
+                 bounding box at rest), got {}",
+                super::checker::show(smallest),
+                super::checker::show(thickness)
+            ),
+        );
+    }
 }

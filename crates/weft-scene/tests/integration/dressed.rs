@@ -177,3 +177,36 @@ fn skirt_bytes(threads: usize, frames: usize) -> Vec<u8> {
 fn the_dressed_walker_gives_the_same_bytes_on_one_and_two_threads() {
     assert_eq!(skirt_bytes(1, 30), skirt_bytes(2, 30));
 }
+
+#[test]
+fn the_layered_outfit_starts_uncrossed_in_one_solver_and_runs() {
+    // The T-shirt under the cape, both 1.5 mm: one method, so one solver holds both (they
+    // can meet); nothing crosses at the start (the cape hangs 3 cm behind the shirt's back
+    // panel); the first 20 frames (past the shirt's seams) stay finite and on the body.
+    let scene = load(&scenes_dir().join("layered_outfit.toml"), &[]);
+    assert!(scene.cloths.iter().all(|c| c.thickness == 0.0015));
+    let mut groups = scene.build().expect("builds");
+    assert_eq!(groups.len(), 1);
+    let g = &mut groups[0];
+    assert_eq!(g.solver.cloths().len(), 2);
+    let triangles: Vec<[u32; 3]> = g
+        .solver
+        .cloths()
+        .iter()
+        .flat_map(|c| c.triangles.iter().copied())
+        .collect();
+    let start = weft_collide::crossings::measure(&g.solver.particles().positions, &triangles, 0.0);
+    assert_eq!(start.crossings, 0);
+    for frame in 0..20 {
+        g.step()
+            .unwrap_or_else(|e| panic!("layered_outfit, frame {frame}: {e}"));
+    }
+    let far = g
+        .solver
+        .particles()
+        .positions
+        .iter()
+        .map(|p| p.length())
+        .fold(0.0, f64::max);
+    assert!(far < 3.0, "a particle {far} m from the origin");
+}

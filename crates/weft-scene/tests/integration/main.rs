@@ -16,3 +16,4 @@ mod self_fold;
 mod shipped_scenes;
 mod sphere_drop;
 mod table_drape;
+mod thickness;
