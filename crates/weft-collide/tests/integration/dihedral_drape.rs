@@ -78,12 +78,15 @@ fn draped_cloth_with_dihedral_bending_loses_energy_under_xpbd_and_pbd() {
                 3.5 + 0.5 * (k + 1) as f64
             );
         }
-        // After the landing (the first second), the motion never again reaches its peak.
+        // After the landing (the first second) and the swing that follows it, the motion never
+        // again comes near its peak. Converged bending (stiff hinges solved by conjugate
+        // gradients, as the cantilever measures) swings for longer than the old, too soft
+        // single sweep: the window from 1 s to 1.5 s still holds 0.6 of the landing's peak.
         let landing = windows[0].max(windows[1]);
-        let later = windows[2..].iter().copied().fold(0.0, f64::max);
+        let later = windows[3..].iter().copied().fold(0.0, f64::max);
         assert!(
             later < 0.5 * landing,
-            "{method}: peak KE {later} J after 1 s against {landing} J at the landing"
+            "{method}: peak KE {later} J after 1.5 s against {landing} J at the landing"
         );
     }
 }
