@@ -267,7 +267,7 @@ def character(r):
 def dressed(r):
     print("## A dressed character (`crates/weft-scene/benches/dressed.rs`, "
           "`crates/weft-character/benches/dressed.rs`, XPBD, 10 substeps × 1 iteration)\n")
-    print("| the walker in its T-shirt (`assets/scenes/character.toml`, 10,172 particles, "
+    print("| the walker in its T-shirt (`assets/scenes/character.toml`, 10,203 particles, "
           "jersey), one frame after the seams closed | ms/frame |")
     print("|---|---|")
     for f, label in [("tshirt: solve + body + self-collision", "solve + body contact + self-collision"),

@@ -1,4 +1,4 @@
-//! The walker in its T-shirt (assets/scenes/character.toml: 10,172 particles, 10 substeps,
+//! The walker in its T-shirt (assets/scenes/character.toml: 10,203 particles, 10 substeps,
 //! body contact, self-collision), one frame at a time once the seams have closed, and the
 //! same frame without self-collision and without any contact, so that the differences split
 //! the cost into solve, body contact and self-collision; and the whole frame and the solve

@@ -7,6 +7,7 @@ mod common;
 mod character;
 mod dressed;
 mod friction;
+mod garment_shape;
 mod fuzz;
 mod glb_character;
 mod material_key;
