@@ -66,14 +66,14 @@ fn shipped_garments_start_outside_the_walker() {
             None => assert!(hi < 0.07, "armhole seam {k}: pairs up to {hi} m apart"),
         }
     }
-    // Skirt: front and back 0.28 m apart at the waist, each leaning out 10° over its 0.45 m,
-    // so 0.28 + 2 · 0.45 sin 10° apart at the hem.
-    let hem = 0.28 + 2.0 * 0.45 * 10f64.to_radians().sin();
+    // Skirt: front and back hems 2 × 0.218 m apart, each panel leaning in 10° over its
+    // 0.45 m up to the waist, so 0.436 − 2 · 0.45 sin 10° (about 0.28 m) apart there.
+    let waist = 0.436 - 2.0 * 0.45 * 10f64.to_radians().sin();
     let skirt = seam_gaps(&garment("skirt"));
     assert!(
         skirt
             .iter()
-            .all(|&(lo, hi)| (lo - 0.28).abs() < 1e-6 && (hi - hem).abs() < 1e-6),
+            .all(|&(lo, hi)| (lo - waist).abs() < 1e-9 && (hi - 0.436).abs() < 1e-9),
         "{skirt:?}"
     );
 }
