@@ -21,6 +21,10 @@
 //!
 //! Every part is parallel over pairs and sums in the list's order: same bits on any thread
 //! count.
+//!
+//! The grid of `broad` and the segment distance of `geometry` resemble those of
+//! `crate::crossings` on purpose: that module judges contact in the tests, so it shares no
+//! code with it.
 
 mod broad;
 mod failsafe;
