@@ -225,8 +225,9 @@ impl ClothContact {
     }
 
     /// One sweep of proximity contacts; returns the contact count and the deepest overlap.
-    pub(crate) fn project(&mut self, p: &mut Particles) -> (usize, f64) {
+    pub(crate) fn project(&mut self, p: &mut Particles, pressed: &[bool]) -> (usize, f64) {
         self.check(p);
+        self.sweep.weigh(p, pressed);
         let mut s = self
             .sweep
             .run(&self.el, &self.list, p, self.params.friction);

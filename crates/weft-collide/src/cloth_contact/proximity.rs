@@ -25,6 +25,14 @@ use super::topology::Elements;
 use crate::friction::Friction;
 use crate::trimesh::closest::Feature;
 
+/// How many times heavier a particle a collider pressed counts in the layers' push. Where a
+/// collider pushes two layers onto one surface, pushing them apart by their masses alone moves
+/// the lower one back into the collider, and the squeezed pair creeps together substep after
+/// substep until the fail-safe freezes it: measured on two 2 mm sheets over a ball, at 1 their
+/// closest approach at rest was 0.64 mm with 23 impacts a frame while landing; at 10 it is
+/// 1.3 mm with 2.
+const PRESSED_WEIGHT: f64 = 10.0;
+
 /// One pair's corrections: four particles (a triangle's pair repeats none; an unused slot has
 /// weight zero) and the depth below the distance kept.
 type Correction = ([u32; 4], [DVec3; 4], f64);
@@ -35,6 +43,7 @@ pub(crate) struct Sweep {
     sum: Vec<DVec3>,
     count: Vec<u32>,
     touched: Vec<u32>,
+    weights: Vec<f64>,
 }
 
 /// What a sweep did: contacts and the deepest overlap (m).
@@ -47,6 +56,21 @@ pub(crate) struct SweepStats {
 }
 
 impl Sweep {
+    /// Inverse masses for the push: a particle a collider moved in this projection weighs
+    /// [`PRESSED_WEIGHT`] times its mass, so the layer over it moves out rather than it into
+    /// the collider.
+    pub(crate) fn weigh(&mut self, p: &Particles, pressed: &[bool]) {
+        self.weights.clear();
+        self.weights
+            .extend((p.inv_masses.iter().enumerate()).map(|(i, &w)| {
+                if pressed.get(i).copied().unwrap_or(false) {
+                    w / PRESSED_WEIGHT
+                } else {
+                    w
+                }
+            }));
+    }
+
     /// One sweep over `list`'s pairs at `p`'s positions, with `friction` between the layers.
     pub(crate) fn run(
         &mut self,
@@ -60,7 +84,7 @@ impl Sweep {
             self.sum = vec![DVec3::ZERO; n];
             self.count = vec![0; n];
         }
-        let (x, prev, w) = (&p.positions, &p.prev_positions, &p.inv_masses);
+        let (x, prev, w) = (&p.positions, &p.prev_positions, &self.weights);
         let vf: Vec<Correction> = (list.vf.par_iter())
             .filter_map(|&(v, f, t)| {
                 let tri = el.triangles[f as usize];
