@@ -224,10 +224,16 @@ impl ClothContact {
         self.check(p);
     }
 
+    /// Before the colliders' contacts of a projection: where each particle is, so that
+    /// [`Self::project`] can weigh those the colliders move.
+    pub(crate) fn before_colliders(&mut self, p: &Particles) {
+        self.sweep.remember(p);
+    }
+
     /// One sweep of proximity contacts; returns the contact count and the deepest overlap.
-    pub(crate) fn project(&mut self, p: &mut Particles, pressed: &[bool]) -> (usize, f64) {
+    pub(crate) fn project(&mut self, p: &mut Particles) -> (usize, f64) {
         self.check(p);
-        self.sweep.weigh(p, pressed);
+        self.sweep.weigh(p);
         let mut s = self
             .sweep
             .run(&self.el, &self.list, p, self.params.friction);

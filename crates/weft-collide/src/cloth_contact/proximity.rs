@@ -44,6 +44,8 @@ pub(crate) struct Sweep {
     count: Vec<u32>,
     touched: Vec<u32>,
     weights: Vec<f64>,
+    /// Positions before the colliders' contacts of this projection.
+    before: Vec<DVec3>,
 }
 
 /// What a sweep did: contacts and the deepest overlap (m).
@@ -56,19 +58,28 @@ pub(crate) struct SweepStats {
 }
 
 impl Sweep {
-    /// Inverse masses for the push: a particle a collider moved in this projection weighs
-    /// [`PRESSED_WEIGHT`] times its mass, so the layer over it moves out rather than it into
-    /// the collider.
-    pub(crate) fn weigh(&mut self, p: &Particles, pressed: &[bool]) {
+    /// Keeps `p`'s positions before the colliders' contacts (see [`Self::weigh`]).
+    pub(crate) fn remember(&mut self, p: &Particles) {
+        self.before.clear();
+        self.before.extend_from_slice(&p.positions);
+    }
+
+    /// Inverse masses for the push: a particle a collider moved since [`Self::remember`]
+    /// weighs [`PRESSED_WEIGHT`] times its mass, so the layer over it moves out rather than it
+    /// into the collider.
+    pub(crate) fn weigh(&mut self, p: &Particles) {
+        let before = &self.before;
         self.weights.clear();
         self.weights
-            .extend((p.inv_masses.iter().enumerate()).map(|(i, &w)| {
-                if pressed.get(i).copied().unwrap_or(false) {
-                    w / PRESSED_WEIGHT
-                } else {
-                    w
-                }
-            }));
+            .extend(
+                (p.inv_masses.iter().zip(&p.positions).enumerate()).map(|(i, (&w, x))| {
+                    if before.get(i).is_some_and(|b| b != x) {
+                        w / PRESSED_WEIGHT
+                    } else {
+                        w
+                    }
+                }),
+            );
     }
 
     /// One sweep over `list`'s pairs at `p`'s positions, with `friction` between the layers.

@@ -734,7 +734,9 @@ impl SubstepHook for CollisionWorld {
             None => (0, 0.0),
         };
         // Cloth contact weighs the particles the colliders move (see `cloth_contact`).
-        let before = (self.cloth_contact.as_ref()).map(|_| particles.positions.clone());
+        if let Some(cc) = &mut self.cloth_contact {
+            cc.before_colliders(particles);
+        }
         let (mut collider_contacts, swept) = self.resolve_colliders(particles, fresh);
         for b in &mut self.bodies {
             let c = b.contact(particles, &self.thickness, fresh);
@@ -750,13 +752,7 @@ impl SubstepHook for CollisionWorld {
         // continuous check (`end_substep`) judges the result.
         let (self_contacts, self_depth) = match &mut self.cloth_contact {
             Some(cc) => {
-                let pressed: Vec<bool> = match &before {
-                    Some(b) => (b.iter().zip(&particles.positions))
-                        .map(|(a, c)| a != c)
-                        .collect(),
-                    None => Vec::new(),
-                };
-                let (n, depth) = cc.project(particles, &pressed);
+                let (n, depth) = cc.project(particles);
                 (self_contacts + n, self_depth.max(depth))
             }
             None => (self_contacts, self_depth),
