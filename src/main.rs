@@ -6,6 +6,7 @@
 mod say;
 mod app;
 mod cli;
+mod crossing_report;
 mod default_scene;
 mod experiments;
 mod explain;
@@ -188,6 +189,9 @@ fn check(args: &cli::CheckArgs) -> anyhow::Result<ExitCode> {
                         }
                     }
                 }
+            }
+            for c in weft_sim::crossings::start_crossings(&scene, &groups) {
+                say!("  warning: {c}")?;
             }
             Ok(ExitCode::SUCCESS)
         }

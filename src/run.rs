@@ -12,6 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use weft_scene::Scene;
 use weft_solver::SolverError;
 
+use crate::crossing_report::CrossingTally;
 use crate::output::{Named, Output, refuse_clashes};
 use weft_record::{RecordOptions, Recorder, Status};
 use weft_sim::Simulation;
@@ -94,6 +95,7 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
             "--strict: a cloth's springs are past their stability limit; nothing was run"
         );
     }
+    crate::crossing_report::warn_start(&sim);
     sim.set_stop(Arc::clone(stop));
     // From here a signal raises the flag: the loop below stops and closes the log.
     let _polling = crate::stop::Polling::start();
@@ -119,6 +121,7 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
     let mut status = Status::Complete;
     let mut torn = false;
     let mut last = sim.stats(0.0, 0);
+    let mut tally = CrossingTally::default();
     let result = (|| -> anyhow::Result<()> {
         if let Some(r) = rec.as_mut() {
             r.frame(&sim, &last)?;
@@ -131,6 +134,7 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
             match sim.step() {
                 Ok(stats) => {
                     last = stats;
+                    tally.add(&stats);
                     if let Some(r) = rec.as_mut() {
                         r.frame(&sim, &stats)?;
                         if stats.frame % 16 == 0 {
@@ -213,6 +217,9 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
         last.residual_max,
         last.kinetic_energy,
     )?;
+    if let Some(line) = tally.line() {
+        say!("crossings: {line}")?;
+    }
     if let Some(peak) = crate::limits::peak_memory() {
         say!(
             "memory: peak {}, estimated {}",

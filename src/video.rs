@@ -562,6 +562,7 @@ pub fn render(
     let gpu = Gpu::headless().context("cannot render")?;
     let mut sim = Simulation::new(scene)?;
     crate::stability::warn(&sim.groups);
+    crate::crossing_report::warn_start(&sim);
     // From here a signal raises the flag (the solver sees it within a substep) and the images
     // rendered so far are kept.
     sim.set_stop(Arc::clone(stop));

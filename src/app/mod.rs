@@ -81,6 +81,7 @@ pub fn view(args: &ViewArgs, stop: Arc<AtomicBool>) -> anyhow::Result<ExitCode> 
     let file = args.record.as_deref().map(Output::create_log).transpose()?;
     let sim = Simulation::new(scene)?;
     crate::stability::warn(&sim.groups);
+    crate::crossing_report::warn_start(&sim);
     let log = file
         .map(|f| {
             SessionLog::new(

@@ -253,6 +253,15 @@ fn stats_section(ui: &mut Ui, session: &Session) {
             s.contacts.to_string(),
             "cloth–collider contacts in the last frame",
         );
+        if let Some(c) = &s.crossings {
+            row(
+                "crossings",
+                crate::crossing_report::frame_text(c),
+                "edge–triangle crossings between cloth elements in the last frame (0 while \
+                 contact holds), and how close non-adjacent elements came, by a count \
+                 independent of contact",
+            );
+        }
         row(
             "sim time",
             format!("{time:.3} s"),

@@ -55,6 +55,8 @@ pub struct Stats {
     pub dropped_last: u32,
     /// Contacts in the last substep.
     pub contacts: usize,
+    /// Cloth crossings of the last frame, when measured.
+    pub crossings: Option<weft_sim::CrossingStats>,
 }
 
 /// The simulation the window shows.
@@ -126,6 +128,7 @@ impl Session {
             Ok(stats) => {
                 self.stats.step_ms = start.elapsed().as_secs_f64() * 1e3;
                 self.stats.contacts = stats.contacts;
+                self.stats.crossings = stats.crossings;
                 self.stats.steps_last += 1;
                 self.frames += 1;
                 if let Some(log) = self.log.as_mut() {

@@ -6,6 +6,7 @@ mod common;
 
 mod bad_input;
 mod collider_state;
+mod crossing_report;
 mod e2e_drag;
 mod e2e_keys;
 mod e2e_view;

@@ -49,9 +49,7 @@ impl SolverGroup {
             && let Some(w) = self.world.as_mut()
         {
             // The cloths and parameters were checked when the scene was built.
-            if w.enable_self_collision(&self.solver, &d.cloths, d.params)
-                .is_ok()
-            {
+            if d.contact.enable(w, &self.solver, &d.cloths).is_ok() {
                 self.delayed_self_collision = None;
             }
         }
@@ -106,6 +104,9 @@ impl Scene {
                 }
                 if c.motion != Motion::Static {
                     for &v in &c.mesh.pinned {
+                        if c.held.binary_search(&v).is_ok() {
+                            continue;
+                        }
                         b.add_kinematic_pin(idx, v, c.motion)
                             .map_err(|e| err(key.clone(), &e))?;
                     }

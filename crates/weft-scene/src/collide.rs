@@ -4,11 +4,14 @@
 use std::sync::Arc;
 
 use weft_collide::{
-    ColliderDesc, CollisionWorld, Friction, KinematicBody, MeshAnimation, SelfCollisionParams,
+    ClothContactParams, CollideError, ColliderDesc, CollisionWorld, Friction, KinematicBody,
+    MeshAnimation, SelfCollisionParams,
 };
 use weft_solver::Solver;
 
 use crate::error::{Origin, SceneError};
+use crate::scene::{ColliderSpec, Scene};
+use crate::schema::ContactKind;
 
 /// Self-collision to turn on once a garment's seams have closed.
 #[derive(Clone, Debug)]
@@ -17,10 +20,34 @@ pub struct DelayedSelfCollision {
     pub at: f64,
     /// The solver's cloths that take part.
     pub cloths: Vec<usize>,
-    /// Its parameters.
-    pub params: SelfCollisionParams,
+    /// Its kind and parameters.
+    pub contact: SelfContact,
 }
-use crate::scene::{ColliderSpec, Scene};
+
+/// What keeps a scene's cloths apart, with its parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SelfContact {
+    /// Particle–particle self-collision.
+    Particles(SelfCollisionParams),
+    /// Mesh-level cloth contact.
+    Mesh(ClothContactParams),
+}
+
+impl SelfContact {
+    /// Turns it on in `world` among `cloths` of `solver` (their present positions the rest
+    /// state).
+    pub fn enable(
+        &self,
+        world: &mut CollisionWorld,
+        solver: &Solver,
+        cloths: &[usize],
+    ) -> Result<(), CollideError> {
+        match *self {
+            Self::Particles(p) => world.enable_self_collision(solver, cloths, p),
+            Self::Mesh(p) => world.enable_cloth_contact(solver, cloths, p),
+        }
+    }
+}
 
 /// The collision crate's description of a collider (the shape is already in its form).
 pub fn collider_desc(c: &ColliderSpec) -> ColliderDesc {
@@ -84,11 +111,18 @@ impl Scene {
         if let Some(sc) = &self.self_collision
             && !self_cloths.is_empty()
         {
-            let params = SelfCollisionParams {
-                friction: Friction::new(sc.static_friction, sc.dynamic_friction),
-                max_displacement: sc.max_displacement,
-                search_margin: sc.search_margin,
-                adaptive_margin: sc.adaptive_search_margin,
+            let friction = Friction::new(sc.static_friction, sc.dynamic_friction);
+            let contact = match sc.contact {
+                ContactKind::Particles => SelfContact::Particles(SelfCollisionParams {
+                    friction,
+                    max_displacement: sc.max_displacement,
+                    search_margin: sc.search_margin,
+                    adaptive_margin: sc.adaptive_search_margin,
+                }),
+                ContactKind::Mesh => SelfContact::Mesh(ClothContactParams {
+                    friction,
+                    ..ClothContactParams::default()
+                }),
             };
             let sewn_at = self_cloths
                 .iter()
@@ -101,11 +135,11 @@ impl Scene {
                     delayed = Some(DelayedSelfCollision {
                         at,
                         cloths: self_cloths,
-                        params,
+                        contact,
                     })
                 }
-                _ => world
-                    .enable_self_collision(solver, &self_cloths, params)
+                _ => contact
+                    .enable(&mut world, solver, &self_cloths)
                     .map_err(|e| self.collide_error("self_collision".into(), e.to_string()))?,
             }
         }

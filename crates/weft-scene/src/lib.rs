@@ -20,11 +20,12 @@ mod source;
 mod suggest;
 
 pub use build::SolverGroup;
-pub use collide::{DelayedSelfCollision, collider_desc};
+pub use collide::{DelayedSelfCollision, SelfContact, collider_desc};
 pub use error::{LONGEST_WORD, Origin, SceneError, SceneErrors, elide};
 pub use limits::{
     BASE_BYTES, BYTES_PER_PAIR, BYTES_PER_PARTICLE, Limits, Member, PER_PARTICLE_SELF_COLLISION,
-    available_memory, estimate_bytes, human, peak_memory, self_collision_pairs,
+    available_memory, contact_pairs, estimate_bytes, human, mesh_contact_pairs, peak_memory,
+    self_collision_pairs,
 };
 pub use load::{from_text, from_text_with, load, load_with};
 pub use overrides::{Override, parse_value};

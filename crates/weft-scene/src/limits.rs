@@ -2,7 +2,7 @@
 //! the scene may need once built, estimated from its particle count before any cloth exists.
 
 use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, Scene, SelfCollisionSpec};
-use crate::schema::{DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, SceneFile};
+use crate::schema::{ContactKind, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, SceneFile};
 
 /// What a load may read and allocate.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -120,6 +120,39 @@ pub fn self_collision_pairs(members: &[Member], margin: f64, adaptive: bool) -> 
     (total as f64 * partners / 2.0).ceil() as u64
 }
 
+/// A bound on the element pairs mesh-level cloth contact lists for `members`. Pairs are listed
+/// while their boxes lie within D = 3 t (the reach t, the largest thickness, and a skin of
+/// 2 t); an element's box is at most h = √(2 a) across (a the smallest area per particle), so
+/// a vertex's partners lie within D + h in each of the 2D/t + 1 layers contact keeps t apart,
+/// π (D + h)² / a particles a layer. Each particle brings two triangles and three edges: its
+/// vertex meets two triangles of each partner and its three edges three of each partner's,
+/// 6.5 pairs per partner, each listed once.
+pub fn mesh_contact_pairs(members: &[Member]) -> u64 {
+    let total: u64 = members.iter().map(|m| m.particles).sum();
+    let t = members.iter().map(|m| m.thickness).fold(0.0, f64::max);
+    if total < 2 || t <= 0.0 {
+        return 0;
+    }
+    let a = members
+        .iter()
+        .filter(|m| m.particles > 0)
+        .map(|m| m.area / m.particles as f64)
+        .fold(f64::INFINITY, f64::min);
+    let d = 3.0 * t;
+    let r = d + (2.0 * a).sqrt();
+    let partners = ((2.0 * d / t + 1.0) * std::f64::consts::PI * r * r / a).min((total - 1) as f64);
+    (total as f64 * partners * 6.5 / 2.0).ceil() as u64
+}
+
+/// The candidate pairs of `members` under contact `kind` (see [`self_collision_pairs`] and
+/// [`mesh_contact_pairs`]).
+pub fn contact_pairs(members: &[Member], kind: ContactKind, margin: f64, adaptive: bool) -> u64 {
+    match kind {
+        ContactKind::Particles => self_collision_pairs(members, margin, adaptive),
+        ContactKind::Mesh => mesh_contact_pairs(members),
+    }
+}
+
 /// The memory a scene of `particles` needs once built and running: the process, the
 /// particles, and with self-collision its `members` and their candidate `pairs` (see
 /// [`self_collision_pairs`]).
@@ -175,7 +208,12 @@ pub(crate) fn built_pairs(cloths: &[ClothSpec], sc: Option<&SelfCollisionSpec>) 
         })
         .collect();
     let count = members.iter().map(|m| m.particles).sum();
-    let pairs = self_collision_pairs(&members, sc.search_margin, sc.adaptive_search_margin);
+    let pairs = contact_pairs(
+        &members,
+        sc.contact,
+        sc.search_margin,
+        sc.adaptive_search_margin,
+    );
     (count, pairs)
 }
 

@@ -8,13 +8,12 @@ use toml_edit::DocumentMut;
 use crate::duplicate::{Duplicate, duplicate};
 use crate::error::{Origin, SceneError, SceneErrors};
 use crate::limits::{
-    BYTES_PER_PAIR, Limits, Member, built_bytes, estimate_bytes, grid_members, human,
-    self_collision_pairs,
+    BYTES_PER_PAIR, Limits, Member, built_bytes, contact_pairs, estimate_bytes, grid_members, human,
 };
 use crate::overrides::{self, Override};
 use crate::resolve::{Checker, resolve};
 use crate::scene::{CappedDirFiles, Files, Scene, read_regular};
-use crate::schema::SceneFile;
+use crate::schema::{ContactKind, SceneFile};
 use crate::source::{Source, key_at, line_at};
 use crate::suggest::closest;
 
@@ -127,10 +126,11 @@ pub fn from_text_with(
         let grids = grid_members(&file);
         let total: u64 = grids.iter().map(|(_, m, _)| m.particles).sum();
         let members: Vec<Member> = (grids.iter()).filter(|g| g.2).map(|g| g.1).collect();
-        let (margin, adaptive) = (file.self_collision.as_ref()).map_or((0.0, false), |s| {
-            (s.search_margin, s.adaptive_search_margin)
-        });
-        let pairs = self_collision_pairs(&members, margin, adaptive);
+        let (kind, margin, adaptive) = (file.self_collision.as_ref())
+            .map_or((ContactKind::Particles, 0.0, false), |s| {
+                (s.contact, s.search_margin, s.adaptive_search_margin)
+            });
+        let pairs = contact_pairs(&members, kind, margin, adaptive);
         let count = members.iter().map(|m| m.particles).sum();
         let need = estimate_bytes(total, count, pairs);
         let thickest =
@@ -347,5 +347,23 @@ mod tests {
             err.contains("s.toml") && err.contains("adaptive_search_margin"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn contact_is_particles_unless_the_scene_asks_for_the_mesh() {
+        let spec = |scene: Scene| scene.self_collision.expect("self-collision on");
+        assert_eq!(
+            spec(self_collision("").expect("valid")).contact,
+            ContactKind::Particles
+        );
+        let mesh = self_collision("contact = \"mesh\"\n").expect("valid");
+        assert_eq!(spec(mesh.clone()).contact, ContactKind::Mesh);
+        let groups = mesh.build().expect("builds");
+        let world = groups[0].world.as_ref().expect("a collision world");
+        assert!(world.cloth_contact_stats().is_some(), "mesh contact is on");
+        let err = self_collision("contact = \"edges\"\n")
+            .expect_err("no such contact")
+            .to_string();
+        assert!(err.contains("s.toml:6: self_collision.contact"), "{err}");
     }
 }

@@ -9,7 +9,7 @@ use weft_solver::glam::{DQuat, DVec3};
 use weft_solver::{ClothMesh, ClothParams, Forces, Method, Motion, Settings, Topology};
 
 use crate::overrides::Override;
-use crate::schema::SceneFile;
+use crate::schema::{ContactKind, SceneFile};
 
 /// Reads the files a scene names (OBJ meshes), by the path written in the scene.
 pub trait Files {
@@ -106,6 +106,8 @@ pub struct ClothSpec {
     pub thickness: f64,
     /// Motion of its pins.
     pub motion: Motion,
+    /// Pinned particles that stay still whatever `motion` does, ascending.
+    pub held: Vec<u32>,
     /// Garment seams: vertex pairs (mesh indices) to sew (empty for other cloths).
     pub seams: Vec<[u32; 2]>,
     /// Time over which the seams close (s).
@@ -236,6 +238,8 @@ pub struct SelfCollisionSpec {
     pub search_margin: f64,
     /// Whether the search margin follows the cloth's motion.
     pub adaptive_search_margin: bool,
+    /// Particle or mesh-level contact.
+    pub contact: ContactKind,
 }
 
 /// A validated scene.

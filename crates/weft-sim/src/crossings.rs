@@ -167,12 +167,17 @@ pub(crate) fn combine(parts: impl IntoIterator<Item = CrossingStats>) -> Crossin
         .into_iter()
         .fold(CrossingStats::default(), |acc, s| CrossingStats {
             crossings: acc.crossings + s.crossings,
-            closest: match (acc.closest, s.closest) {
-                (Some(a), Some(b)) => Some(a.min(b)),
-                (a, b) => a.or(b),
-            },
+            closest: closer(acc.closest, s.closest),
             reach: acc.reach.max(s.reach),
         })
+}
+
+/// The closer of two closest approaches, either of which may be missing (nothing in reach).
+pub fn closer(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
 }
 
 /// Whether cloth can meet cloth in `scene`: self-collision is on for some cloth, or a solver

@@ -3,9 +3,12 @@
 //! (`weft_collide::crossings::measure`, through `Simulation`'s statistics, each solver's
 //! cloths together, a closed seam's two sides as one vertex).
 //!
-//! Scenes whose thin cloth meets cloth wait for mesh-level cloth contact (issue 62):
+//! Single sheets that fold over a collider with no cloth contact turned on cross themselves:
 //! [`AWAITING_MESH_CONTACT`] lists them, and [`they_still_cross_today`] checks that they do,
-//! so the list cannot outlive the contact that empties it.
+//! so the list cannot outlive the contact that empties it. The thin layers (`layers.toml`,
+//! `towel_fold.toml`, `twist.toml`) hold by mesh contact and are checked with the rest; the
+//! twist's turning pins ([`PIN_DRIVEN`]) may force cloth through cloth, but only after the
+//! contact's fail-safe has reported a pair it could not stop.
 
 use std::path::{Path, PathBuf};
 
@@ -16,20 +19,18 @@ use weft_solver::Method;
 /// Frames each scene runs under each method (2 s at 60 frames a second).
 const FRAMES: u64 = 120;
 
-/// Scenes whose cloth passes through itself or another cloth today, as measured: particle
-/// self-collision alone cannot keep thin cloth apart (its particles slip between each
-/// other's), and a single sheet with no self-collision that folds over a ball, a table or the
-/// bumpy blob (`sphere_drop`, `table_drape`, `mesh_drape`) folds through itself.
-const AWAITING_MESH_CONTACT: &[&str] = &[
-    "layers.toml",
-    "mesh_drape.toml",
-    "sphere_drop.toml",
-    "table_drape.toml",
-];
+/// Scenes whose cloth passes through itself today, as measured: a single sheet with no
+/// self-collision that folds over a ball, a table or the bumpy blob folds through itself.
+const AWAITING_MESH_CONTACT: &[&str] = &["mesh_drape.toml", "sphere_drop.toml", "table_drape.toml"];
 
 /// Scenes checked for longer than [`FRAMES`]: `towel_fold.toml` folds its layers together
 /// only after 2 s.
 const LONGER: &[(&str, u64)] = &[("towel_fold.toml", 300)];
+
+/// Scenes whose pins are driven through cloth by design: the twist's turning edge winds the
+/// sheet until, past about half a turn, it drags cloth through cloth where no free particle
+/// can give way. Their crossings must come after the fail-safe reports such a forced pair.
+const PIN_DRIVEN: &[&str] = &["twist.toml"];
 
 /// Scenes built to diverge under some method, by design.
 const BUILT_TO_EXPLODE: &[&str] = &["explode.toml"];
@@ -60,6 +61,13 @@ pub struct Run {
     pub checked: usize,
     /// The frame with the most crossings and how many, if any crossed.
     pub worst: Option<(u64, usize)>,
+    /// Pairs the mesh contact's fail-safe found forced together by pins (every free particle
+    /// of the pair frozen, the pins still driving it in), over every substep of the run (0
+    /// without mesh contact).
+    pub forced: u64,
+    /// The first checked frame that crossed before any pair was forced, and its count: a
+    /// crossing the contact let through, not one the pins made.
+    pub unforced: Option<(u64, usize)>,
 }
 
 /// Runs `path` (with `extra` overrides) under every method for `frames` frames and counts the
@@ -80,6 +88,8 @@ pub fn crossings_under_every_method(path: &Path, extra: &[String], frames: u64) 
                 method,
                 checked: 0,
                 worst: None,
+                forced: 0,
+                unforced: None,
             };
             for k in 0..frames {
                 // Measured only on the frames checked: the count costs about a frame.
@@ -96,10 +106,22 @@ pub fn crossings_under_every_method(path: &Path, extra: &[String], frames: u64) 
                 if n > 0 && run.worst.is_none_or(|(_, w)| n > w) {
                     run.worst = Some((s.frame, n));
                 }
+                if n > 0 && run.unforced.is_none() && forced_so_far(&sim) == 0 {
+                    run.unforced = Some((s.frame, n));
+                }
             }
+            run.forced = forced_so_far(&sim);
             run
         })
         .collect()
+}
+
+/// Pairs forced through each other by pins so far, over every solver's mesh contact.
+fn forced_so_far(sim: &Simulation) -> u64 {
+    (sim.groups.iter())
+        .filter_map(|g| g.world.as_ref()?.cloth_contact_stats())
+        .map(|s| s.forced_so_far)
+        .sum()
 }
 
 /// The scene at `path` with every cloth switched to `method` (one solver for all).
@@ -149,7 +171,12 @@ fn no_shipped_scene_crosses_under_any_method() {
         for run in crossings_under_every_method(path, &[], frames) {
             println!("{} under {}: {run:?}", path.display(), run.method);
             assert!(run.checked >= 10, "{}: {run:?}", path.display());
-            if let Some((frame, n)) = run.worst {
+            let let_through = if PIN_DRIVEN.contains(&name) {
+                run.unforced
+            } else {
+                run.worst
+            };
+            if let Some((frame, n)) = let_through {
                 failed.push(format!(
                     "{} under {}: {n} crossings at frame {frame}",
                     path.display(),

@@ -156,8 +156,23 @@ impl GridDesc {
             return Err(MeshError::InvalidMass { value: mass_value });
         }
         let masses = lumped_masses(&positions, &triangles, self.mass);
+        let pinned = self.pin_indices(&self.pins)?;
+        Ok(ClothMesh {
+            positions,
+            triangles,
+            masses,
+            pinned,
+            stretch,
+            shear,
+            grid: Some((nx, ny)),
+        })
+    }
+
+    /// The particles `pins` name on this grid, ascending, each once.
+    pub fn pin_indices(&self, pins: &[Pin]) -> Result<Vec<u32>, MeshError> {
+        let (nx, ny) = self.resolution;
         let mut pinned = Vec::new();
-        for pin in &self.pins {
+        for pin in pins {
             match *pin {
                 Pin::Corner(c) => pinned.push(match c {
                     Corner::TopLeft => self.index(0, 0),
@@ -180,15 +195,7 @@ impl GridDesc {
         }
         pinned.sort_unstable();
         pinned.dedup();
-        Ok(ClothMesh {
-            positions,
-            triangles,
-            masses,
-            pinned,
-            stretch,
-            shear,
-            grid: Some((nx, ny)),
-        })
+        Ok(pinned)
     }
 }
 

@@ -2,32 +2,18 @@
 //! settings, checked and built into a [`ClothSpec`].
 
 use weft_solver::{
-    ClothMesh, ClothParams, Corner, Edge, GridDesc, Mass, MeshError, Method, Orientation, Pin,
-    Settings,
+    ClothMesh, ClothParams, GridDesc, Mass, MeshError, Method, Orientation, Settings,
 };
 
 use super::garment::{DEFAULT_SEAM_TIME, Rig, garment};
+use super::pins::{grid_pins, mesh_pins};
 use super::{Checker, valid_name};
 use crate::family::{self, Field, Setting};
 use crate::ranges;
 use crate::scene::ClothSpec;
 use crate::schema::{
-    ClothSection, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, OrientationName, PinSpec,
+    ClothSection, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, OrientationName,
 };
-
-fn named_pin(name: &str) -> Option<Pin> {
-    Some(match name {
-        "top-left" => Pin::Corner(Corner::TopLeft),
-        "top-right" => Pin::Corner(Corner::TopRight),
-        "bottom-left" => Pin::Corner(Corner::BottomLeft),
-        "bottom-right" => Pin::Corner(Corner::BottomRight),
-        "top" => Pin::Edge(Edge::Top),
-        "bottom" => Pin::Edge(Edge::Bottom),
-        "left" => Pin::Edge(Edge::Left),
-        "right" => Pin::Edge(Edge::Right),
-        _ => return None,
-    })
-}
 
 pub(super) fn cloth(
     c: &mut Checker<'_>,
@@ -72,6 +58,8 @@ pub(super) fn cloth(
     };
     let center = c.vector(&k("center"), s.center.unwrap_or_default());
     let pins = s.pins.clone().unwrap_or_default();
+    let held_specs = s.held.clone().unwrap_or_default();
+    let mut held = Vec::new();
     let mut params = ClothParams::default();
     let entries = s.family_settings();
     for &(fam, setting) in &entries {
@@ -127,6 +115,11 @@ pub(super) fn cloth(
             &s.pins,
             "by a garment cloth (attach it to a bone)",
         );
+        c.unused(
+            &k("held"),
+            &s.held,
+            "by a garment cloth (attach it to a bone)",
+        );
         c.non_negative(&k("seam_time"), seam_time);
         let explicit = s.mass.is_some() || s.density.is_some() || material.is_some();
         let g = garment(c, name, s, explicit.then_some(mass), center, rig)?;
@@ -142,19 +135,9 @@ pub(super) fn cloth(
         c.unused(&k("orientation"), &s.orientation, "by a mesh cloth");
         let scale = s.scale.unwrap_or(1.0);
         c.within(&k("scale"), scale, &ranges::SCALE);
-        let mut indices = Vec::new();
-        for (i, p) in pins.iter().enumerate() {
-            match p {
-                PinSpec::Index(v) if *v >= 0 && *v <= u32::MAX as i64 => indices.push(*v as u32),
-                PinSpec::Index(v) => {
-                    c.bad(&format!("{}[{i}]", k("pins")), format!("bad index {v}"))
-                }
-                PinSpec::Named(n) => c.bad(
-                    &format!("{}[{i}]", k("pins")),
-                    format!("`{n}`: a mesh cloth is pinned by vertex index only"),
-                ),
-            }
-        }
+        let mut indices = mesh_pins(c, &k("pins"), &pins);
+        held = mesh_pins(c, &k("held"), &held_specs);
+        indices.extend(&held);
         let (positions, triangles) = c.read_mesh(&k("mesh"), path, scale)?;
         let positions = positions.into_iter().map(|p| p + center).collect();
         if c.errors.len() > before {
@@ -175,36 +158,13 @@ pub(super) fn cloth(
         let [w, h] = s.size.unwrap_or(DEFAULT_SIZE);
         c.within(&k("size"), w, &ranges::SIZE);
         c.within(&k("size"), h, &ranges::SIZE);
-        let mut grid_pins = Vec::new();
-        for (i, p) in pins.iter().enumerate() {
-            let key = format!("{}[{i}]", k("pins"));
-            match p {
-                PinSpec::Named(n) => match named_pin(n) {
-                    Some(pin) => grid_pins.push(pin),
-                    None => c.bad(
-                        &key,
-                        format!(
-                            "unknown pin `{n}`: expected top-left, top-right, bottom-left, \
-                             bottom-right, top, bottom, left, right or a vertex index"
-                        ),
-                    ),
-                },
-                PinSpec::Index(v) if *v >= 0 && *v < nx.saturating_mul(ny) => {
-                    grid_pins.push(Pin::Index(*v as u32))
-                }
-                PinSpec::Index(v) => c.bad(
-                    &key,
-                    format!(
-                        "vertex {v} does not exist (the grid has {})",
-                        nx.max(0).saturating_mul(ny.max(0))
-                    ),
-                ),
-            }
-        }
+        let mut pinned = grid_pins(c, &k("pins"), &pins, nx, ny);
+        let still = grid_pins(c, &k("held"), &held_specs, nx, ny);
         if c.errors.len() > before {
             return None;
         }
-        GridDesc {
+        pinned.extend(&still);
+        let desc = GridDesc {
             resolution: (nx as usize, ny as usize),
             size: (w, h),
             center,
@@ -213,12 +173,18 @@ pub(super) fn cloth(
                 OrientationName::Horizontal => Orientation::Horizontal,
             },
             mass,
-            pins: grid_pins,
-        }
-        .build()
-        .map_err(|e| mesh_error(c, name, &e, false))
-        .ok()?
+            pins: pinned,
+        };
+        held = desc
+            .pin_indices(&still)
+            .map_err(|e| mesh_error(c, name, &e, false))
+            .ok()?;
+        desc.build()
+            .map_err(|e| mesh_error(c, name, &e, false))
+            .ok()?
     };
+    held.sort_unstable();
+    held.dedup();
     if thickness_ok {
         thinner_than_the_cloth(c, &k("thickness"), thickness, &mesh);
     }
@@ -251,6 +217,7 @@ pub(super) fn cloth(
         params,
         thickness,
         motion,
+        held,
         seams,
         seam_time,
         attachments,

@@ -8,6 +8,7 @@ mod cloth;
 mod collider;
 mod garment;
 mod model;
+mod pins;
 
 use weft_collide::SelfCollisionParams;
 use weft_solver::{Aero, Forces, Settings, Wind};
@@ -145,6 +146,7 @@ pub(crate) fn resolve(file: &SceneFile, c: &mut Checker<'_>) -> Option<ResolvedP
             max_displacement: s.max_displacement,
             search_margin: s.search_margin,
             adaptive_search_margin: s.adaptive_search_margin,
+            contact: s.contact,
         })
     });
     c.errors.is_empty().then_some(ResolvedParts {

@@ -182,6 +182,9 @@ cloth_section! {
         /// Motion the pins follow (default: static).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub motion: Option<MotionSpec>,
+        /// Pinned particles that stay where they are while `motion` drives `pins`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub held: Option<Vec<PinSpec>>,
         /// Collision thickness (m).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub thickness: Option<f64>,

@@ -284,6 +284,22 @@ pub struct SelfCollisionSection {
     /// Whether the search margin follows the cloth's motion (changes cost only).
     #[serde(default = "yes")]
     pub adaptive_search_margin: bool,
+    /// What keeps the cloths apart: `particles` or `mesh`.
+    #[serde(default)]
+    pub contact: ContactKind,
+}
+
+/// `[self_collision] contact`: what keeps cloth apart from cloth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactKind {
+    /// Particles kept a thickness apart: holds while the thickness is near the particle
+    /// spacing (no particle can slip between its neighbours).
+    #[default]
+    Particles,
+    /// Vertex–triangle and edge–edge contact within the thickness, whatever the spacing, with
+    /// no substep creating a crossing.
+    Mesh,
 }
 
 fn yes() -> bool {

@@ -10,6 +10,7 @@ mod friction;
 mod fuzz;
 mod garment_shape;
 mod glb_character;
+mod held_pins;
 mod material_key;
 mod memory_estimate;
 mod mesh_drape;

@@ -39,6 +39,11 @@ const SKINNED: &[&str] = &["glb_character.toml"];
 /// so), where every other method holds.
 const CANTILEVER: &[&str] = &["cantilever.toml"];
 
+/// Thin layers of thousands of particles under mesh contact, stepped under every method by
+/// weft-sim's tests/crossings_hold.rs (2 s, the towel 5 s), which fails on a step's error as
+/// on a crossing: running them here too would double the suite's slowest minutes.
+const MESH_CONTACT: &[&str] = &["layers.toml", "towel_fold.toml", "twist.toml"];
+
 #[test]
 fn every_shipped_scene_runs_300_frames_under_every_method() {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(scenes_dir())
@@ -51,6 +56,7 @@ fn every_shipped_scene_runs_300_frames_under_every_method() {
                 && !DRESSED.contains(&name)
                 && !SKINNED.contains(&name)
                 && !CANTILEVER.contains(&name)
+                && !MESH_CONTACT.contains(&name)
         })
         .collect();
     paths.sort();
