@@ -49,7 +49,8 @@ pub struct FailSafeStats {
 }
 
 /// Checks every listed pair over `x_prev → x` and freezes impact zones (see the module doc);
-/// `eta` is η₀, the fraction of a pair's distance it may not come within.
+/// `eta` is η₀, the fraction of a pair's distance it may not come within; `list` measured
+/// along those paths ([`Candidates::measure`]).
 pub(crate) fn enforce(
     el: &Elements,
     list: &Candidates,
@@ -71,17 +72,26 @@ pub(crate) fn enforce(
             Some(f) => ids.iter().any(|&i| f[i as usize]),
         };
         let vf: Vec<[u32; 4]> = (list.vf.par_iter())
-            .filter_map(|&(v, f, t)| {
-                let tri = el.triangles[f as usize];
-                let ids = [v, tri[0], tri[1], tri[2]];
-                (recheck(&ids) && impact(ids, x, prev, t * eta, Kind::VertexFace)).then_some(ids)
+            .filter_map(|l| {
+                let tri = el.triangles[l.b as usize];
+                let ids = [l.a, tri[0], tri[1], tri[2]];
+                let eta = l.keep * eta;
+                // Never within η on the substep's paths (the list's bound): no impact.
+                (recheck(&ids)
+                    && list.lower_bound(l, &ids, 1) <= eta
+                    && impact(ids, x, prev, eta, Kind::VertexFace))
+                .then_some(ids)
             })
             .collect();
         let ee: Vec<[u32; 4]> = (list.ee.par_iter())
-            .filter_map(|&(e, g, t)| {
-                let ([a0, a1], [b0, b1]) = (el.edges[e as usize], el.edges[g as usize]);
+            .filter_map(|l| {
+                let ([a0, a1], [b0, b1]) = (el.edges[l.a as usize], el.edges[l.b as usize]);
                 let ids = [a0, a1, b0, b1];
-                (recheck(&ids) && impact(ids, x, prev, t * eta, Kind::EdgeEdge)).then_some(ids)
+                let eta = l.keep * eta;
+                (recheck(&ids)
+                    && list.lower_bound(l, &ids, 2) <= eta
+                    && impact(ids, x, prev, eta, Kind::EdgeEdge))
+                .then_some(ids)
             })
             .collect();
         if fresh.is_none() {

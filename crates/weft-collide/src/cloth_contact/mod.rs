@@ -234,6 +234,7 @@ impl ClothContact {
     pub(crate) fn project(&mut self, p: &mut Particles) -> (usize, f64) {
         self.check(p);
         self.sweep.weigh(p);
+        self.list.measure_at(&p.positions);
         let mut s = self
             .sweep
             .run(&self.el, &self.list, p, self.params.friction);
@@ -241,6 +242,7 @@ impl ClothContact {
             if s.contacts == 0 {
                 break;
             }
+            self.list.measure_at(&p.positions);
             let more = self
                 .sweep
                 .run(&self.el, &self.list, p, self.params.friction);
@@ -253,6 +255,7 @@ impl ClothContact {
 
     /// After the substep's velocities: the continuous check and its fail-safe.
     pub(crate) fn end_substep(&mut self, p: &mut Particles) {
+        // Measures the list along the substep's paths for the fail-safe's bounds.
         self.check(p);
         let eta = self.params.impact_fraction;
         self.stats.fail_safe = failsafe::enforce(&self.el, &self.list, p, eta, &mut self.frozen);

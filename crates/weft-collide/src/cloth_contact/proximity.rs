@@ -82,7 +82,8 @@ impl Sweep {
             );
     }
 
-    /// One sweep over `list`'s pairs at `p`'s positions, with `friction` between the layers.
+    /// One sweep over `list`'s pairs at `p`'s positions, with `friction` between the layers
+    /// (`list` measured at those positions: [`Candidates::measure_at`]).
     pub(crate) fn run(
         &mut self,
         el: &Elements,
@@ -97,16 +98,24 @@ impl Sweep {
         }
         let (x, prev, w) = (&p.positions, &p.prev_positions, &self.weights);
         let vf: Vec<Correction> = (list.vf.par_iter())
-            .filter_map(|&(v, f, t)| {
-                let tri = el.triangles[f as usize];
-                let ids = [v, tri[0], tri[1], tri[2]];
-                vertex_face(ids, x, prev, w, t, friction)
+            .filter_map(|l| {
+                let tri = el.triangles[l.b as usize];
+                let ids = [l.a, tri[0], tri[1], tri[2]];
+                // Too far apart to touch (the list's bound at `x`): no distance needed.
+                if list.lower_bound(l, &ids, 1) >= l.keep {
+                    return None;
+                }
+                vertex_face(ids, x, prev, w, l.keep, friction)
             })
             .collect();
         let ee: Vec<Correction> = (list.ee.par_iter())
-            .filter_map(|&(e, g, t)| {
-                let ([a0, a1], [b0, b1]) = (el.edges[e as usize], el.edges[g as usize]);
-                edge_edge([a0, a1, b0, b1], x, prev, w, t, friction)
+            .filter_map(|l| {
+                let ([a0, a1], [b0, b1]) = (el.edges[l.a as usize], el.edges[l.b as usize]);
+                let ids = [a0, a1, b0, b1];
+                if list.lower_bound(l, &ids, 2) >= l.keep {
+                    return None;
+                }
+                edge_edge(ids, x, prev, w, l.keep, friction)
             })
             .collect();
         let mut stats = SweepStats::default();
