@@ -184,6 +184,17 @@ impl Candidates {
         let edges: Vec<(Aabb, f64)> = el.edges.par_iter().map(|e| grown(e)).collect();
         let (tri_grid, edge_grid) = rayon::join(|| Grid::new(&tris), || Grid::new(&edges));
         let (tris, edges, keep) = (&tris, &edges, &keep);
+        // A pair of elements `ids` at distance `apart` at the anchors, with radii summing to
+        // `r`: listed if within the distance it keeps (the reach first, which needs no
+        // `keep`; not a number lists nothing either).
+        let listed = |pair: Pair, (a, b): (u32, u32), apart: f64, r: f64| {
+            let within = apart <= reach + r;
+            if !within {
+                return None;
+            }
+            let keep = keep(pair);
+            (apart <= keep + r + ROUNDING).then_some(Listed { a, b, keep, apart })
+        };
         // Vertex v against triangle f, found in cell `home` (`None`: its only cell, or outside
         // the grid).
         let vertex_face = |v: u32, vbox: &Aabb, rv: f64, f: u32, home: Option<I64Vec3>| {
@@ -193,19 +204,7 @@ impl Candidates {
                 return None;
             }
             let apart = point_triangle_distance(at(v), [at(t[0]), at(t[1]), at(t[2])]);
-            let r = rv + rf;
-            // Not a number lists nothing either.
-            let within = apart <= reach + r;
-            if !within {
-                return None;
-            }
-            let keep = keep(Pair::VertexFace(v, f));
-            (apart <= keep + r + ROUNDING).then_some(Listed {
-                a: v,
-                b: f,
-                keep,
-                apart,
-            })
+            listed(Pair::VertexFace(v, f), (v, f), apart, rv + rf)
         };
         self.vf = el
             .vertices
@@ -235,19 +234,7 @@ impl Candidates {
                 return None;
             }
             let apart = segment_distance(at(a0), at(a1), at(b0), at(b1));
-            let r = re + rg;
-            // Not a number lists nothing either.
-            let within = apart <= reach + r;
-            if !within {
-                return None;
-            }
-            let keep = keep(Pair::EdgeEdge(e, g));
-            (apart <= keep + r + ROUNDING).then_some(Listed {
-                a: e,
-                b: g,
-                keep,
-                apart,
-            })
+            listed(Pair::EdgeEdge(e, g), (e, g), apart, re + rg)
         };
         self.ee = (0..el.edges.len() as u32)
             .into_par_iter()
@@ -448,6 +435,7 @@ fn key(c: I64Vec3) -> u64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::topology::edges_of;
     use super::*;
 
     /// A pseudo-random number in [0, 1).
@@ -486,12 +474,7 @@ mod tests {
                 triangles.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
             }
         }
-        let mut edges: Vec<[u32; 2]> = (triangles.iter())
-            .flat_map(|t: &[u32; 3]| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-            .map(|[a, b]| [a.min(b), a.max(b)])
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
+        let edges = edges_of(&triangles);
         let el = Elements {
             vertices: (0..(n * n) as u32).collect(),
             triangles,

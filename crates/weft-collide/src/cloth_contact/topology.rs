@@ -46,12 +46,7 @@ impl Elements {
         vertices.dedup();
         triangles.sort_unstable();
         triangles.dedup();
-        let mut edges: Vec<[u32; 2]> = (triangles.iter())
-            .flat_map(|t: &[u32; 3]| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-            .map(|[a, b]| [a.min(b), a.max(b)])
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
+        let edges = edges_of(&triangles);
         Ok(Self {
             vertices,
             triangles,
@@ -60,4 +55,15 @@ impl Elements {
             rest: solver.particles().positions.clone(),
         })
     }
+}
+
+/// The edges of `triangles`, each as its two vertices lower first, sorted, once.
+pub(crate) fn edges_of(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = (triangles.iter())
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
 }
