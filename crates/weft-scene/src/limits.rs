@@ -121,8 +121,8 @@ pub fn self_collision_pairs(members: &[Member], margin: f64, adaptive: bool) -> 
 }
 
 /// A bound on the element pairs mesh-level cloth contact lists for `members`. Pairs are listed
-/// while their boxes lie within D = 3 t (the reach t, the largest thickness, and a skin of
-/// 2 t); an element's box is at most h = √(2 a) across (a the smallest area per particle), so
+/// while their boxes lie within D = (1 + s) t (the reach t, the largest thickness, and the
+/// contact's default skin of s t); an element's box is at most h = √(2 a) across (a the smallest area per particle), so
 /// a vertex's partners lie within D + h in each of the 2D/t + 1 layers contact keeps t apart,
 /// π (D + h)² / a particles a layer. Each particle brings two triangles and three edges: its
 /// vertex meets two triangles of each partner and its three edges three of each partner's,
@@ -138,7 +138,7 @@ pub fn mesh_contact_pairs(members: &[Member]) -> u64 {
         .filter(|m| m.particles > 0)
         .map(|m| m.area / m.particles as f64)
         .fold(f64::INFINITY, f64::min);
-    let d = 3.0 * t;
+    let d = (1.0 + weft_collide::ClothContactParams::default().skin) * t;
     let r = d + (2.0 * a).sqrt();
     let partners = ((2.0 * d / t + 1.0) * std::f64::consts::PI * r * r / a).min((total - 1) as f64);
     (total as f64 * partners * 6.5 / 2.0).ceil() as u64
