@@ -1,6 +1,8 @@
 //! `cloth.<name>.material`: a fabric preset by name, or a table of physical values
 //! (`density` in g/m², `stretch` and `shear` in N/m, `bending` in N·m) that may start from a
-//! `preset` and override some of its fields.
+//! `preset` and override some of its fields. `stretch` and `bending` set every direction;
+//! `stretch_warp`, `stretch_weft`, `bending_warp`, `bending_weft` and `bending_bias` set one
+//! (warp along the grid's rows, weft along its columns; see `weft_solver::Direction`).
 
 use std::fmt;
 
@@ -37,6 +39,21 @@ pub struct MaterialTable {
     /// Bending stiffness (N·m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bending: Option<f64>,
+    /// Stretch stiffness along the warp (N/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_warp: Option<f64>,
+    /// Stretch stiffness along the weft (N/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_weft: Option<f64>,
+    /// Bending stiffness of a strip along the warp (N·m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_warp: Option<f64>,
+    /// Bending stiffness of a strip along the weft (N·m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_weft: Option<f64>,
+    /// Bending stiffness of a strip on the bias (N·m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_bias: Option<f64>,
 }
 
 impl<'de> Deserialize<'de> for MaterialSpec {
@@ -47,7 +64,8 @@ impl<'de> Deserialize<'de> for MaterialSpec {
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
                 f.write_str(
                     "a preset name such as \"cotton\" or a table { preset, density, stretch, \
-                     shear, bending }",
+                     shear, bending, stretch_warp, stretch_weft, bending_warp, bending_weft, \
+                     bending_bias }",
                 )
             }
             fn visit_str<E: de::Error>(self, v: &str) -> Result<MaterialSpec, E> {
@@ -92,10 +110,49 @@ pub fn resolve(spec: &MaterialSpec) -> Result<Material, (String, String)> {
             "missing: give it or a `preset` to take it from".to_owned(),
         )),
     };
+    // A direction's own key, else the key for every direction, else the preset's value.
+    let directed =
+        |name: &str, own: Option<f64>, all: (&str, Option<f64>), from: Option<f64>| match (
+            own, all.1,
+        ) {
+            (Some(v), _) => field(name, Some(v), None),
+            (None, Some(v)) => field(all.0, Some(v), None),
+            (None, None) => field(all.0, None, from),
+        };
+    let stretch = ("stretch", table.stretch);
+    let bending = ("bending", table.bending);
     Ok(Material {
         density: field("density", table.density, base.map(|b| b.density * 1e3))? * 1e-3,
-        stretch: field("stretch", table.stretch, base.map(|b| b.stretch))?,
+        stretch: directed(
+            "stretch_warp",
+            table.stretch_warp,
+            stretch,
+            base.map(|b| b.stretch),
+        )?,
+        stretch_weft: directed(
+            "stretch_weft",
+            table.stretch_weft,
+            stretch,
+            base.map(|b| b.stretch_weft),
+        )?,
         shear: field("shear", table.shear, base.map(|b| b.shear))?,
-        bending: field("bending", table.bending, base.map(|b| b.bending))?,
+        bending: directed(
+            "bending_warp",
+            table.bending_warp,
+            bending,
+            base.map(|b| b.bending),
+        )?,
+        bending_weft: directed(
+            "bending_weft",
+            table.bending_weft,
+            bending,
+            base.map(|b| b.bending_weft),
+        )?,
+        bending_bias: directed(
+            "bending_bias",
+            table.bending_bias,
+            bending,
+            base.map(|b| b.bending_bias),
+        )?,
     })
 }

@@ -9,7 +9,7 @@ use crate::constraints::{
 use crate::error::{BuildError, ParamError};
 use crate::forces::Forces;
 use crate::motion::{KinematicPin, Motion};
-use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
+use crate::params::{ClothParams, Direction, Family, FamilyParams, check_thickness};
 use crate::particles::Particles;
 use crate::settings::Settings;
 use crate::solver::{Cloth, Solver};
@@ -25,7 +25,7 @@ pub struct SolverBuilder {
     forces: Forces,
     particles: Particles,
     cloths: Vec<Cloth>,
-    params: Vec<FamilyParams>,
+    params: Vec<ClothParams>,
     distance: BlockBuilder<2, Distance>,
     dihedral: BlockBuilder<4, Dihedral>,
     isometric: BlockBuilder<4, Isometric>,
@@ -42,7 +42,7 @@ struct Finished {
     forces: Forces,
     particles: Particles,
     cloths: Vec<Cloth>,
-    params: Vec<FamilyParams>,
+    params: Vec<ClothParams>,
     pins: Vec<KinematicPin>,
 }
 
@@ -111,8 +111,15 @@ impl SolverBuilder {
             let w = if pinned[i] || m <= 0.0 { 0.0 } else { 1.0 / m };
             self.particles.push(x, w);
         }
-        let group = |f: Family| (cloth * Family::COUNT + f.index()) as u32;
-        self.params.extend_from_slice(&params.families);
+        // A stretch edge acts along itself; a hinge bends the cloth across its edge.
+        let along = |a: u32, b: u32| grid_direction(mesh.grid, a, b);
+        let across = |a: u32, b: u32| match along(a, b) {
+            Direction::Warp => Direction::Weft,
+            Direction::Weft => Direction::Warp,
+            Direction::Bias => Direction::Bias,
+        };
+        let group = |f: Family, d: Direction| ClothParams::group(cloth, f, d);
+        self.params.push(params);
         let g = |i: u32| i + offset;
         let p = &mesh.positions;
         let dist = |a: u32, b: u32| p[a as usize].distance(p[b as usize]);
@@ -122,8 +129,11 @@ impl SolverBuilder {
         ] {
             if params.get(family).enabled {
                 for &[a, b] in pairs {
-                    self.distance
-                        .push([g(a), g(b)], group(family), Distance { rest: dist(a, b) });
+                    self.distance.push(
+                        [g(a), g(b)],
+                        group(family, along(a, b)),
+                        Distance { rest: dist(a, b) },
+                    );
                 }
             }
         }
@@ -140,7 +150,7 @@ impl SolverBuilder {
             for (a, b) in pairs {
                 self.distance.push(
                     [g(a), g(b)],
-                    group(Family::BendDistance),
+                    group(Family::BendDistance, Direction::Bias),
                     Distance { rest: dist(a, b) },
                 );
             }
@@ -149,8 +159,12 @@ impl SolverBuilder {
             for wing in &topo.wings {
                 let idx = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
                 if let Some(rest) = Dihedral::angle(&idx.map(|i| p[i as usize])) {
-                    self.dihedral
-                        .push(idx.map(g), group(Family::BendDihedral), Dihedral { rest });
+                    let d = across(wing.edge[0], wing.edge[1]);
+                    self.dihedral.push(
+                        idx.map(g),
+                        group(Family::BendDihedral, d),
+                        Dihedral { rest },
+                    );
                 }
             }
         }
@@ -158,8 +172,9 @@ impl SolverBuilder {
             for wing in &topo.wings {
                 let idx = [wing.wing_a, wing.wing_b, wing.edge[0], wing.edge[1]];
                 if let Some(shape) = Isometric::at_rest(&idx.map(|i| p[i as usize])) {
+                    let d = across(wing.edge[0], wing.edge[1]);
                     self.isometric
-                        .push(idx.map(g), group(Family::BendIsometric), shape);
+                        .push(idx.map(g), group(Family::BendIsometric, d), shape);
                 }
             }
         }
@@ -173,7 +188,7 @@ impl SolverBuilder {
                 if let Some(anchor) = nearest {
                     self.tethers.push(
                         [g(i), g(anchor)],
-                        group(Family::Tether),
+                        group(Family::Tether, Direction::Warp),
                         Tether {
                             max_length: dist(i, anchor),
                         },
@@ -285,7 +300,7 @@ impl SolverBuilder {
                 &p.constraints,
                 &p.particles.positions,
                 &p.particles.inv_masses,
-                &p.params,
+                &crate::params::expand(&p.params, p.settings.iterations),
                 c.particles.clone(),
                 false,
             )
@@ -329,5 +344,22 @@ impl SolverBuilder {
             params: self.params,
             pins: self.pins,
         }
+    }
+}
+
+/// The direction of the edge `a`–`b` on a cloth with grid `grid` (vertex `j · columns + i`),
+/// [`Direction::Bias`] on a cloth without one.
+fn grid_direction(grid: Option<(usize, usize)>, a: u32, b: u32) -> Direction {
+    let Some((columns, _)) = grid else {
+        return Direction::Bias;
+    };
+    let at = |v: u32| (v as usize % columns, v as usize / columns);
+    let ((ia, ja), (ib, jb)) = (at(a), at(b));
+    if ja == jb {
+        Direction::Warp
+    } else if ia == ib {
+        Direction::Weft
+    } else {
+        Direction::Bias
     }
 }

@@ -14,7 +14,10 @@
 //! - `topology`: unique edges and the wing vertices across each interior edge.
 //! - `params`: constraint families and their per-method parameters, with their range checks.
 //! - `material`: fabrics in physical units, and the parameters every method derives from them.
-//! - `presets`: fabric presets from published Kawabata (KES-F) measurements.
+//! - `presets`: fabric presets from published Kawabata (KES-F) measurements and Wang et al.
+//!   2011's ten measured fabrics (warp, weft and bias).
+//! - `fabric`: a material from a textile lab's measurements, and the virtual cantilever that
+//!   reads its bending length back.
 //! - `cantilever`: the cantilever bending test's strip, clamp and chord angle.
 //! - `elastica`: the heavy elastica, the exact shape of the cantilever bending test.
 //! - `spring_defaults`: spring constants scaled to the cloth, stable for the explicit springs.
@@ -46,6 +49,7 @@ mod domains;
 pub mod driver;
 mod elastica;
 mod error;
+mod fabric;
 mod forces;
 mod grid;
 mod hook;
@@ -73,13 +77,17 @@ pub use domains::DomainStats;
 pub use driver::PinDriver;
 pub use elastica::{Elastica, MAX_LOAD as ELASTICA_MAX_LOAD, bending_length};
 pub use error::{BuildError, MeshError, ParamError, SolverError};
+pub use fabric::{
+    ASTM_STRIP_LENGTH, CantileverReading, FabricError, FabricMeasurements, KES_LOAD, load_at_chord,
+    virtual_cantilever,
+};
 pub use forces::{Aero, Forces, Wind};
 pub use grid::{Corner, Edge, GridDesc, Orientation, Pin};
 pub use hook::{Contacts, ParticleContacts, ParticleRun, SubstepContext, SubstepHook};
 pub use material::{HINGE_RELAXATION, Material, MaterialStiffness};
 pub use method::{Method, UnknownMethod};
 pub use motion::{KinematicPin, Motion, RigidTransform};
-pub use params::{ClothParams, Family, FamilyParams};
+pub use params::{Anisotropy, ClothParams, Direction, Family, FamilyParams, GROUPS_PER_CLOTH};
 pub use particles::Particles;
 pub use presets::{PRESETS, preset, preset_names};
 pub use settings::{DEFAULT_CG_MAX_ITERATIONS, DEFAULT_CG_TOLERANCE, Settings};

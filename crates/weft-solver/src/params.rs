@@ -160,17 +160,107 @@ impl FamilyParams {
     }
 }
 
+/// The material directions a constraint acts along, on a grid cloth: the warp is the grid's
+/// rows (its first index), the weft its columns, the bias the diagonals between them.
+///
+/// A stretch constraint acts along its edge. A bending hinge bends the cloth across its edge:
+/// a hinge on an edge along the weft bends a strip that runs along the warp, so it takes the
+/// warp's bending. Constraints of a cloth without a grid take the bias.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Direction {
+    /// Along the grid's rows (the first index).
+    Warp,
+    /// Along the grid's columns.
+    Weft,
+    /// Diagonal to both, or a cloth without a grid.
+    Bias,
+}
+
+impl Direction {
+    /// Every direction, in the order of the solver's parameter groups.
+    pub const ALL: [Direction; 3] = [Direction::Warp, Direction::Weft, Direction::Bias];
+
+    /// Position in [`Direction::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// How much stiffer one family is along the weft and the bias than along the warp (the
+/// family's own parameters); 1 and 1 for an isotropic cloth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Anisotropy {
+    /// Weft stiffness over warp stiffness.
+    pub weft: f64,
+    /// Bias stiffness over warp stiffness.
+    pub bias: f64,
+}
+
+impl Default for Anisotropy {
+    fn default() -> Self {
+        Self::ISOTROPIC
+    }
+}
+
+impl Anisotropy {
+    /// The same stiffness in every direction.
+    pub const ISOTROPIC: Anisotropy = Anisotropy {
+        weft: 1.0,
+        bias: 1.0,
+    };
+
+    /// The ratio for `direction`.
+    pub fn ratio(&self, direction: Direction) -> f64 {
+        match direction {
+            Direction::Warp => 1.0,
+            Direction::Weft => self.weft,
+            Direction::Bias => self.bias,
+        }
+    }
+}
+
+impl FamilyParams {
+    /// These parameters made `ratio` times stiffer, for a solver running `iterations`
+    /// iterations: XPBD compliance ÷ ratio, spring stiffness × ratio, damping unchanged; PBD
+    /// stiffness k such that n iterations remove what a spring `ratio` times stiffer would in
+    /// XPBD's first iteration: with f = 1 − (1 − k)ⁿ the fraction removed and
+    /// q = f/(1 − f) = s α̃⁻¹ (Macklin et al. 2016, eq. 18), q' = ratio · q.
+    pub fn scaled(&self, ratio: f64, iterations: u32) -> FamilyParams {
+        if ratio == 1.0 {
+            return *self;
+        }
+        let n = f64::from(iterations.max(1));
+        let f = 1.0 - (1.0 - self.pbd_stiffness).powf(n);
+        let pbd_stiffness = if f >= 1.0 {
+            self.pbd_stiffness
+        } else {
+            let q = ratio * f / (1.0 - f);
+            let f = q / (1.0 + q);
+            (1.0 - (1.0 - f).powf(1.0 / n)).clamp(0.0, 1.0)
+        };
+        FamilyParams {
+            compliance: self.compliance / ratio,
+            spring_stiffness: self.spring_stiffness * ratio,
+            pbd_stiffness,
+            ..*self
+        }
+    }
+}
+
 /// Parameters of every family of one cloth, indexed by [`Family::index`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClothParams {
-    /// One entry per family.
+    /// One entry per family: its values along the warp (every direction when isotropic).
     pub families: [FamilyParams; Family::COUNT],
+    /// Per family, how much stiffer it is along the weft and the bias.
+    pub anisotropy: [Anisotropy; Family::COUNT],
 }
 
 impl Default for ClothParams {
     fn default() -> Self {
         Self {
             families: Family::ALL.map(FamilyParams::default_for),
+            anisotropy: [Anisotropy::ISOTROPIC; Family::COUNT],
         }
     }
 }
@@ -198,13 +288,48 @@ impl ClothParams {
         self
     }
 
-    /// Validates every family.
+    /// Validates every family and its anisotropy (ratios finite and > 0).
     pub fn validate(&self) -> Result<(), ParamError> {
-        Family::ALL
-            .iter()
-            .try_for_each(|&f| self.get(f).validate(f))
+        Family::ALL.iter().try_for_each(|&f| {
+            self.get(f).validate(f)?;
+            let a = self.anisotropy[f.index()];
+            for (field, value) in [("weft", a.weft), ("bias", a.bias)] {
+                if !(value.is_finite() && value > 0.0) {
+                    return Err(ParamError {
+                        name: format!("{}.anisotropy.{field}", f.name()),
+                        value,
+                        expected: "finite and > 0",
+                    });
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// The parameter groups of this cloth, as the solver's constraints index them
+    /// ([`ClothParams::group`]): every family along each [`Direction`], for a solver running
+    /// `iterations` iterations.
+    pub fn groups(&self, iterations: u32) -> [FamilyParams; GROUPS_PER_CLOTH] {
+        std::array::from_fn(|g| {
+            let (direction, family) = (Direction::ALL[g / Family::COUNT], g % Family::COUNT);
+            let ratio = self.anisotropy[family].ratio(direction);
+            self.families[family].scaled(ratio, iterations)
+        })
+    }
+
+    /// The group index of `family` along `direction` on cloth `cloth`.
+    pub fn group(cloth: usize, family: Family, direction: Direction) -> u32 {
+        (cloth * GROUPS_PER_CLOTH + direction.index() * Family::COUNT + family.index()) as u32
     }
 }
+
+/// Every cloth's parameter groups, in cloth order (see [`ClothParams::groups`]).
+pub(crate) fn expand(cloths: &[ClothParams], iterations: u32) -> Vec<FamilyParams> {
+    cloths.iter().flat_map(|c| c.groups(iterations)).collect()
+}
+
+/// Parameter groups per cloth: one per family and [`Direction`].
+pub const GROUPS_PER_CLOTH: usize = Family::COUNT * Direction::ALL.len();
 
 /// A parameter outside the range where it makes sense.
 #[derive(Clone, Debug, Error, PartialEq)]

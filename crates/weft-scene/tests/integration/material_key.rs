@@ -71,3 +71,51 @@ fn bad_materials_are_named_with_their_key_and_line() {
         .to_string();
     assert!(e.contains("cloth.c.material.shear"), "{e}");
 }
+
+#[test]
+fn a_measured_preset_and_direction_keys_make_the_cloth_anisotropic() {
+    // The jeans of Wang et al. 2011: stiffer along the weft in stretch, along the warp in
+    // bending; the ratios go to the solver's weft and bias groups.
+    let s = scene("material = \"11oz-black-denim\"").expect("valid");
+    let jeans = preset("11oz-black-denim").expect("preset");
+    let a = s.cloths[0].params.anisotropy;
+    let stretch = a[Family::Stretch.index()];
+    let e = |v: f64| (v - jeans.shear).max(0.1 * v);
+    assert!((stretch.weft - e(jeans.stretch_weft) / e(jeans.stretch)).abs() < 1e-12);
+    // The hinges of a grid are set so that each strip bends at its own B (`grid_hinges`).
+    let hinges = jeans.grid_hinges();
+    let bend = a[Family::BendIsometric.index()];
+    assert!((bend.weft - hinges.bending_weft / hinges.bending).abs() < 1e-12);
+    assert!((bend.bias - hinges.bending_bias / hinges.bending).abs() < 1e-12);
+    assert!(bend.weft < 1.0 && bend.bias < 1.0, "{bend:?}");
+    // `bending` sets every direction; a direction's own key wins over it.
+    let s =
+        scene("material = { preset = \"11oz-black-denim\", bending = 2e-5, bending_weft = 1e-5 }")
+            .expect("valid");
+    let p = s.cloths[0].params;
+    let given = weft_solver::Material {
+        bending: 2e-5,
+        bending_weft: 1e-5,
+        bending_bias: 2e-5,
+        ..jeans
+    }
+    .grid_hinges();
+    assert_eq!(
+        p.get(Family::BendIsometric).spring_stiffness,
+        HINGE_RELAXATION * given.bending
+    );
+    let bend = p.anisotropy[Family::BendIsometric.index()];
+    assert!((bend.weft - given.bending_weft / given.bending).abs() < 1e-12);
+    assert!((bend.bias - 2e-5 / given.bending).abs() < 1e-12);
+    // An isotropic preset stays isotropic.
+    let s = scene("material = \"cotton\"").expect("valid");
+    assert!(
+        (s.cloths[0].params.anisotropy)
+            .iter()
+            .all(|a| *a == weft_solver::Anisotropy::ISOTROPIC)
+    );
+    let e = scene("material = { preset = \"cotton\", bending_weft = 0.0 }")
+        .expect_err("zero")
+        .to_string();
+    assert!(e.contains("cloth.c.material.bending_weft"), "{e}");
+}

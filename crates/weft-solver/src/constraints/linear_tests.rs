@@ -56,7 +56,9 @@ pub(crate) fn crumpled(
         .map(|p| *p * 1.3 + DVec3::new(rnd(), rnd(), rnd()) * 0.02)
         .collect();
     let v: Vec<DVec3> = x.iter().map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
-    let params = solver.cloth_params(0).expect("one cloth").families.to_vec();
+    let params = (solver.cloth_params(0).expect("one cloth"))
+        .groups(settings.iterations)
+        .to_vec();
     (solver.constraints().clone(), params, x, v)
 }
 

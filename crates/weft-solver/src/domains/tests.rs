@@ -172,14 +172,17 @@ fn the_unit_k_form_runs_only_when_every_constrained_group_has_k_one() {
     let (block, n) = block(12, false);
     let mut domains = Domains::new(&block, n, 64, SimdPath::Scalar);
     let params = |edit: &dyn Fn(Family, &mut FamilyParams)| -> Vec<FamilyParams> {
-        Family::ALL
-            .map(|f| {
-                let mut p = FamilyParams::default_for(f);
-                p.enabled |= f == Family::BendDistance;
-                edit(f, &mut p);
-                p
-            })
-            .to_vec()
+        let families = Family::ALL.map(|f| {
+            let mut p = FamilyParams::default_for(f);
+            p.enabled |= f == Family::BendDistance;
+            edit(f, &mut p);
+            p
+        });
+        let cloth = crate::ClothParams {
+            families,
+            ..Default::default()
+        };
+        cloth.groups(1).to_vec()
     };
     let xpbd = Rule::Xpbd { h: 1.0 / 600.0 };
     let cases: [(&str, Vec<FamilyParams>, Rule, bool); 5] = [

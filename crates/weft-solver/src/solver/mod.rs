@@ -17,7 +17,7 @@ use crate::forces::Forces;
 use crate::hook::SubstepHook;
 use crate::methods::SpringWork;
 use crate::motion::KinematicPin;
-use crate::params::{ClothParams, Family, FamilyParams, check_thickness};
+use crate::params::{ClothParams, FamilyParams, GROUPS_PER_CLOTH, check_thickness};
 use crate::particles::Particles;
 use crate::settings::{Settings, within_bound};
 use crate::stability::{StabilityBound, bound};
@@ -67,6 +67,10 @@ pub struct Solver {
     particles: Particles,
     cloths: Vec<Cloth>,
     all_triangles: Vec<[u32; 3]>,
+    /// Each cloth's parameters as given.
+    cloth_params: Vec<ClothParams>,
+    /// Every cloth's parameter groups (see [`ClothParams::groups`]), as the constraints index
+    /// them.
     params: Vec<FamilyParams>,
     constraints: ConstraintSet,
     pins: Vec<KinematicPin>,
@@ -106,7 +110,7 @@ impl Solver {
         forces: Forces,
         particles: Particles,
         cloths: Vec<Cloth>,
-        params: Vec<FamilyParams>,
+        cloth_params: Vec<ClothParams>,
         constraints: ConstraintSet,
         pins: Vec<KinematicPin>,
         scratch: Vec<DVec3>,
@@ -131,7 +135,8 @@ impl Solver {
             particles,
             cloths,
             all_triangles,
-            params,
+            params: crate::params::expand(&cloth_params, settings.iterations),
+            cloth_params,
             constraints,
             pins,
             drivers: Vec::new(),
@@ -225,7 +230,12 @@ impl Solver {
             // Only an explicit method's bound estimates the highest mode.
             self.stability = std::sync::OnceLock::new();
         }
+        let iterations_changed = settings.iterations != self.settings.iterations;
         self.settings = settings;
+        if iterations_changed {
+            // PBD's stiffness across the grain depends on the iteration count.
+            self.params = crate::params::expand(&self.cloth_params, settings.iterations);
+        }
         Ok(())
     }
 
@@ -243,11 +253,7 @@ impl Solver {
 
     /// The family parameters of cloth `cloth`, if it exists.
     pub fn cloth_params(&self, cloth: usize) -> Option<ClothParams> {
-        let base = cloth * Family::COUNT;
-        let p = self.params.get(base..base + Family::COUNT)?;
-        Some(ClothParams {
-            families: std::array::from_fn(|f| p[f]),
-        })
+        self.cloth_params.get(cloth).copied()
     }
 
     fn check_cloth(&self, cloth: usize) -> Result<(), ParamError> {
@@ -270,8 +276,10 @@ impl Solver {
     ) -> Result<(), ParamError> {
         self.check_cloth(cloth)?;
         params.validate()?;
-        let base = cloth * Family::COUNT;
-        self.params[base..base + Family::COUNT].copy_from_slice(&params.families);
+        let base = cloth * GROUPS_PER_CLOTH;
+        self.params[base..base + GROUPS_PER_CLOTH]
+            .copy_from_slice(&params.groups(self.settings.iterations));
+        self.cloth_params[cloth] = params;
         self.stability = std::sync::OnceLock::new();
         Ok(())
     }

@@ -45,12 +45,7 @@ fn settle(method: Method, mesh: &ClothMesh, material: &Material, frames: usize) 
 }
 
 /// A soft membrane, so its stretch is large enough to measure.
-const SOFT: Material = Material {
-    density: 0.2,
-    stretch: 20.0,
-    shear: 2.0,
-    bending: 1e-6,
-};
+const SOFT: Material = Material::isotropic(0.2, 20.0, 2.0, 1e-6);
 
 #[test]
 fn a_curtain_stretches_as_a_membrane_under_its_own_weight_at_every_resolution() {
