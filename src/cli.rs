@@ -45,6 +45,45 @@ pub enum Command {
     /// Export a log's cloth and colliders for other tools: an OBJ sequence or an animated
     /// glTF binary (GLB) that Blender imports.
     Export(ExportArgs),
+    /// Turn a textile lab's measurements into a material table for a scene, and check it on
+    /// the virtual cantilever (ASTM D1388).
+    Fabric(FabricArgs),
+}
+
+/// `weft fabric`.
+#[derive(Debug, Args)]
+pub struct FabricArgs {
+    /// Areal weight (g/m²).
+    #[arg(long, allow_negative_numbers = true)]
+    pub weight: f64,
+    /// Cantilever bending length c along the warp (cm): half the overhang at which the strip
+    /// reaches ASTM D1388's 41.5° plane.
+    #[arg(long, allow_negative_numbers = true)]
+    pub bending_length_warp: f64,
+    /// Cantilever bending length along the weft (cm; default: the warp's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub bending_length_weft: Option<f64>,
+    /// Extension along the warp at `--load` (%).
+    #[arg(long, allow_negative_numbers = true)]
+    pub extension_warp: f64,
+    /// Extension along the weft at `--load` (%; default: the warp's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub extension_weft: Option<f64>,
+    /// The tensile load of the extensions per unit width (N/m; default KES-F's 500 gf/cm).
+    #[arg(long, allow_negative_numbers = true, default_value_t = weft_solver::KES_LOAD)]
+    pub load: f64,
+    /// In-plane shear stiffness (N/m; default 56, a shirting's KES-F G of 1 gf/(cm·deg)).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 56.0)]
+    pub shear: f64,
+    /// The method the virtual cantilever runs, at its defaults.
+    #[arg(long, default_value = "xpbd")]
+    pub method: Method,
+    /// Cells along the virtual strip's overhang.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub segments: u32,
+    /// Print the material without running the virtual cantilever.
+    #[arg(long)]
+    pub no_check: bool,
 }
 
 /// What `weft export` writes.

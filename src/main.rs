@@ -11,6 +11,7 @@ mod default_scene;
 mod experiments;
 mod explain;
 mod export;
+mod fabric;
 mod framing;
 mod limits;
 mod output;
@@ -60,6 +61,10 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render_command(&args, &stop),
         Some(Command::Recover(args)) => recover::recover(&args),
         Some(Command::Export(args)) => export::export(&args, &stop),
+        Some(Command::Fabric(args)) => {
+            let _polling = stop::Polling::start();
+            fabric::fabric(&args, &stop)
+        }
     };
     match result {
         Ok(code) => code,

@@ -1,18 +1,22 @@
 //! The cantilever bending test (ASTM D1388) in an experiments file: a `[cantilever]` table
 //! names the scene's strip cloth and its overhang in bending lengths; each run's strip is then
 //! shaped from its own material (overhang, square cells, two clamped columns), with
-//! `cantilever.segments` swept like a scene key, and the run measures the chord angle against
-//! the heavy elastica's.
+//! `cantilever.segments` swept like a scene key (and `cantilever.direction`, the strip cut
+//! along the `"warp"` or the `"weft"`), and the run measures the chord angle against the heavy
+//! elastica's.
 
 use std::path::Path;
 
 use anyhow::{Context, bail};
 use serde::Deserialize;
 use weft_scene::Override;
-use weft_solver::{Cantilever, Material};
+use weft_solver::{Cantilever, Direction, Material};
 
 /// The key that sets the segments along the overhang (swept, or in `set`).
 pub const SEGMENTS_KEY: &str = "cantilever.segments";
+
+/// The key that cuts the strip along the warp or the weft (swept, or in `set`).
+pub const DIRECTION_KEY: &str = "cantilever.direction";
 
 /// `[cantilever]` of an experiments file.
 #[derive(Debug, Deserialize)]
@@ -75,9 +79,16 @@ pub fn prepare(
         );
     }
     let mut segments = None;
+    let mut direction = Direction::Warp;
     let mut overrides = Vec::new();
     for o in run_overrides {
-        if o.key == SEGMENTS_KEY {
+        if o.key == DIRECTION_KEY {
+            direction = match o.value.trim().trim_matches('"') {
+                "warp" => Direction::Warp,
+                "weft" => Direction::Weft,
+                other => bail!("{DIRECTION_KEY} must be \"warp\" or \"weft\", got {other}"),
+            };
+        } else if o.key == SEGMENTS_KEY {
             let n = o
                 .value
                 .trim()
@@ -116,7 +127,7 @@ pub fn prepare(
     if g.is_nan() || g <= 0.0 {
         bail!("cantilever: the scene needs gravity");
     }
-    let shape = Cantilever::of_material(&material, g, spec.lengths, segments);
+    let shape = Cantilever::of_material_along(&material, direction, g, spec.lengths, segments);
     let grid = shape.grid(material.density);
     let list = |v: &[f64]| {
         format!(

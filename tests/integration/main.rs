@@ -13,6 +13,7 @@ mod e2e_view;
 mod experiments;
 mod export;
 mod export_body;
+mod fabric;
 mod fuzz_inputs;
 mod hostile_names;
 mod limits;
