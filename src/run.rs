@@ -217,6 +217,11 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
         last.residual_max,
         last.kinetic_energy,
     )?;
+    if let Some(b) = last.bending_residual {
+        say!(
+            "bending residual (XPBD, last substep): {b:.1e} (0 converged, 1 about twice too soft)"
+        )?;
+    }
     if let Some(line) = tally.line() {
         say!("crossings: {line}")?;
     }

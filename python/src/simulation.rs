@@ -260,7 +260,9 @@ impl Simulation {
 
     /// The last frame's statistics, as the log's `/stats` channel has them: `frame`, `time`
     /// (s), `kinetic_energy` (J), `residual_max` and `residual_rms` (m, the distance
-    /// constraints' violation), `contacts`, and `step_ms` (the step's wall-clock time, ms).
+    /// constraints' violation), `contacts`, `cg_iterations` (the implicit method's),
+    /// `bending_residual` (under XPBD with bending hinges only: 0 converged, 1 a hinge about
+    /// twice too soft), and `step_ms` (the step's wall-clock time, ms).
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.state.last;
         let d = PyDict::new(py);
@@ -270,6 +272,10 @@ impl Simulation {
         d.set_item("residual_max", s.residual_max)?;
         d.set_item("residual_rms", s.residual_rms)?;
         d.set_item("contacts", s.contacts)?;
+        d.set_item("cg_iterations", s.cg_iterations)?;
+        if let Some(b) = s.bending_residual {
+            d.set_item("bending_residual", b)?;
+        }
         d.set_item("step_ms", s.step_ms)?;
         Ok(d)
     }

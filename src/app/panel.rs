@@ -253,6 +253,14 @@ fn stats_section(ui: &mut Ui, session: &Session) {
             s.contacts.to_string(),
             "cloth–collider contacts in the last frame",
         );
+        if let Some(b) = s.bending_residual {
+            row(
+                "bending residual",
+                format!("{b:.1e}"),
+                "how far XPBD's last substep left the bending hinges from their equation: 0 \
+                 converged, 1 a hinge about twice as soft as its compliance",
+            );
+        }
         if let Some(c) = &s.crossings {
             row(
                 "crossings",

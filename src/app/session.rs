@@ -57,6 +57,8 @@ pub struct Stats {
     pub contacts: usize,
     /// Cloth crossings of the last frame, when measured.
     pub crossings: Option<weft_sim::CrossingStats>,
+    /// XPBD's bending residual of the last frame, where it bends.
+    pub bending_residual: Option<f64>,
 }
 
 /// The simulation the window shows.
@@ -129,6 +131,7 @@ impl Session {
                 self.stats.step_ms = start.elapsed().as_secs_f64() * 1e3;
                 self.stats.contacts = stats.contacts;
                 self.stats.crossings = stats.crossings;
+                self.stats.bending_residual = stats.bending_residual;
                 self.stats.steps_last += 1;
                 self.frames += 1;
                 if let Some(log) = self.log.as_mut() {

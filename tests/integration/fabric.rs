@@ -99,3 +99,30 @@ fn bad_measurements_are_refused_naming_the_option() {
         assert!(!stdout.contains("material ="), "{flag} {value}: {stdout}");
     }
 }
+
+#[test]
+fn weft_run_reports_xpbds_bending_residual_where_a_fabric_bends() {
+    let residual = |set: &[&str]| {
+        let mut args = vec!["run", "assets/scenes/hanging.toml", "--frames", "10"];
+        args.extend_from_slice(set);
+        let out = run(&args);
+        let (stdout, stderr) = texts(&out);
+        assert!(out.status.success(), "{stdout}{stderr}");
+        (stdout.lines())
+            .find_map(|l| l.strip_prefix("bending residual (XPBD, last substep): "))
+            .map(|rest| {
+                let v = rest.split(' ').next().unwrap_or("");
+                v.parse::<f64>()
+                    .unwrap_or_else(|_| panic!("not a number in {rest}"))
+            })
+    };
+    // Cotton bends through XPBD hinges solved to tolerance: a small residual.
+    let cotton = residual(&["--set", "cloth.cloth.material=cotton"]).expect("a residual line");
+    assert!((0.0..0.05).contains(&cotton), "{cotton}");
+    // Bend-distance constraints (the default scene) and other methods have no hinge residual.
+    assert_eq!(residual(&[]), None);
+    assert_eq!(
+        residual(&["--set", "cloth.cloth.material=cotton", "--method", "pbd"]),
+        None
+    );
+}

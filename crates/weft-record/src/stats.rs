@@ -5,7 +5,7 @@ use serde_json::Value;
 use weft_sim::FrameStats;
 
 /// The JSON schema of `/stats` messages.
-pub const STATS_SCHEMA: &str = r#"{"title":"weft.FrameStats","type":"object","properties":{"frame":{"type":"integer"},"time":{"type":"number","description":"simulated time (s)"},"kinetic_energy":{"type":"number","description":"J"},"residual_max":{"type":"number","description":"largest |C| of distance-like constraints (m)"},"residual_rms":{"type":"number","description":"largest per-solver RMS |C| (m)"},"contacts":{"type":"integer"},"cg_iterations":{"type":"integer","description":"conjugate-gradient iterations of the frame's implicit mass-spring solves"},"crossings":{"type":"integer","description":"edge-triangle crossings between cloth elements that share no vertex, every cloth of a solver together; only where crossings are measured (cloth can meet cloth, or asked for)"},"closest_approach":{"type":["number","null"],"description":"closest approach between cloth elements that share no vertex (m), null when none comes within crossing_reach; only with crossings"},"crossing_reach":{"type":"number","description":"how far the closest approach is looked for (m): 3 times the largest cloth thickness; only with crossings"},"step_ms":{"type":"number","description":"wall-clock step time (ms); only with --timing"},"log_wait_ms":{"type":"number","description":"wall-clock time the run has waited for the log's queue before this frame (ms); only with --timing"}},"required":["frame","time","kinetic_energy","residual_max","residual_rms","contacts"]}"#;
+pub const STATS_SCHEMA: &str = r#"{"title":"weft.FrameStats","type":"object","properties":{"frame":{"type":"integer"},"time":{"type":"number","description":"simulated time (s)"},"kinetic_energy":{"type":"number","description":"J"},"residual_max":{"type":"number","description":"largest |C| of distance-like constraints (m)"},"residual_rms":{"type":"number","description":"largest per-solver RMS |C| (m)"},"contacts":{"type":"integer"},"cg_iterations":{"type":"integer","description":"conjugate-gradient iterations of the frame's implicit mass-spring solves"},"bending_residual":{"type":"number","description":"largest relative residual XPBD's last substep left in the bending hinges' equation (0 converged, 1 a hinge about twice as soft as its compliance); only under XPBD with bending"},"crossings":{"type":"integer","description":"edge-triangle crossings between cloth elements that share no vertex, every cloth of a solver together; only where crossings are measured (cloth can meet cloth, or asked for)"},"closest_approach":{"type":["number","null"],"description":"closest approach between cloth elements that share no vertex (m), null when none comes within crossing_reach; only with crossings"},"crossing_reach":{"type":"number","description":"how far the closest approach is looked for (m): 3 times the largest cloth thickness; only with crossings"},"step_ms":{"type":"number","description":"wall-clock step time (ms); only with --timing"},"log_wait_ms":{"type":"number","description":"wall-clock time the run has waited for the log's queue before this frame (ms); only with --timing"}},"required":["frame","time","kinetic_energy","residual_max","residual_rms","contacts"]}"#;
 
 /// The `/stats` message of a frame; `waited_ms` (the wait for the log's queue) adds the
 /// wall-clock fields (`--timing`).
@@ -19,6 +19,9 @@ pub(crate) fn json(s: &FrameStats, waited_ms: Option<f64>) -> Value {
         "contacts": s.contacts,
         "cg_iterations": s.cg_iterations,
     });
+    if let Some(b) = s.bending_residual {
+        json["bending_residual"] = b.into();
+    }
     if let Some(c) = &s.crossings {
         json["crossings"] = c.crossings.into();
         json["closest_approach"] = c.closest.into();
@@ -76,6 +79,7 @@ mod tests {
             residual_rms: 1e-5,
             contacts: 7,
             cg_iterations: 12,
+            bending_residual: None,
             step_ms: 2.5,
             crossings: None,
         };
@@ -92,6 +96,14 @@ mod tests {
             (plain, Some(0.25), 9),
             (measured(Some(0.0012)), None, 10),
             (measured(None), Some(0.25), 12),
+            (
+                FrameStats {
+                    bending_residual: Some(2e-3),
+                    ..plain
+                },
+                None,
+                8,
+            ),
         ];
         for (stats, waited, keys) in cases {
             let m = json(&stats, waited);
@@ -105,6 +117,12 @@ mod tests {
                 assert!(obj.contains_key(r), "{r} missing from {m}");
             }
         }
+        let bent = FrameStats {
+            bending_residual: Some(2e-3),
+            ..plain
+        };
+        assert_eq!(json(&bent, None)["bending_residual"], 2e-3);
+        assert!(json(&plain, None).get("bending_residual").is_none());
         let m = json(&measured(None), None);
         assert_eq!(m["crossings"], 12);
         assert!(m["closest_approach"].is_null());

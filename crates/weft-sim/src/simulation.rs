@@ -29,6 +29,10 @@ pub struct FrameStats {
     pub contacts: usize,
     /// Conjugate-gradient iterations of the frame's implicit solves (0 without implicit springs).
     pub cg_iterations: u64,
+    /// The largest XPBD bending residual of the last substep over the solvers
+    /// (`Solver::bending_residual`: 0 converged, 1 a hinge about twice too soft); `None`
+    /// without XPBD bending.
+    pub bending_residual: Option<f64>,
     /// Wall-clock time of the step (ms); not deterministic.
     pub step_ms: f64,
     /// Cloth crossings and the closest approach, when measured (see
@@ -224,6 +228,9 @@ impl Simulation {
             s.kinetic_energy += g.solver.particles().kinetic_energy();
             s.residual_max = s.residual_max.max(r.max);
             s.residual_rms = s.residual_rms.max(r.rms);
+            if let Some(b) = g.solver.bending_residual() {
+                s.bending_residual = Some(s.bending_residual.map_or(b, |a| a.max(b)));
+            }
         }
         if self.crossing_meshes.is_some() {
             s.crossings = Some(self.crossings_now());
