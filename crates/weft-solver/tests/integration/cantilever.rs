@@ -24,49 +24,20 @@ fn cantilever(
     off_by(material, 1.0, segments, settings, frames)
 }
 
-/// A strip of `material` cut along `direction`, bent by the material `mapped` (the strip and
-/// its elastica are `material`'s), as [`cantilever`].
-fn strip_along(
+/// A strip of `material` cut along `direction` with `segments` cells, bent by the material
+/// `mapped` (the strip and its elastica are `material`'s), stepped `frames` frames of
+/// `settings` with damping 3/s: the solver and the chord angle's difference from the
+/// elastica's (degrees).
+fn strip(
     material: &Material,
     mapped: &Material,
     direction: Direction,
-    settings: Settings,
-    frames: usize,
-) -> f64 {
-    let strip = Cantilever::of_material_along(material, direction, G, 2.0, 8);
-    let mesh = strip.grid(material.density).build().expect("strip");
-    let params = mapped.params(&mesh, &settings, &ClothParams::default());
-    let forces = Forces {
-        damping: 3.0,
-        ..Forces::default()
-    };
-    let mut b = SolverBuilder::new(settings, forces).expect("settings");
-    b.add_cloth("strip", &mesh, params, 0.0).expect("strip");
-    let mut s = b.build();
-    for _ in 0..frames {
-        s.step().expect("finite");
-    }
-    let elastica = strip.elastica(material, G).expect("in range").chord_angle();
-    (strip.chord_angle(&s.particles().positions) - elastica).to_degrees()
-}
-
-/// [`cantilever`] with the strip's bending constant scaled by `scale` in the material mapping
-/// (the strip and the elastica are still those of `material`).
-fn off_by(
-    material: &Material,
-    scale: f64,
     segments: usize,
     settings: Settings,
     frames: usize,
 ) -> (Solver, f64) {
-    let strip = Cantilever::of_material(material, G, 2.0, segments);
+    let strip = Cantilever::of_material_along(material, direction, G, 2.0, segments);
     let mesh = strip.grid(material.density).build().expect("strip");
-    let mapped = Material {
-        bending: material.bending * scale,
-        bending_weft: material.bending_weft * scale,
-        bending_bias: material.bending_bias * scale,
-        ..*material
-    };
     let params = mapped.params(&mesh, &settings, &ClothParams::default());
     let forces = Forces {
         damping: 3.0,
@@ -81,6 +52,42 @@ fn off_by(
     let elastica = strip.elastica(material, G).expect("in range").chord_angle();
     let error = (strip.chord_angle(&s.particles().positions) - elastica).to_degrees();
     (s, error)
+}
+
+/// [`strip`] at 8 cells: the chord angle's difference only.
+fn strip_along(
+    material: &Material,
+    mapped: &Material,
+    direction: Direction,
+    settings: Settings,
+    frames: usize,
+) -> f64 {
+    strip(material, mapped, direction, 8, settings, frames).1
+}
+
+/// [`cantilever`] with the strip's bending constant scaled by `scale` in the material mapping
+/// (the strip and the elastica are still those of `material`).
+fn off_by(
+    material: &Material,
+    scale: f64,
+    segments: usize,
+    settings: Settings,
+    frames: usize,
+) -> (Solver, f64) {
+    let mapped = Material {
+        bending: material.bending * scale,
+        bending_weft: material.bending_weft * scale,
+        bending_bias: material.bending_bias * scale,
+        ..*material
+    };
+    strip(
+        material,
+        &mapped,
+        Direction::Warp,
+        segments,
+        settings,
+        frames,
+    )
 }
 
 fn defaults(method: Method) -> Settings {
