@@ -241,9 +241,8 @@ impl Material {
         } else {
             *self
         };
-        let k = hinged.stiffness(mesh);
-        // Weft and bias as ratios to the warp's per-constraint stiffness.
-        let [_, weft, bias] = crate::Direction::ALL.map(|d| hinged.along(d).stiffness(mesh));
+        // Each direction's per-constraint stiffness; weft and bias become ratios to the warp's.
+        let [k, weft, bias] = crate::Direction::ALL.map(|d| hinged.along(d).stiffness(mesh));
         let ratio = |of: fn(&MaterialStiffness) -> Option<f64>, d: &MaterialStiffness| match (
             of(d),
             of(&k),
