@@ -5,6 +5,7 @@
 mod common;
 
 mod cantilever;
+mod cusick;
 mod determinism;
 mod dihedral_energy;
 mod driven_pins;
