@@ -38,7 +38,8 @@ const BUILT_TO_EXPLODE: &[&str] = &["explode.toml"];
 /// The walker's and the skinned character's scenes: thousands of particles on a moving body
 /// under four methods would hold the suite up for minutes (their own tests run them), and
 /// explicit mass-spring needs far smaller substeps for their fabrics; and the cantilever
-/// strip, which explicit mass-spring cannot hold at its substeps (`weft check` says so).
+/// strip and the Cusick disc, which explicit mass-spring cannot hold at their substeps
+/// (`weft check` says so).
 const HEAVY: &[&str] = &[
     "cape.toml",
     "character.toml",
@@ -46,6 +47,7 @@ const HEAVY: &[&str] = &[
     "layered_outfit.toml",
     "glb_character.toml",
     "cantilever.toml",
+    "cusick.toml",
 ];
 
 fn scenes_dir() -> PathBuf {

@@ -110,6 +110,8 @@ pub(super) fn cloth(
         c.unused(&k("size"), &s.size, "by a garment cloth");
         c.unused(&k("orientation"), &s.orientation, "by a garment cloth");
         c.unused(&k("scale"), &s.scale, "by a garment cloth");
+        c.unused(&k("disc_radius"), &s.disc_radius, "by a garment cloth");
+        c.unused(&k("clamp_radius"), &s.clamp_radius, "by a garment cloth");
         c.unused(
             &k("pins"),
             &s.pins,
@@ -133,6 +135,8 @@ pub(super) fn cloth(
         c.unused(&k("resolution"), &s.resolution, "by a mesh cloth");
         c.unused(&k("size"), &s.size, "by a mesh cloth");
         c.unused(&k("orientation"), &s.orientation, "by a mesh cloth");
+        c.unused(&k("disc_radius"), &s.disc_radius, "by a mesh cloth");
+        c.unused(&k("clamp_radius"), &s.clamp_radius, "by a mesh cloth");
         let scale = s.scale.unwrap_or(1.0);
         c.within(&k("scale"), scale, &ranges::SCALE);
         let mut indices = mesh_pins(c, &k("pins"), &pins);
@@ -179,9 +183,24 @@ pub(super) fn cloth(
             .pin_indices(&still)
             .map_err(|e| mesh_error(c, name, &e, false))
             .ok()?;
-        desc.build()
+        let grid = desc
+            .build()
             .map_err(|e| mesh_error(c, name, &e, false))
-            .ok()?
+            .ok()?;
+        match disc(c, name, s, w.min(h)) {
+            Some((radius, clamp)) => {
+                let (mesh, map) = grid
+                    .cut_disc(center, radius, clamp, mass)
+                    .map_err(|e| mesh_error(c, name, &e, false))
+                    .ok()?;
+                held = held
+                    .iter()
+                    .filter_map(|&i| map.get(i as usize).copied().flatten())
+                    .collect();
+                mesh
+            }
+            None => grid,
+        }
     };
     held.sort_unstable();
     held.dedup();
@@ -222,6 +241,34 @@ pub(super) fn cloth(
         seam_time,
         attachments,
     })
+}
+
+/// A grid cloth's `disc_radius` and `clamp_radius` (0 without one), checked against the
+/// grid's shorter side `side`; `None` without a disc or where either is bad (reported).
+fn disc(c: &mut Checker<'_>, name: &str, s: &ClothSection, side: f64) -> Option<(f64, f64)> {
+    let k = |field: &str| format!("cloth.{name}.{field}");
+    let Some(radius) = s.disc_radius else {
+        c.unused(
+            &k("clamp_radius"),
+            &s.clamp_radius,
+            "without a `disc_radius`",
+        );
+        return None;
+    };
+    let radius_ok = c.check(
+        &k("disc_radius"),
+        radius,
+        radius > 0.0 && radius <= 0.5 * side,
+        &format!("finite, > 0 and at most half the grid's shorter side ({side} m)"),
+    );
+    let clamp = s.clamp_radius.unwrap_or(0.0);
+    let clamp_ok = c.check(
+        &k("clamp_radius"),
+        clamp,
+        clamp >= 0.0 && clamp < radius,
+        &format!("finite, >= 0 and less than disc_radius ({radius} m)"),
+    );
+    (radius_ok && clamp_ok).then_some((radius, clamp))
 }
 
 fn mesh_error(c: &mut Checker<'_>, name: &str, e: &MeshError, is_mesh: bool) {

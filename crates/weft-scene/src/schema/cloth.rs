@@ -157,6 +157,14 @@ cloth_section! {
         /// Grid plane: `vertical` or `horizontal`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub orientation: Option<OrientationName>,
+        /// The grid cut to a disc of this radius around its centre (m): the Cusick drape
+        /// test's specimen.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub disc_radius: Option<f64>,
+        /// Every particle of the disc within this distance of its centre pinned (m): the
+        /// Cusick tester's clamped support.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub clamp_radius: Option<f64>,
         /// OBJ mesh file, relative to the scene file (instead of a grid).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub mesh: Option<String>,

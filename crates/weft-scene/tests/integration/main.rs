@@ -5,6 +5,7 @@
 mod common;
 
 mod character;
+mod cusick;
 mod dressed;
 mod friction;
 mod fuzz;

@@ -36,8 +36,9 @@ const DRESSED: &[&str] = &[
 const SKINNED: &[&str] = &["glb_character.toml"];
 /// The cantilever test's strip, run by assets/experiments/cantilever.toml under the methods it
 /// is for: cotton on 2.3 mm cells needs 3,682 explicit mass-spring substeps (`weft check` says
-/// so), where every other method holds.
-const CANTILEVER: &[&str] = &["cantilever.toml"];
+/// so), where every other method holds. The Cusick drape test's disc likewise (cotton on
+/// 1.25 cm cells), run by assets/experiments/cusick.toml and tests/cusick.rs.
+const CANTILEVER: &[&str] = &["cantilever.toml", "cusick.toml"];
 
 /// Thin layers of thousands of particles under mesh contact, stepped under every method by
 /// weft-sim's tests/crossings_hold.rs (2 s, the towel 5 s), which fails on a step's error as
