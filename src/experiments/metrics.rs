@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::experiments::cantilever::Strip;
 use weft_sim::{FrameStats, Simulation};
+use weft_solver::Drape;
 
 /// A quantity reported per run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize, Serialize)]
@@ -31,6 +32,8 @@ pub enum Metric {
     ElasticaAngle,
     /// Cantilever: chord angle minus the elastica's (degrees).
     AngleError,
+    /// Cusick drape test: the share of the free annulus the disc's shadow covers (1 flat).
+    DrapeCoefficient,
 }
 
 impl Metric {
@@ -48,6 +51,7 @@ impl Metric {
             Metric::ChordAngle => "chord_angle",
             Metric::ElasticaAngle => "elastica_angle",
             Metric::AngleError => "angle_error",
+            Metric::DrapeCoefficient => "drape_coefficient",
         }
     }
 
@@ -61,11 +65,12 @@ impl Metric {
             Metric::Cost => "sweeps/frame",
             Metric::Frames => "frames",
             Metric::ChordAngle | Metric::ElasticaAngle | Metric::AngleError => "°",
+            Metric::DrapeCoefficient => "",
         }
     }
 
     /// Every metric.
-    pub const ALL: [Metric; 11] = [
+    pub const ALL: [Metric; 12] = [
         Metric::Sag,
         Metric::StretchErrorMax,
         Metric::StretchErrorRms,
@@ -77,6 +82,7 @@ impl Metric {
         Metric::ChordAngle,
         Metric::ElasticaAngle,
         Metric::AngleError,
+        Metric::DrapeCoefficient,
     ];
 
     /// The metric called `name`.
@@ -94,6 +100,8 @@ pub struct Meter {
     last: FrameStats,
     wall_ms: f64,
     strip: Option<Strip>,
+    /// The first disc cloth (`disc_radius`) and its flat shadow.
+    drape: Option<(usize, Drape)>,
 }
 
 fn lowest(sim: &Simulation) -> f64 {
@@ -102,12 +110,25 @@ fn lowest(sim: &Simulation) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The first cloth cut to a disc (`disc_radius`) and its [`Drape`] at rest, its support the
+/// clamp (`clamp_radius`).
+fn drape(sim: &Simulation) -> Option<(usize, Drape)> {
+    sim.scene.cloths.iter().enumerate().find_map(|(i, c)| {
+        let section = sim.scene.file.cloth.get(&c.name)?;
+        let radius = section.disc_radius?;
+        let clamp = section.clamp_radius.unwrap_or(0.0);
+        let drape = Drape::new(&c.mesh.positions, &c.mesh.triangles, radius, clamp);
+        Some((i, drape))
+    })
+}
+
 impl Meter {
     /// Starts at the initial state; `strip` is the run's cantilever, if it has one.
     pub fn new(sim: &Simulation, strip: Option<Strip>) -> Self {
         Self {
             rest_lowest: lowest(sim),
             strip,
+            drape: drape(sim),
             ..Self::default()
         }
     }
@@ -128,6 +149,9 @@ impl Meter {
             .strip
             .map_or(f64::NAN, |t| t.chord_angle(sim.cloth_positions(t.cloth)));
         let elastica = self.strip.map_or(f64::NAN, |t| t.elastica_angle());
+        let drape = self.drape.map_or(f64::NAN, |(i, d)| {
+            d.coefficient(sim.cloth_positions(i), &sim.scene.cloths[i].mesh.triangles)
+        });
         Metric::ALL
             .into_iter()
             .map(|m| {
@@ -143,6 +167,7 @@ impl Meter {
                     Metric::ChordAngle => chord,
                     Metric::ElasticaAngle => elastica,
                     Metric::AngleError => chord - elastica,
+                    Metric::DrapeCoefficient => drape,
                 };
                 (m, v)
             })

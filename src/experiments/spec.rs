@@ -154,9 +154,11 @@ pub fn toml_text(v: &Value) -> String {
     }
 }
 
-/// A number, or a fraction string such as "1/60".
+/// A number, or a fraction string such as "1/60", or a list's first (a grid resolution's
+/// columns).
 pub fn numeric(v: &Value) -> Option<f64> {
     match v {
+        Value::Array(a) => a.first().and_then(numeric),
         Value::Number(n) => n.as_f64(),
         Value::String(s) => match s.split_once('/') {
             Some((a, b)) => Some(a.trim().parse::<f64>().ok()? / b.trim().parse::<f64>().ok()?),

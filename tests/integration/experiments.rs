@@ -127,3 +127,53 @@ fn a_non_finite_set_or_swept_value_is_an_error_naming_its_line_and_key() {
         assert!(!out_dir.join("results").exists(), "{name}: ran anyway");
     }
 }
+
+#[test]
+fn the_cusick_experiment_reports_the_drape_coefficient_by_resolution() {
+    let dir = temp_dir("experiments-cusick");
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/cusick.toml");
+    let exp = write(
+        &dir,
+        "exp.toml",
+        &format!(
+            r#"title = "cusick"
+scene = {scene:?}
+duration = 1.0
+metrics = ["drape_coefficient"]
+
+[[series]]
+name = "cotton"
+vary = {{ "cloth.specimen.resolution" = [[11, 11], [15, 15]] }}
+
+[[plot]]
+file = "dc.png"
+title = "dc"
+x = "cloth.specimen.resolution"
+y = "drape_coefficient"
+"#,
+            scene = scene.to_string_lossy()
+        ),
+    );
+    let o = dir.join("out");
+    let out = run(&[
+        "experiments",
+        &exp,
+        "--out",
+        &o.to_string_lossy(),
+        "--no-mcap",
+    ]);
+    let (stdout, e) = texts(&out);
+    assert!(out.status.success(), "{stdout}{e}");
+    let csv = std::fs::read_to_string(o.join("summary.csv")).expect("csv");
+    // The disc has draped a second: less than flat, more than hanging straight down.
+    let values: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().and_then(|v| v.parse().ok()).expect(l))
+        .collect();
+    assert_eq!(values.len(), 2, "{csv}");
+    assert!(values.iter().all(|v| (0.1..0.95).contains(v)), "{csv}");
+    // The plot's x is the resolution's columns: both points drawn.
+    let png = std::fs::read(o.join("dc.png")).expect("plot written");
+    assert_eq!(&png[1..4], b"PNG");
+}
