@@ -259,7 +259,10 @@ fn disc(c: &mut Checker<'_>, name: &str, s: &ClothSection, side: f64) -> Option<
         &k("disc_radius"),
         radius,
         radius > 0.0 && radius <= 0.5 * side,
-        &format!("finite, > 0 and at most half the grid's shorter side ({side} m)"),
+        &format!(
+            "finite, > 0 and at most half the grid's shorter side, {} m",
+            0.5 * side
+        ),
     );
     let clamp = s.clamp_radius.unwrap_or(0.0);
     let clamp_ok = c.check(
