@@ -6,9 +6,9 @@
 //! The strips are 8 segments long (a debug build runs them in seconds; 16 and 32 are in
 //! `assets/experiments/cantilever.toml` and `docs/validation.md`).
 
+use crate::common;
 use weft_solver::{
-    Cantilever, ClothParams, Direction, Forces, Material, Method, Settings, Solver, SolverBuilder,
-    preset,
+    Cantilever, ClothParams, Direction, Forces, Material, Method, Settings, Solver, preset,
 };
 
 const G: f64 = 9.81;
@@ -43,12 +43,8 @@ fn strip(
         damping: 3.0,
         ..Forces::default()
     };
-    let mut b = SolverBuilder::new(settings, forces).expect("settings");
-    b.add_cloth("strip", &mesh, params, 0.0).expect("strip");
-    let mut s = b.build();
-    for _ in 0..frames {
-        s.step().expect("finite");
-    }
+    let mut s = common::solver(settings, forces, &mesh, params);
+    common::run(&mut s, frames);
     let elastica = strip.elastica(material, G).expect("in range").chord_angle();
     let error = (strip.chord_angle(&s.particles().positions) - elastica).to_degrees();
     (s, error)
@@ -74,12 +70,7 @@ fn off_by(
     settings: Settings,
     frames: usize,
 ) -> (Solver, f64) {
-    let mapped = Material {
-        bending: material.bending * scale,
-        bending_weft: material.bending_weft * scale,
-        bending_bias: material.bending_bias * scale,
-        ..*material
-    };
+    let mapped = common::bending_scaled(material, scale);
     strip(
         material,
         &mapped,

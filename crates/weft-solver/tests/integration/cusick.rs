@@ -1,10 +1,11 @@
 //! The Cusick drape test (BS 5058): a 30 cm disc clamped on an 18 cm support drapes under its
 //! own weight; its drape coefficient across resolutions, methods and fabrics.
 
+use crate::common;
 use weft_solver::glam::DVec3;
 use weft_solver::{
     ClothParams, Drape, Forces, GridDesc, Mass, Material, Method, Orientation, SPECIMEN_RADIUS,
-    SUPPORT_RADIUS, Settings, SolverBuilder, preset,
+    SUPPORT_RADIUS, Settings, preset,
 };
 
 /// The drape coefficient of `material` cut from a grid of `cells` across the diameter, after
@@ -29,12 +30,8 @@ fn drape(material: &Material, cells: usize, settings: Settings, seconds: f64) ->
         damping: 3.0,
         ..Forces::default()
     };
-    let mut b = SolverBuilder::new(settings, forces).expect("settings");
-    b.add_cloth("disc", &mesh, params, 0.0).expect("disc");
-    let mut s = b.build();
-    for _ in 0..(seconds / settings.dt).round() as usize {
-        s.step().expect("finite");
-    }
+    let mut s = common::solver(settings, forces, &mesh, params);
+    common::run(&mut s, (seconds / settings.dt).round() as usize);
     let drape = Drape::new(
         &mesh.positions,
         &mesh.triangles,
@@ -49,15 +46,6 @@ fn with(method: Method, substeps: u32) -> Settings {
         method,
         substeps,
         ..Settings::default()
-    }
-}
-
-fn scaled(m: &Material, scale: f64) -> Material {
-    Material {
-        bending: m.bending * scale,
-        bending_weft: m.bending_weft * scale,
-        bending_bias: m.bending_bias * scale,
-        ..*m
     }
 }
 
@@ -80,8 +68,8 @@ fn xpbd_drapes_a_disc_alike_at_two_resolutions_and_by_its_bending() {
     // 0.1 either way (measured 0.2587 and 0.5976 against 0.4175).
     let cotton = preset("cotton").expect("preset");
     let base = drape(&cotton, 20, xpbd, 4.0);
-    let soft = drape(&scaled(&cotton, 0.5), 20, xpbd, 4.0);
-    let stiff = drape(&scaled(&cotton, 2.0), 20, xpbd, 4.0);
+    let soft = drape(&common::bending_scaled(&cotton, 0.5), 20, xpbd, 4.0);
+    let stiff = drape(&common::bending_scaled(&cotton, 2.0), 20, xpbd, 4.0);
     println!("cotton B/2 {soft:.4}, B {base:.4}, 2B {stiff:.4}");
     assert!(
         soft < base - 0.1 && stiff > base + 0.1,

@@ -7,8 +7,8 @@ use std::collections::HashMap;
 
 use weft_solver::glam::DVec3;
 use weft_solver::{
-    ClothMesh, ClothParams, Corner, Edge, Family, Forces, GridDesc, Mass, Method, Orientation, Pin,
-    Settings, Solver, SolverBuilder,
+    ClothMesh, ClothParams, Corner, Edge, Family, Forces, GridDesc, Mass, Material, Method,
+    Orientation, Pin, Settings, Solver, SolverBuilder,
 };
 
 /// Cloth parameters with every family switched off.
@@ -88,6 +88,16 @@ pub fn top_pinned_grid(resolution: (usize, usize)) -> ClothMesh {
     }
     .build()
     .expect("valid grid")
+}
+
+/// `material` with its bending in every direction scaled by `scale`.
+pub fn bending_scaled(material: &Material, scale: f64) -> Material {
+    Material {
+        bending: material.bending * scale,
+        bending_weft: material.bending_weft * scale,
+        bending_bias: material.bending_bias * scale,
+        ..*material
+    }
 }
 
 /// Steps `frames` frames, panicking with the solver's error if it diverges.
