@@ -335,6 +335,7 @@ impl SolverBuilder {
                 isometric_constants: Default::default(),
                 xpbd_h: 0.0,
                 bending_cg: [false; 2],
+                joint_cg: false,
                 cg: Default::default(),
             },
             settings: self.settings,

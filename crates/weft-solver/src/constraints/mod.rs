@@ -16,8 +16,8 @@
 //!   constants.
 //! - `quad_sweep`: the symmetric Gauss–Seidel sweep of a four-particle block through its lane
 //!   kernel.
-//! - `quad_cg`: XPBD's bending step by conjugate gradients where one sweep leaves it soft, and
-//!   its residual.
+//! - `quad_cg`: XPBD's bending step, alone or with the distance constraints, by conjugate
+//!   gradients where one sweep leaves it soft, and its residual.
 //! - `parts`: contiguous particle ranges that let one colour be projected in parallel.
 
 mod block;
@@ -126,7 +126,10 @@ pub struct ConstraintSet {
     /// Whether the dihedral and the isometric block are solved by conjugate gradients this
     /// frame (see `quad_cg`).
     pub(crate) bending_cg: [bool; 2],
-    /// The conjugate gradients' scratch of the dihedral and the isometric block.
+    /// Whether the distance and bending constraints are solved together by conjugate
+    /// gradients this frame (see `quad_cg`).
+    pub(crate) joint_cg: bool,
+    /// The conjugate gradients' scratch of the dihedral (or the joint) and the isometric block.
     pub(crate) cg: [quad_cg::CgScratch; 2],
 }
 
@@ -197,7 +200,9 @@ impl ConstraintSet {
     /// substep ([`Block::soft_per_substep`]).
     ///
     /// Under XPBD, a bending block whose mean s/α̃ at `x` exceeds [`quad_cg::CG_ABOVE`] is
-    /// solved by conjugate gradients instead of swept (see `quad_cg`).
+    /// solved by conjugate gradients instead of swept; where either block's exceeds
+    /// [`quad_cg::JOINT_ABOVE`] and the whole system has at most [`quad_cg::JOINT_MAX_ROWS`]
+    /// rows, both blocks are solved together with the distance constraints (see `quad_cg`).
     pub(crate) fn prepare_sweeps(
         &mut self,
         x: &[DVec3],
@@ -207,12 +212,17 @@ impl ConstraintSet {
     ) {
         self.xpbd_h = 0.0;
         self.bending_cg = [false; 2];
+        self.joint_cg = false;
         if let Rule::Xpbd { h } = rule {
             self.xpbd_h = h;
-            self.bending_cg = [
-                self.dihedral.mean_stiffness_ratio(x, w, params, h) > quad_cg::CG_ABOVE,
-                self.isometric.mean_stiffness_ratio(x, w, params, h) > quad_cg::CG_ABOVE,
+            let ratios = [
+                self.dihedral.mean_stiffness_ratio(x, w, params, h),
+                self.isometric.mean_stiffness_ratio(x, w, params, h),
             ];
+            self.bending_cg = ratios.map(|r| r > quad_cg::CG_ABOVE);
+            let rows = self.distance.len() + self.dihedral.len() + 3 * self.isometric.len();
+            self.joint_cg =
+                ratios.iter().any(|&r| r > quad_cg::JOINT_ABOVE) && rows <= quad_cg::JOINT_MAX_ROWS;
         }
         self.isometric_forward = self.isometric.soft_per_substep(w, params, rule);
         self.isometric
@@ -242,7 +252,11 @@ impl ConstraintSet {
 
     /// Clears the XPBD multipliers (at the start of each substep).
     pub(crate) fn reset_multipliers(&mut self) {
-        // The distance constraints' multipliers live in `Domains`, which clears its own.
+        // The sweep's distance multipliers live in `Domains`, which clears its own; these are
+        // the joint solve's.
+        if self.joint_cg {
+            self.distance.reset_multipliers();
+        }
         self.dihedral.reset_multipliers();
         self.isometric.reset_multipliers();
         self.tethers.reset_multipliers();
@@ -251,8 +265,49 @@ impl ConstraintSet {
 
     /// One Gauss–Seidel sweep over the bending, tether and seam constraints, colour by colour,
     /// the bending blocks' symmetric (forward, then backward) through their lane kernels on
-    /// kernel path `path`; the distance constraints are solved by [`crate::domains::Domains`].
+    /// kernel path `path`; the distance constraints are solved by [`crate::domains::Domains`],
+    /// except in a frame solved jointly ([`Self::solves_jointly`]), where they are solved here
+    /// with the bending.
     pub(crate) fn project_others(
+        &mut self,
+        x: &mut [DVec3],
+        prev: &[DVec3],
+        w: &[f64],
+        params: &[FamilyParams],
+        rule: Rule,
+        path: SimdPath,
+    ) {
+        let h = self.xpbd_h;
+        for cg in &mut self.cg {
+            cg.iterations = 0;
+        }
+        if self.joint_cg {
+            let cg = &mut self.cg[0];
+            cg.begin(x.len());
+            let at = quad_cg::Linearised {
+                x,
+                prev,
+                w,
+                params,
+                h,
+            };
+            self.distance.gather_rows(0, &at, cg);
+            self.dihedral.gather_rows(1, &at, cg);
+            self.isometric.gather_rows(2, &at, cg);
+            cg.solve();
+            self.distance.apply_rows(0, x, cg);
+            self.dihedral.apply_rows(1, x, cg);
+            self.isometric.apply_rows(2, x, cg);
+        } else {
+            self.project_bending(x, prev, w, params, rule, path);
+        }
+        self.tethers.project(x, prev, w, params, rule);
+        self.seams.project(x, prev, w, &self.seam_params, rule);
+    }
+
+    /// The bending blocks' step: each by conjugate gradients or by its symmetric lane sweep
+    /// (see [`Self::prepare_sweeps`]).
+    fn project_bending(
         &mut self,
         x: &mut [DVec3],
         prev: &[DVec3],
@@ -279,8 +334,17 @@ impl ConstraintSet {
             self.isometric
                 .project_symmetric_lanes(x, prev, w, params, rule, path, forward, constants);
         }
-        self.tethers.project(x, prev, w, params, rule);
-        self.seams.project(x, prev, w, &self.seam_params, rule);
+    }
+
+    /// Whether this frame's distance and bending constraints are solved together by
+    /// conjugate gradients (see `quad_cg`), so that the domains' sweep is skipped.
+    pub(crate) fn solves_jointly(&self) -> bool {
+        self.joint_cg
+    }
+
+    /// Conjugate-gradient iterations of the last substep's solves.
+    pub(crate) fn cg_iterations(&self) -> usize {
+        self.cg.iter().map(|c| c.iterations).sum()
     }
 
     /// One more sweep over the closed seams alone (rest length 0, at most

@@ -200,6 +200,7 @@ impl Solver {
         let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
         // The last substep's velocities (and its driven pins') are still to be computed.
         let mut pending = false;
+        let mut cg_iterations = 0;
         for k in 0..s.substeps {
             if self.stopping() {
                 if pending {
@@ -272,13 +273,16 @@ impl Solver {
             strategy.begin_substep(&mut self.constraints);
             match rule {
                 Some(rule) => {
+                    let joint = self.constraints.solves_jointly();
                     for it in 0..s.iterations {
-                        self.domains.project_global(
-                            &mut p.positions,
-                            &p.prev_positions,
-                            &p.inv_masses,
-                            it == 0,
-                        );
+                        if !joint {
+                            self.domains.project_global(
+                                &mut p.positions,
+                                &p.prev_positions,
+                                &p.inv_masses,
+                                it == 0,
+                            );
+                        }
                         self.constraints.project_others(
                             &mut p.positions,
                             &p.prev_positions,
@@ -287,6 +291,7 @@ impl Solver {
                             rule,
                             path,
                         );
+                        cg_iterations += self.constraints.cg_iterations();
                         stats.contacts = hook.project(&ctx, p);
                     }
                     if self.constraints.seam_count() > 0 {
@@ -309,7 +314,7 @@ impl Solver {
             self.finish_velocities(inv_h, keep);
             hook.end_substep(&ctx, &mut self.particles);
         }
-        stats.cg_iterations = self.spring_work.iterations;
+        stats.cg_iterations = self.spring_work.iterations + cg_iterations as u32;
         Frame {
             stats,
             whole,

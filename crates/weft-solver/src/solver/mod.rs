@@ -45,8 +45,8 @@ pub struct Cloth {
 pub struct StepStats {
     /// Contacts reported by the hook in the last substep.
     pub contacts: usize,
-    /// Conjugate-gradient iterations over the frame's substeps (implicit mass-spring; 0 for the
-    /// other methods).
+    /// Conjugate-gradient iterations over the frame's substeps: implicit mass-spring's, and
+    /// XPBD's bending or joint solves (see [`Solver::solves_jointly`]); 0 otherwise.
     pub cg_iterations: u32,
 }
 
@@ -494,6 +494,13 @@ impl Solver {
             self.check_divergence(frame)?;
         }
         Ok(stats)
+    }
+
+    /// Whether the last XPBD frame solved its distance and bending constraints together by
+    /// conjugate gradients (bending stiff per substep on a system of at most
+    /// 20,000 rows; see `constraints/quad_cg.rs`) rather than sweeping the distances.
+    pub fn solves_jointly(&self) -> bool {
+        self.constraints.solves_jointly()
     }
 
     /// Whether a frame of this solver runs fused (integration, sweep and contacts inside the
