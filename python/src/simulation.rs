@@ -260,9 +260,10 @@ impl Simulation {
 
     /// The last frame's statistics, as the log's `/stats` channel has them: `frame`, `time`
     /// (s), `kinetic_energy` (J), `residual_max` and `residual_rms` (m, the distance
-    /// constraints' violation), `contacts`, `cg_iterations` (the implicit method's),
-    /// `bending_residual` (under XPBD with bending hinges only: 0 converged, 1 a hinge about
-    /// twice too soft), and `step_ms` (the step's wall-clock time, ms).
+    /// constraints' violation), `contacts`, `cg_iterations` (conjugate-gradient iterations:
+    /// implicit mass-spring's, XPBD's of stiff bending and stretch), `bending_residual`
+    /// (under XPBD with bending hinges only: 0 converged, 1 a hinge about twice too soft),
+    /// and `step_ms` (the step's wall-clock time, ms).
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.state.last;
         let d = PyDict::new(py);
