@@ -299,41 +299,26 @@ impl ConstraintSet {
             self.dihedral.apply_rows(1, x, cg);
             self.isometric.apply_rows(2, x, cg);
         } else {
-            self.project_bending(x, prev, w, params, rule, path);
+            let none = FrameConstants::default();
+            if self.bending_cg[0] {
+                self.dihedral
+                    .solve_cg(x, prev, w, params, h, &mut self.cg[0]);
+            } else {
+                self.dihedral
+                    .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
+            }
+            if self.bending_cg[1] {
+                self.isometric
+                    .solve_cg(x, prev, w, params, h, &mut self.cg[1]);
+            } else {
+                let forward = self.isometric_forward;
+                let constants = &self.isometric_constants;
+                self.isometric
+                    .project_symmetric_lanes(x, prev, w, params, rule, path, forward, constants);
+            }
         }
         self.tethers.project(x, prev, w, params, rule);
         self.seams.project(x, prev, w, &self.seam_params, rule);
-    }
-
-    /// The bending blocks' step: each by conjugate gradients or by its symmetric lane sweep
-    /// (see [`Self::prepare_sweeps`]).
-    fn project_bending(
-        &mut self,
-        x: &mut [DVec3],
-        prev: &[DVec3],
-        w: &[f64],
-        params: &[FamilyParams],
-        rule: Rule,
-        path: SimdPath,
-    ) {
-        let none = FrameConstants::default();
-        let h = self.xpbd_h;
-        if self.bending_cg[0] {
-            self.dihedral
-                .solve_cg(x, prev, w, params, h, &mut self.cg[0]);
-        } else {
-            self.dihedral
-                .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
-        }
-        if self.bending_cg[1] {
-            self.isometric
-                .solve_cg(x, prev, w, params, h, &mut self.cg[1]);
-        } else {
-            let forward = self.isometric_forward;
-            let constants = &self.isometric_constants;
-            self.isometric
-                .project_symmetric_lanes(x, prev, w, params, rule, path, forward, constants);
-        }
     }
 
     /// Whether this frame's distance and bending constraints are solved together by

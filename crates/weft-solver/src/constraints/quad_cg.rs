@@ -450,18 +450,23 @@ mod tests {
         (x, w, b.finish(&free))
     }
 
-    #[test]
-    fn conjugate_gradients_solve_what_one_sweep_leaves_soft() {
-        let (x0, w, mut block) = strip(6);
-        assert!(block.len() >= 6);
-        let params = [FamilyParams {
+    /// One enabled family of compliance `alpha`.
+    fn compliant(alpha: f64) -> [FamilyParams; 1] {
+        [FamilyParams {
             enabled: true,
-            compliance: 1e-3,
+            compliance: alpha,
             damping: 0.0,
             pbd_stiffness: 1.0,
             spring_stiffness: 1e3,
             spring_damping: 0.0,
-        }];
+        }]
+    }
+
+    #[test]
+    fn conjugate_gradients_solve_what_one_sweep_leaves_soft() {
+        let (x0, w, mut block) = strip(6);
+        assert!(block.len() >= 6);
+        let params = compliant(1e-3);
         let h = 1.0;
         let ratio = block.mean_stiffness_ratio(&x0, &w, &params, h);
         assert!(
@@ -513,18 +518,8 @@ mod tests {
                 .fold(0.0f64, f64::max)
         };
         let before = stretched(&x0, &edges);
-        let params = [FamilyParams {
-            enabled: true,
-            compliance: 1e-3,
-            damping: 0.0,
-            pbd_stiffness: 1.0,
-            spring_stiffness: 1e3,
-            spring_damping: 0.0,
-        }];
-        let stiff = [FamilyParams {
-            compliance: 1e-8,
-            ..params[0]
-        }];
+        let params = compliant(1e-3);
+        let stiff = compliant(1e-8);
         let mut x = x0.clone();
         let mut cg = CgScratch::default();
         for _ in 0..3 {
