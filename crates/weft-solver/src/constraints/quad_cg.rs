@@ -513,9 +513,7 @@ mod tests {
         }
         let mut edges = b.finish(&free);
         let stretched = |x: &[DVec3], e: &Block<2, Distance>| {
-            (e.particles.iter().zip(&e.shapes))
-                .map(|(p, d)| (x[p[0] as usize].distance(x[p[1] as usize]) - d.rest).abs())
-                .fold(0.0f64, f64::max)
+            e.residuals(x).fold(0.0f64, |m, c| m.max(c.abs()))
         };
         let before = stretched(&x0, &edges);
         let params = compliant(1e-3);

@@ -3,7 +3,7 @@
 //! so that the chord from the clamp's edge to the tip falls at 41.49° (Peirce 1930). The
 //! strip's stiffness comes only from the material mapping (5/4 B per hinge, see
 //! `material.rs`), so a 10 % error in the bending constant moves the angle by about 2.3°.
-//! The strips are 8 segments long (a debug build runs them in seconds; 16 and 32 are in
+//! The strips are 8 and 16 segments long (a debug build runs them in seconds; 32 is in
 //! `assets/experiments/cantilever.toml` and `docs/validation.md`).
 
 use crate::common;
