@@ -253,6 +253,21 @@ fn stats_section(ui: &mut Ui, session: &Session) {
             s.contacts.to_string(),
             "cloth–collider contacts in the last frame",
         );
+        row(
+            "stretch error",
+            format!("{:.2} mm", s.stretch_error * 1e3),
+            "the largest |C| over the stretch and shear constraints after the last frame: how far \
+             the stiffest edge stands from its rest length",
+        );
+        if s.cg_iterations > 0 {
+            row(
+                "CG iterations",
+                s.cg_iterations.to_string(),
+                "conjugate-gradient iterations of the last frame, every substep together: \
+                 implicit mass-spring's solve, XPBD's solve of stiff bending (with the stretch \
+                 on small cloths)",
+            );
+        }
         if let Some(b) = s.bending_residual {
             row(
                 "bending residual",

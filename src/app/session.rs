@@ -57,6 +57,11 @@ pub struct Stats {
     pub contacts: usize,
     /// Cloth crossings of the last frame, when measured.
     pub crossings: Option<weft_sim::CrossingStats>,
+    /// Largest |C| over the distance-like constraints after the last frame (m).
+    pub stretch_error: f64,
+    /// Conjugate-gradient iterations of the last frame (implicit mass-spring's, XPBD's
+    /// bending or joint solves).
+    pub cg_iterations: u64,
     /// XPBD's bending residual of the last frame, where it bends.
     pub bending_residual: Option<f64>,
 }
@@ -131,6 +136,8 @@ impl Session {
                 self.stats.step_ms = start.elapsed().as_secs_f64() * 1e3;
                 self.stats.contacts = stats.contacts;
                 self.stats.crossings = stats.crossings;
+                self.stats.stretch_error = stats.residual_max;
+                self.stats.cg_iterations = stats.cg_iterations;
                 self.stats.bending_residual = stats.bending_residual;
                 self.stats.steps_last += 1;
                 self.frames += 1;
@@ -265,6 +272,27 @@ mod tests {
         // (frames since the reset, frames dropped) start again.
         assert!(s.frames > 5);
         assert_eq!(s.clock.dropped_total(), 0);
+    }
+
+    /// The panel's solver figures are the frame's: the stretch error, and the conjugate
+    /// gradients of XPBD's joint solve on the cantilever strip (none on the default cloth).
+    #[test]
+    fn the_panel_shows_the_frames_stretch_error_and_cg_iterations() {
+        let mut s = session();
+        s.step_once().expect("steps");
+        let now = s.sim.stats(0.0, 0);
+        assert!(s.stats.stretch_error > 0.0);
+        assert_eq!(s.stats.stretch_error, now.residual_max);
+        assert_eq!(
+            s.stats.cg_iterations, 0,
+            "the default cloth does not bend stiffly"
+        );
+        let strip = SceneSource::File(PathBuf::from("assets/scenes/cantilever.toml"));
+        s.switch_scene(strip).expect("loads");
+        s.step_once().expect("steps");
+        assert!(s.sim.groups[0].solver.solves_jointly());
+        assert!(s.stats.cg_iterations >= 10, "{}", s.stats.cg_iterations);
+        assert_eq!(s.stats.stretch_error, s.sim.stats(0.0, 0).residual_max);
     }
 
     #[test]

@@ -27,7 +27,8 @@ pub struct FrameStats {
     pub residual_rms: f64,
     /// Contacts in the last substep.
     pub contacts: usize,
-    /// Conjugate-gradient iterations of the frame's implicit solves (0 without implicit springs).
+    /// Conjugate-gradient iterations of the frame: implicit mass-spring's, and XPBD's bending or
+    /// joint solves (0 where neither runs).
     pub cg_iterations: u64,
     /// The largest XPBD bending residual of the last substep over the solvers
     /// (`Solver::bending_residual`: 0 converged, 1 a hinge about twice too soft); `None`
