@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::experiments::cantilever::Strip;
+use crate::experiments::reference::Tracker;
 use weft_sim::{FrameStats, Simulation};
 use weft_solver::Drape;
 
@@ -34,6 +35,10 @@ pub enum Metric {
     AngleError,
     /// Cusick drape test: the share of the free annulus the disc's shadow covers (1 flat).
     DrapeCoefficient,
+    /// RMS distance of the particles from the reference's at the last frame (m).
+    ShapeError,
+    /// RMS distance of the particles from the reference's over its sampled frames (m).
+    TrajectoryError,
 }
 
 impl Metric {
@@ -52,6 +57,8 @@ impl Metric {
             Metric::ElasticaAngle => "elastica_angle",
             Metric::AngleError => "angle_error",
             Metric::DrapeCoefficient => "drape_coefficient",
+            Metric::ShapeError => "shape_error",
+            Metric::TrajectoryError => "trajectory_error",
         }
     }
 
@@ -66,11 +73,12 @@ impl Metric {
             Metric::Frames => "frames",
             Metric::ChordAngle | Metric::ElasticaAngle | Metric::AngleError => "°",
             Metric::DrapeCoefficient => "",
+            Metric::ShapeError | Metric::TrajectoryError => "m",
         }
     }
 
     /// Every metric.
-    pub const ALL: [Metric; 12] = [
+    pub const ALL: [Metric; 14] = [
         Metric::Sag,
         Metric::StretchErrorMax,
         Metric::StretchErrorRms,
@@ -83,7 +91,14 @@ impl Metric {
         Metric::ElasticaAngle,
         Metric::AngleError,
         Metric::DrapeCoefficient,
+        Metric::ShapeError,
+        Metric::TrajectoryError,
     ];
+
+    /// Whether the metric is measured against a `[reference]` run.
+    pub fn needs_reference(self) -> bool {
+        matches!(self, Metric::ShapeError | Metric::TrajectoryError)
+    }
 
     /// The metric called `name`.
     pub fn from_name(name: &str) -> Option<Metric> {
@@ -102,6 +117,8 @@ pub struct Meter {
     strip: Option<Strip>,
     /// The first disc cloth (`disc_radius`) and its flat shadow.
     drape: Option<(usize, Drape)>,
+    /// The run against the experiment's reference, when it has one.
+    reference: Option<Tracker>,
 }
 
 fn lowest(sim: &Simulation) -> f64 {
@@ -123,22 +140,27 @@ fn drape(sim: &Simulation) -> Option<(usize, Drape)> {
 }
 
 impl Meter {
-    /// Starts at the initial state; `strip` is the run's cantilever, if it has one.
-    pub fn new(sim: &Simulation, strip: Option<Strip>) -> Self {
+    /// Starts at the initial state; `strip` is the run's cantilever, `reference` its
+    /// comparison with the experiment's reference, if it has them.
+    pub fn new(sim: &Simulation, strip: Option<Strip>, reference: Option<Tracker>) -> Self {
         Self {
             rest_lowest: lowest(sim),
             strip,
             drape: drape(sim),
+            reference,
             ..Self::default()
         }
     }
 
-    /// Records one stepped frame.
-    pub fn frame(&mut self, stats: &FrameStats) {
+    /// Records one stepped frame, `sim` as it left it.
+    pub fn frame(&mut self, stats: &FrameStats, sim: &Simulation) {
         self.worst_max = self.worst_max.max(stats.residual_max);
         self.worst_rms = self.worst_rms.max(stats.residual_rms);
         self.wall_ms += stats.step_ms;
         self.last = *stats;
+        if let Some(t) = self.reference.as_mut() {
+            t.frame(stats.frame, sim);
+        }
     }
 
     /// Every metric of the run so far.
@@ -168,6 +190,14 @@ impl Meter {
                     Metric::ElasticaAngle => elastica,
                     Metric::AngleError => chord - elastica,
                     Metric::DrapeCoefficient => drape,
+                    Metric::ShapeError => self
+                        .reference
+                        .as_ref()
+                        .map_or(f64::NAN, |t| t.shape_error(sim)),
+                    Metric::TrajectoryError => self
+                        .reference
+                        .as_ref()
+                        .map_or(f64::NAN, Tracker::trajectory_error),
                 };
                 (m, v)
             })

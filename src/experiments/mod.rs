@@ -2,13 +2,16 @@
 //! shard of it), logs each run to MCAP, and writes a summary table and plots.
 
 mod cantilever;
+mod front;
 mod metrics;
 mod montage;
 mod plot;
 mod progress;
+mod reference;
 mod report;
 mod spec;
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -17,6 +20,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, bail};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use weft_scene::Override;
 
 use crate::cli::ExperimentArgs;
 use crate::output::{Named, Output, refuse_clashes};
@@ -272,6 +277,13 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         // From here a signal raises the flag: running runs close their logs, runs not yet
         // started are left `not run`.
         let _polling = crate::stop::Polling::start();
+        let reference = match &spec.reference {
+            Some(_) => {
+                eprintln!("weft: running the reference");
+                run_reference(&spec, &scene_path, &limits, stop).context("the [reference] run")?
+            }
+            None => None,
+        };
         let bar = progress::QueueProgress::new(mine.len());
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
@@ -298,6 +310,7 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
                                 spec: &spec,
                                 run: r,
                                 strip: *strip,
+                                reference: reference.as_ref(),
                             };
                             run.execute(sim, &out, !args.no_mcap, gpu.as_ref(), stop)
                         })
@@ -397,11 +410,13 @@ fn write_montages(
     Ok(())
 }
 
-/// One run to execute: its plan, and its cantilever strip if the file has one.
+/// One run to execute: its plan, and its cantilever strip and the experiment's reference
+/// where the file has them.
 struct Execute<'a> {
     spec: &'a Spec,
     run: &'a PlannedRun,
     strip: Option<cantilever::Strip>,
+    reference: Option<&'a Arc<reference::Reference>>,
 }
 
 impl Execute<'_> {
@@ -415,11 +430,7 @@ impl Execute<'_> {
     ) -> anyhow::Result<RunResult> {
         let (spec, r) = (self.spec, self.run);
         let dt = sim.scene.settings.dt;
-        let frames = match (spec.frames, spec.duration) {
-            (Some(f), _) => f,
-            (None, Some(d)) => (d / dt).round().max(1.0) as u64,
-            (None, None) => 1,
-        };
+        let frames = spec.frames(dt);
         sim.set_stop(Arc::clone(stop));
         let rel = format!("{}.mcap", run_dir(r));
         let log = mcap.then(|| Output::create(&out.join(&rel))).transpose()?;
@@ -451,7 +462,8 @@ impl Execute<'_> {
             v.frame_span(&sim, frames as f64 * dt);
             v.frame(&sim)?;
         }
-        let mut meter = Meter::new(&sim, self.strip);
+        let tracker = self.reference.map(|r| r.track(&sim)).transpose()?;
+        let mut meter = Meter::new(&sim, self.strip, tracker);
         let mut status = Status::Complete;
         let mut first = sim.stats(0.0, 0);
         first.frame = 0;
@@ -466,7 +478,7 @@ impl Execute<'_> {
                 }
                 match sim.step() {
                     Ok(stats) => {
-                        meter.frame(&stats);
+                        meter.frame(&stats, &sim);
                         if let Some(rec) = rec.as_mut() {
                             rec.frame(&sim, &stats)?;
                         }
@@ -517,5 +529,90 @@ impl Execute<'_> {
             metrics,
             mcap: mcap.then_some(rel),
         })
+    }
+}
+
+/// The reference run's overrides: the file's common `set`, then the reference's own; refuses
+/// a reference that changes the frame time step.
+fn reference_overrides(
+    common: &BTreeMap<String, Value>,
+    spec: &spec::ReferenceSpec,
+) -> anyhow::Result<Vec<Override>> {
+    if spec.set.contains_key("sim.dt") {
+        bail!(
+            "reference.set: `sim.dt` cannot change (the reference is compared frame by frame); \
+             refine it with sim.substeps"
+        );
+    }
+    common
+        .iter()
+        .chain(&spec.set)
+        .map(|(k, v)| {
+            format!("{k}={}", spec::toml_text(v))
+                .parse::<Override>()
+                .with_context(|| format!("reference.set.{k}"))
+        })
+        .collect()
+}
+
+/// Loads and runs the reference of an experiments file for as many frames as its runs;
+/// `None` without a `[reference]` or when stopped.
+fn run_reference(
+    spec: &Spec,
+    scene_path: &Path,
+    limits: &weft_scene::Limits,
+    stop: &Arc<AtomicBool>,
+) -> anyhow::Result<Option<Arc<reference::Reference>>> {
+    let Some(r) = &spec.reference else {
+        return Ok(None);
+    };
+    let (ov, _) = cantilever::prepare(
+        spec.cantilever.as_ref(),
+        scene_path,
+        &reference_overrides(&spec.set, r)?,
+        limits,
+    )?;
+    let scene =
+        weft_scene::load_with(scene_path, &ov, limits).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let frames = spec.frames(scene.settings.dt);
+    let sim = Simulation::new(scene)?;
+    Ok(reference::Reference::run(sim, r.every, frames, stop)?.map(Arc::new))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every shipped experiments file loads, expands, names plots it can draw, and every run's
+    /// scene (and the reference's) loads with its overrides: a shipped experiment never stops
+    /// on its own input.
+    #[test]
+    fn every_shipped_experiment_and_its_runs_load() {
+        let limits = weft_scene::Limits::default();
+        let mut files: Vec<PathBuf> = std::fs::read_dir("assets/experiments")
+            .expect("assets/experiments")
+            .map(|e| e.expect("entry").path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        files.sort();
+        assert!(files.len() >= 9, "{files:?}");
+        for file in files {
+            let spec = Spec::load(&file).unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+            let runs = spec.expand().expect("expands");
+            spec.check_plots(&runs).expect("plots");
+            let scene = spec.scene_path(&file);
+            let mut overrides: Vec<Vec<Override>> =
+                runs.iter().map(|r| r.overrides.clone()).collect();
+            if let Some(r) = &spec.reference {
+                overrides.push(reference_overrides(&spec.set, r).expect("reference"));
+            }
+            for ov in overrides {
+                let (ov, _) = cantilever::prepare(spec.cantilever.as_ref(), &scene, &ov, &limits)
+                    .unwrap_or_else(|e| panic!("{}: {e:#}", file.display()));
+                if let Err(e) = weft_scene::load_with(&scene, &ov, &limits) {
+                    panic!("{}: {e}", file.display());
+                }
+            }
+        }
     }
 }

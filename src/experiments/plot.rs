@@ -9,6 +9,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 use crate::experiments::Row;
+use crate::experiments::front::{self, Point};
 use crate::experiments::metrics::Metric;
 use crate::experiments::spec::PlotSpec;
 
@@ -44,23 +45,34 @@ fn x_of(spec: &PlotSpec, row: &Row<'_>) -> Option<f64> {
     }
 }
 
+/// The rows that have both of `spec`'s values, as its points.
+pub fn points<'a>(spec: &PlotSpec, rows: &'a [Row<'_>]) -> Vec<Point<'a>> {
+    rows.iter()
+        .filter_map(|row| {
+            Some(Point {
+                series: row.run.series.as_str(),
+                label: row.run.label.as_str(),
+                x: x_of(spec, row)?,
+                y: row.result.metrics.get(spec.y.name()).copied().flatten()?,
+            })
+        })
+        .collect()
+}
+
 /// Draws `spec` from `rows` into `path`.
 pub fn draw(spec: &PlotSpec, rows: &[Row<'_>], path: &Path) -> anyhow::Result<()> {
     register_font();
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-    for row in rows {
-        let (Some(x), Some(y)) = (
-            x_of(spec, row),
-            row.result.metrics.get(spec.y.name()).copied().flatten(),
-        ) else {
-            continue;
-        };
+    for Point {
+        series: name, x, y, ..
+    } in points(spec, rows)
+    {
         if (spec.log_x && x <= 0.0) || (spec.log_y && y <= 0.0) {
             continue;
         }
-        match series.iter_mut().find(|(n, _)| *n == row.run.series) {
+        match series.iter_mut().find(|(n, _)| n == name) {
             Some((_, pts)) => pts.push((x, y)),
-            None => series.push((row.run.series.clone(), vec![(x, y)])),
+            None => series.push((name.to_owned(), vec![(x, y)])),
         }
     }
     for (_, pts) in &mut series {
@@ -129,8 +141,13 @@ pub fn draw(spec: &PlotSpec, rows: &[Row<'_>], path: &Path) -> anyhow::Result<()
                 .context("drawing axes")?;
             for (i, (name, pts)) in series.iter().enumerate() {
                 let c = COLORS[i % COLORS.len()];
+                let line = if spec.front {
+                    front::front(pts)
+                } else {
+                    pts.clone()
+                };
                 chart
-                    .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
+                    .draw_series(LineSeries::new(line, c.stroke_width(2)))
                     .context("drawing a series")?
                     .label(name.as_str())
                     .legend(move |(x, y)| {

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use crate::experiments::plot;
 use crate::experiments::spec::{PlannedRun, Spec};
 use crate::experiments::{NOT_RUN, Row, RunResult, result_path};
+use crate::experiments::{front, plot};
 use crate::output::Output;
 
 /// A value for the Markdown table: whole numbers (frame counts) as integers, the rest to four
@@ -103,8 +103,6 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
                 .join(" | ")
         );
     }
-    crate::output::write_file(&out.join("summary.csv"), csv.as_bytes())?;
-    crate::output::write_file(&out.join("summary.md"), md.as_bytes())?;
     // Plots first, so a closed or full standard output never costs a plot. Only complete runs
     // are plotted: an interrupted run's values cover part of its time.
     let complete: Vec<Row<'_>> = rows
@@ -115,6 +113,11 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
             result: r.result.clone(),
         })
         .collect();
+    for p in spec.plot.iter().filter(|p| p.front) {
+        md.push_str(&front::cheapest_table(p, &plot::points(p, &complete)));
+    }
+    crate::output::write_file(&out.join("summary.csv"), csv.as_bytes())?;
+    crate::output::write_file(&out.join("summary.md"), md.as_bytes())?;
     let mut drawn = Vec::new();
     for p in &spec.plot {
         let path = out.join(&p.file);

@@ -39,6 +39,25 @@ pub struct Spec {
     /// The cantilever bending test: the strip cloth shaped from its material per run.
     #[serde(default)]
     pub cantilever: Option<crate::experiments::cantilever::CantileverSpec>,
+    /// The converged run `shape_error` and `trajectory_error` measure against.
+    #[serde(default)]
+    pub reference: Option<ReferenceSpec>,
+}
+
+/// `[reference]` of an experiments file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// Overrides of the reference run, on top of the file's `set` (e.g. `sim.substeps`).
+    #[serde(default)]
+    pub set: BTreeMap<String, Value>,
+    /// Frames between the trajectory's samples (≥ 1).
+    #[serde(default = "one")]
+    pub every: u64,
+}
+
+fn one() -> u64 {
+    1
 }
 
 /// A series: fixed overrides plus a sweep.
@@ -83,6 +102,10 @@ pub struct PlotSpec {
     /// Legend corner: `upper-left`, `upper-right` (default), `lower-left`, `lower-right`.
     #[serde(default)]
     pub legend: Option<String>,
+    /// Join each series' points along its front (the points no cheaper point beats: lowest
+    /// `y` so far in increasing `x`) instead of through all of them.
+    #[serde(default)]
+    pub front: bool,
 }
 
 /// One run of the queue.
@@ -209,6 +232,22 @@ impl Spec {
                 path.display()
             );
         }
+        let wants_reference = spec
+            .metrics
+            .iter()
+            .chain(spec.plot.iter().map(|p| &p.y))
+            .find(|m| m.needs_reference());
+        if let (Some(m), None) = (wants_reference, &spec.reference) {
+            bail!(
+                "{}: the metric `{}` needs a [reference] table (the converged run it is \
+                 measured against)",
+                path.display(),
+                m.name()
+            );
+        }
+        if spec.reference.as_ref().is_some_and(|r| r.every == 0) {
+            bail!("{}: reference.every must be at least 1", path.display());
+        }
         spec.check_finite(path, &text)?;
         Ok(spec)
     }
@@ -272,6 +311,15 @@ impl Spec {
             );
         }
         Ok(())
+    }
+
+    /// Frames per run at a frame time step of `dt`.
+    pub fn frames(&self, dt: f64) -> u64 {
+        match (self.frames, self.duration) {
+            (Some(f), _) => f,
+            (None, Some(d)) => (d / dt).round().max(1.0) as u64,
+            (None, None) => 1,
+        }
     }
 
     /// The base scene's path.

@@ -177,3 +177,97 @@ y = "drape_coefficient"
     let png = std::fs::read(o.join("dc.png")).expect("plot written");
     assert_eq!(&png[1..4], b"PNG");
 }
+
+/// The race's error metrics: a run with the reference's own settings is 0 from it (same
+/// bytes), XPBD's error falls as its substeps approach the reference's (convergence), every
+/// run of a series appears in the table of the cheapest run to each accuracy, and a metric
+/// that needs a reference without a `[reference]` is refused before anything runs.
+#[test]
+fn runs_are_measured_against_a_converged_reference() {
+    let dir = temp_dir("experiments-reference");
+    write(&dir, "small.toml", SMALL);
+    let body = r#"title = "race"
+scene = "small.toml"
+frames = 30
+metrics = ["shape_error", "trajectory_error", "ms_per_frame"]
+set = { "sim.damping" = 0.0, "cloth.flag.orientation" = "horizontal" }
+
+[[series]]
+name = "xpbd"
+vary = { "sim.substeps" = [1, 4, 16, 64] }
+
+[[series]]
+name = "implicit"
+set = { "sim.method" = "implicit-mass-spring" }
+vary = { "sim.substeps" = [4] }
+
+[[plot]]
+file = "front.png"
+x = "ms_per_frame"
+y = "trajectory_error"
+log_x = true
+log_y = true
+front = true
+"#;
+    let missing = write(&dir, "missing.toml", body);
+    let out = run(&[
+        "experiments",
+        &missing,
+        "--out",
+        &dir.join("o1").to_string_lossy(),
+    ]);
+    let (_, e) = texts(&out);
+    assert!(!out.status.success());
+    assert!(e.contains("`shape_error` needs a [reference] table"), "{e}");
+    assert!(!dir.join("o1/results").exists(), "ran anyway");
+    let exp = write(
+        &dir,
+        "exp.toml",
+        &format!("{body}\n[reference]\nset = {{ \"sim.substeps\" = 64 }}\nevery = 2\n"),
+    );
+    let o = dir.join("o2");
+    let out = run(&[
+        "experiments",
+        &exp,
+        "--out",
+        &o.to_string_lossy(),
+        "--no-mcap",
+        "--jobs",
+        "1",
+    ]);
+    let (stdout, e) = texts(&out);
+    assert!(out.status.success(), "{stdout}{e}");
+    let csv = std::fs::read_to_string(o.join("summary.csv")).expect("csv");
+    let value = |series: &str, swept: &str, col: usize| -> f64 {
+        let line = csv
+            .lines()
+            .find(|l| l.contains(&format!("\"{series}\",\"{swept}\"")))
+            .unwrap_or_else(|| panic!("{series} {swept}: {csv}"));
+        line.split(',')
+            .nth(4 + col)
+            .and_then(|v| v.parse().ok())
+            .expect(line)
+    };
+    let traj: Vec<f64> = [1, 4, 16, 64]
+        .iter()
+        .map(|n| value("xpbd", &format!("sim.substeps={n}"), 1))
+        .collect();
+    assert_eq!(traj[3], 0.0, "the reference's own settings: {csv}");
+    assert_eq!(value("xpbd", "sim.substeps=64", 0), 0.0, "{csv}");
+    assert!(
+        traj[0] > traj[1] && traj[1] > traj[2] && traj[2] > 0.0,
+        "{traj:?}"
+    );
+    assert!(value("implicit", "sim.substeps=4", 1) > 0.0, "{csv}");
+    let md = std::fs::read_to_string(o.join("summary.md")).expect("md");
+    assert!(
+        md.contains("## Cheapest run to each accuracy (front.png)"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| trajectory_error ≤ | xpbd | implicit |"),
+        "{md}"
+    );
+    let png = std::fs::read(o.join("front.png")).expect("plot written");
+    assert_eq!(&png[1..4], b"PNG");
+}
