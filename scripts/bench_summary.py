@@ -453,6 +453,7 @@ def main():
     page = buf.getvalue()
     out = opts["out"]
     if out:
+        page += kept_sections(out)
         tmp = Path(out).with_suffix(".md.tmp")
         tmp.write_text(page)
         tmp.replace(out)
@@ -462,6 +463,23 @@ def main():
     if opts["readme"]:
         return update_readme(opts["readme"], page, out)
     return 0
+
+
+def kept_sections(path):
+    """The sections of the page at `path` whose heading says "by hand": figures measured
+    outside criterion (an experiments queue, a bench not yet summarised), kept when the page is
+    regenerated."""
+    try:
+        old = Path(path).read_text()
+    except OSError:
+        return ""
+    kept, keep = [], False
+    for line in old.splitlines(keepends=True):
+        if line.startswith("## "):
+            keep = "by hand" in line
+        if keep:
+            kept.append(line)
+    return ("\n" + "".join(kept)) if kept else ""
 
 
 def write_page(r, root, note):
