@@ -129,8 +129,8 @@ pub struct ConstraintSet {
     /// Whether the distance and bending constraints are solved together by conjugate
     /// gradients this frame (see `quad_cg`).
     pub(crate) joint_cg: bool,
-    /// The conjugate gradients' scratch of the dihedral (or the joint) and the isometric block.
-    pub(crate) cg: [quad_cg::CgScratch; 2],
+    /// The conjugate gradients' scratch, every block under its own id (`quad_cg::*_ROWS`).
+    pub(crate) cg: quad_cg::CgScratch,
 }
 
 /// Max and root-mean-square of |C| over a set of constraints.
@@ -278,11 +278,9 @@ impl ConstraintSet {
         path: SimdPath,
     ) {
         let h = self.xpbd_h;
-        for cg in &mut self.cg {
-            cg.iterations = 0;
-        }
+        self.cg.substep_iterations = 0;
         if self.joint_cg {
-            let cg = &mut self.cg[0];
+            let cg = &mut self.cg;
             cg.begin(x.len());
             let at = quad_cg::Linearised {
                 x,
@@ -291,25 +289,32 @@ impl ConstraintSet {
                 params,
                 h,
             };
-            self.distance.gather_rows(0, &at, cg);
-            self.dihedral.gather_rows(1, &at, cg);
-            self.isometric.gather_rows(2, &at, cg);
+            self.distance.gather_rows(quad_cg::DISTANCE_ROWS, &at, cg);
+            self.dihedral.gather_rows(quad_cg::DIHEDRAL_ROWS, &at, cg);
+            self.isometric.gather_rows(quad_cg::ISOMETRIC_ROWS, &at, cg);
             cg.solve();
-            self.distance.apply_rows(0, x, cg);
-            self.dihedral.apply_rows(1, x, cg);
-            self.isometric.apply_rows(2, x, cg);
+            self.distance.apply_rows(quad_cg::DISTANCE_ROWS, x, cg);
+            self.dihedral.apply_rows(quad_cg::DIHEDRAL_ROWS, x, cg);
+            self.isometric.apply_rows(quad_cg::ISOMETRIC_ROWS, x, cg);
         } else {
             let none = FrameConstants::default();
             if self.bending_cg[0] {
                 self.dihedral
-                    .solve_cg(x, prev, w, params, h, &mut self.cg[0]);
+                    .solve_cg(x, prev, w, params, h, quad_cg::DIHEDRAL_ROWS, &mut self.cg);
             } else {
                 self.dihedral
                     .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
             }
             if self.bending_cg[1] {
-                self.isometric
-                    .solve_cg(x, prev, w, params, h, &mut self.cg[1]);
+                self.isometric.solve_cg(
+                    x,
+                    prev,
+                    w,
+                    params,
+                    h,
+                    quad_cg::ISOMETRIC_ROWS,
+                    &mut self.cg,
+                );
             } else {
                 let forward = self.isometric_forward;
                 let constants = &self.isometric_constants;
@@ -329,7 +334,7 @@ impl ConstraintSet {
 
     /// Conjugate-gradient iterations of the last substep's solves.
     pub(crate) fn cg_iterations(&self) -> usize {
-        self.cg.iter().map(|c| c.iterations).sum()
+        self.cg.substep_iterations
     }
 
     /// One more sweep over the closed seams alone (rest length 0, at most

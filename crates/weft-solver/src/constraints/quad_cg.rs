@@ -61,6 +61,16 @@ pub(crate) const JOINT_MAX_ROWS: usize = 20_000;
 /// stretch at 10 substeps has α̃/s ≈ 3·10⁻⁴, so only rigid rows meet the floor.
 pub(crate) const RIGID_FLOOR: f64 = 1e-6;
 
+/// The block id of the distance rows in [`CgScratch`] (each shape keeps its own id, so that
+/// its warm start survives a frame that solves it alone or jointly).
+pub(crate) const DISTANCE_ROWS: usize = 0;
+
+/// The block id of the dihedral rows in [`CgScratch`].
+pub(crate) const DIHEDRAL_ROWS: usize = 1;
+
+/// The block id of the isometric rows in [`CgScratch`].
+pub(crate) const ISOMETRIC_ROWS: usize = 2;
+
 /// At most this many conjugate-gradient iterations per solve.
 pub(crate) const CG_MAX_ITERATIONS: usize = 400;
 
@@ -157,6 +167,8 @@ pub(crate) struct CgScratch {
     last: Vec<Vec<f64>>,
     /// Iterations of the last solve.
     pub iterations: usize,
+    /// Iterations of every solve since it was last set to 0 (the substep's, for the stats).
+    pub substep_iterations: usize,
 }
 
 impl CgScratch {
@@ -233,6 +245,7 @@ impl CgScratch {
             }
             cg.iterations += 1;
         }
+        cg.substep_iterations += cg.iterations;
     }
 }
 
@@ -353,7 +366,8 @@ impl<const N: usize, Q: Rows<N>> Block<N, Q> {
     }
 
     /// One XPBD step of every enabled constraint of this block alone, by conjugate gradients
-    /// in `scratch` (see [`Self::gather_rows`]).
+    /// in `scratch` as its block `id` (see [`Self::gather_rows`]).
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn solve_cg(
         &mut self,
         x: &mut [DVec3],
@@ -361,6 +375,7 @@ impl<const N: usize, Q: Rows<N>> Block<N, Q> {
         w: &[f64],
         params: &[FamilyParams],
         h: f64,
+        id: usize,
         scratch: &mut CgScratch,
     ) {
         scratch.begin(x.len());
@@ -371,9 +386,9 @@ impl<const N: usize, Q: Rows<N>> Block<N, Q> {
             params,
             h,
         };
-        self.gather_rows(0, &at, scratch);
+        self.gather_rows(id, &at, scratch);
         scratch.solve();
-        self.apply_rows(0, x, scratch);
+        self.apply_rows(id, x, scratch);
     }
 
     /// [`ResidualSums`] of the enabled constraints at `x` (previous positions `prev`) with
@@ -475,7 +490,7 @@ mod tests {
         );
         let mut x = x0.clone();
         let mut cg = CgScratch::default();
-        block.solve_cg(&mut x, &x0, &w, &params, h, &mut cg);
+        block.solve_cg(&mut x, &x0, &w, &params, h, 0, &mut cg);
         // Isometric bending is linear in the positions: the solve is exact to its tolerance.
         let s = block.residual_sums(&x, &x0, &params, h);
         assert!(cg.iterations > 1 && cg.iterations < CG_MAX_ITERATIONS);
@@ -491,7 +506,7 @@ mod tests {
         let iterations = cg.iterations;
         block.reset_multipliers();
         let mut x = x0.clone();
-        block.solve_cg(&mut x, &x0, &w, &params, h, &mut cg);
+        block.solve_cg(&mut x, &x0, &w, &params, h, 0, &mut cg);
         assert!(
             cg.iterations < iterations.min(2),
             "{} of {iterations}",
