@@ -277,13 +277,8 @@ pub fn run(args: &ExperimentArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<Exit
         // From here a signal raises the flag: running runs close their logs, runs not yet
         // started are left `not run`.
         let _polling = crate::stop::Polling::start();
-        let reference = match &spec.reference {
-            Some(_) => {
-                eprintln!("weft: running the reference");
-                run_reference(&spec, &scene_path, &limits, stop).context("the [reference] run")?
-            }
-            None => None,
-        };
+        let reference =
+            run_reference(&spec, &scene_path, &limits, stop).context("the [reference] run")?;
         let bar = progress::QueueProgress::new(mine.len());
         let results: Vec<anyhow::Result<RunResult>> = pool.install(|| {
             mine.par_iter()
@@ -566,6 +561,7 @@ fn run_reference(
     let Some(r) = &spec.reference else {
         return Ok(None);
     };
+    eprintln!("weft: running the reference");
     let (ov, _) = cantilever::prepare(
         spec.cantilever.as_ref(),
         scene_path,

@@ -17,10 +17,12 @@ fn positions(sim: &Simulation) -> Vec<DVec3> {
         .collect()
 }
 
-/// Root mean square of the distances between `a` and `b`, particle by particle.
-fn rms_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
-    let sum: f64 = a.iter().zip(b).map(|(p, q)| p.distance_squared(*q)).sum();
-    (sum / a.len().max(1) as f64).sqrt()
+/// Root mean square of the distances between the particles of `sim` (in scene order) and
+/// `there`.
+fn rms_distance(sim: &Simulation, there: &[DVec3]) -> f64 {
+    let here = (0..sim.scene.cloths.len()).flat_map(|i| sim.cloth_positions(i).iter());
+    let sum: f64 = here.zip(there).map(|(p, q)| p.distance_squared(*q)).sum();
+    (sum / there.len().max(1) as f64).sqrt()
 }
 
 /// The reference run's particles at every `every`-th frame and at its last.
@@ -35,16 +37,15 @@ pub struct Reference {
 }
 
 impl Reference {
-    /// Runs `sim` for `frames` frames, sampling every `every`-th; `None` when stopped.
+    /// Runs `sim` for `frames` frames, sampling every `every`-th (at least 1, as
+    /// `Spec::load` checks); `None` when stopped.
     pub fn run(
         mut sim: Simulation,
         every: u64,
         frames: u64,
         stop: &Arc<AtomicBool>,
     ) -> anyhow::Result<Option<Self>> {
-        if every == 0 {
-            bail!("reference.every must be at least 1");
-        }
+        debug_assert!(every > 0, "Spec::load refuses reference.every = 0");
         sim.set_stop(Arc::clone(stop));
         let mut samples = vec![positions(&sim)];
         for f in 1..=frames {
@@ -72,12 +73,13 @@ impl Reference {
     /// run of another particle count or frame time step.
     pub fn track(self: &Arc<Self>, sim: &Simulation) -> anyhow::Result<Tracker> {
         let n = self.last.len();
-        let here = positions(sim);
-        if here.len() != n {
+        let here: usize = (0..sim.scene.cloths.len())
+            .map(|i| sim.cloth_positions(i).len())
+            .sum();
+        if here != n {
             bail!(
-                "the run has {} particles and the reference {n}: a reference must keep the \
-                 runs' meshes",
-                here.len()
+                "the run has {here} particles and the reference {n}: a reference must keep \
+                 the runs' meshes"
             );
         }
         if (sim.dt() - self.dt).abs() > 1e-12 * self.dt {
@@ -93,7 +95,7 @@ impl Reference {
             sum_sq: 0.0,
             samples: 0,
         };
-        t.sample(0, &here);
+        t.frame(0, sim);
         Ok(t)
     }
 }
@@ -108,7 +110,8 @@ pub struct Tracker {
 }
 
 impl Tracker {
-    fn sample(&mut self, frame: u64, here: &[DVec3]) {
+    /// Records the run's state after frame `frame` (a sampled frame only).
+    pub fn frame(&mut self, frame: u64, sim: &Simulation) {
         let r = &self.reference;
         if frame % r.every != 0 {
             return;
@@ -117,22 +120,15 @@ impl Tracker {
             .ok()
             .and_then(|k| r.samples.get(k))
         {
-            self.sum_sq += rms_distance(here, there).powi(2);
+            self.sum_sq += rms_distance(sim, there).powi(2);
             self.samples += 1;
-        }
-    }
-
-    /// Records the run's state after frame `frame`.
-    pub fn frame(&mut self, frame: u64, sim: &Simulation) {
-        if frame % self.reference.every == 0 {
-            self.sample(frame, &positions(sim));
         }
     }
 
     /// RMS distance from the reference's last frame (m): the error of the rest shape when
     /// both have settled.
     pub fn shape_error(&self, sim: &Simulation) -> f64 {
-        rms_distance(&positions(sim), &self.reference.last)
+        rms_distance(sim, &self.reference.last)
     }
 
     /// RMS distance from the reference over the sampled frames (m): the trajectory's error.
