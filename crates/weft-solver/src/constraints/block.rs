@@ -342,6 +342,7 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
     }
 
     /// Adds spring forces fᵢ = −(k C + c Ċ) ∇Cᵢ, with Ċ = Σ ∇Cⱼ·vⱼ, to `forces`.
+    #[cfg(test)]
     pub fn spring_forces(
         &self,
         x: &[DVec3],

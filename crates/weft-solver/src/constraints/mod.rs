@@ -35,6 +35,7 @@ mod quad_cg;
 mod quad_lanes;
 mod quad_sweep;
 mod seam;
+mod spring_force;
 mod tether;
 
 pub(crate) use block::{Block, BlockBuilder, Rule};
@@ -349,7 +350,9 @@ impl ConstraintSet {
             });
     }
 
-    /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N).
+    /// Adds spring forces −(k C + c Ċ) ∇C of every constraint to `forces` (N): the serial loop
+    /// that [`ConstraintSet::spring_force_slots`] must match bit for bit.
+    #[cfg(test)]
     pub(crate) fn spring_forces(
         &self,
         x: &[DVec3],

@@ -71,7 +71,6 @@ impl Strategy for ImplicitMassSpring {
         params: &[FamilyParams],
         pass: ForcePass<'_>,
         work: &mut SpringWork,
-        _force: &mut [DVec3],
         accel: &mut [DVec3],
     ) {
         let h = pass.h;
@@ -216,9 +215,7 @@ mod tests {
                 },
                 stop: None,
             };
-            let mut force = vec![DVec3::ZERO; n];
-            ImplicitMassSpring
-                .add_internal_forces(&cs, &p, &params, pass, &mut work, &mut force, &mut accel);
+            ImplicitMassSpring.add_internal_forces(&cs, &p, &params, pass, &mut work, &mut accel);
             let dv: Vec<DVec3> = (0..n)
                 .map(|i| {
                     if p.inv_masses[i] > 0.0 {

@@ -1,13 +1,14 @@
-//! `SpringWork`: what the implicit springs keep between substeps — the rows of the spring
-//! operator (built once from the constraint graph), the last velocity change (the next solve's
-//! warm start), the scratch vectors, and the iterations the frame's solves took.
+//! `SpringWork`: what the spring methods keep between substeps — the rows of the spring
+//! operator (built once from the constraint graph; the explicit method sums its forces by
+//! them too), the last velocity change (the implicit solve's warm start), the scratch vectors,
+//! and the iterations the frame's solves took.
 
 use glam::DVec3;
 
 use crate::constraints::{ConstraintSet, SlotRhs, Springs};
 use crate::sparse::{Outcome, PcgScratch, Rows, Sym3};
 
-/// The implicit method's state and scratch, held by the solver (see the module documentation).
+/// The spring methods' state and scratch, held by the solver (see the module documentation).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SpringWork {
     /// The rows of the spring operator and the spring counts they were built for.
@@ -17,7 +18,7 @@ pub(crate) struct SpringWork {
     pub springs: Springs,
     /// Each slot's share of the right-hand side, of A x₀ and of A's diagonal.
     pub rhs: Vec<SlotRhs>,
-    /// Each slot's share of a product (scratch).
+    /// Each slot's share of a product, or of the spring forces (scratch).
     pub y: Vec<DVec3>,
     /// The inverse diagonal blocks of A (zero at filtered particles): the preconditioner.
     pub pinv: Vec<Sym3>,

@@ -32,9 +32,8 @@ impl ForcePass<'_> {
 /// What distinguishes one method inside the shared substep loop.
 pub(crate) trait Strategy: Sync {
     /// Adds internal (constraint) accelerations for the substep of `pass` before integration,
-    /// on top of the external ones in `accel`; `force` is scratch, `work` the state a method
-    /// keeps between substeps.
-    #[allow(clippy::too_many_arguments)]
+    /// on top of the external ones in `accel`; `work` is the state and scratch a method keeps
+    /// between substeps.
     fn add_internal_forces(
         &self,
         _constraints: &ConstraintSet,
@@ -42,7 +41,6 @@ pub(crate) trait Strategy: Sync {
         _params: &[FamilyParams],
         _pass: ForcePass<'_>,
         _work: &mut SpringWork,
-        _force: &mut [DVec3],
         _accel: &mut [DVec3],
     ) {
     }

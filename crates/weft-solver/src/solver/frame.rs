@@ -234,7 +234,6 @@ impl Solver {
                     &self.params,
                     pass,
                     &mut self.spring_work,
-                    &mut self.force,
                     &mut self.accel,
                 );
             }

@@ -89,8 +89,7 @@ pub struct Solver {
     /// (scratch).
     frame_targets: Vec<Vec<(usize, DVec3)>>,
     accel: Vec<DVec3>,
-    force: Vec<DVec3>,
-    /// The implicit springs' rows, warm start and scratch.
+    /// The spring methods' rows, warm start and scratch.
     spring_work: SpringWork,
     time: f64,
     frame: u64,
@@ -143,7 +142,6 @@ impl Solver {
             driven_velocities: Vec::new(),
             driven: (Vec::new(), Vec::new()),
             grab: None,
-            force: scratch.clone(),
             accel: scratch,
             spring_work: SpringWork::default(),
             time: 0.0,
