@@ -1,8 +1,73 @@
 //! Each cloth's explicit-spring stability limit, in words, for `weft check`, the viewer's
-//! panel, and the warning `run`, `view`, `render` and `experiments` print before they start.
+//! panel, and the warning `run`, `view`, `render` and `experiments` print before they start;
+//! for the implicit method, the substeps that keep its swing from being damped away.
 
 use weft_scene::SolverGroup;
-use weft_solver::Solver;
+use weft_solver::{Method, Solver};
+
+/// The share of its amplitude a swing should keep over a second under backward Euler.
+const KEEP: f64 = 0.9;
+
+/// Share of an undamped mode's amplitude that backward Euler keeps over one second at substep
+/// `h`: each substep multiplies it by (1 + ω²h²)^(−1/2) (the implicit step's amplification
+/// factor on ẍ = −ω²x; measured in weft-solver's `oscillator_decays_as_backward_euler_predicts`).
+fn backward_euler_keep(omega: f64, h: f64) -> f64 {
+    (1.0 + (omega * h).powi(2)).powf(-0.5 / h)
+}
+
+/// The fewest substeps of a frame `dt` at which backward Euler keeps [`KEEP`] of a mode of
+/// `omega` over a second (at most a million).
+fn substeps_to_keep(omega: f64, dt: f64) -> u64 {
+    // keep(h) rises as h falls: search the power of two above, then bisect.
+    let ok = |n: u64| backward_euler_keep(omega, dt / n as f64) >= KEEP;
+    let mut hi = 1u64;
+    while !ok(hi) && hi < 1 << 20 {
+        hi *= 2;
+    }
+    let mut lo = hi / 2;
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if ok(mid) { hi = mid } else { lo = mid }
+    }
+    hi.max(1)
+}
+
+/// The implicit method's line: stable at any substep, and how many substeps keep the cloth's
+/// slowest swing, a hanging chain's fundamental ω = (j₀,₁ / 2) √(g / L) with j₀,₁ = 2.4048
+/// the first zero of J₀ and L the cloth's largest extent (Bernoulli's hanging chain).
+fn implicit_advice(solver: &Solver, cloth: usize, explicit_limit: f64) -> String {
+    let s = solver.settings();
+    let c = &solver.cloths()[cloth];
+    let head = format!(
+        "cloth `{}` ({}): stable at any substep (explicit springs would need h < {})",
+        c.name,
+        s.method.name(),
+        millis(explicit_limit)
+    );
+    let x = &solver.particles().positions[c.particles.clone()];
+    let (lo, hi) = x.iter().fold(
+        (
+            glam::DVec3::splat(f64::INFINITY),
+            glam::DVec3::splat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let length = (hi - lo).max_element();
+    let g = solver.forces().gravity.length();
+    if !(length > 0.0 && g > 0.0 && length.is_finite()) {
+        return head;
+    }
+    let omega = 0.5 * 2.4048 * (g / length).sqrt();
+    let kept = backward_euler_keep(omega, s.h());
+    format!(
+        "{head}; its numerical damping keeps {:.0} % of the slowest swing's amplitude a second \
+         (ω = {omega:.1} rad/s, a {length:.2} m hanging chain's); sim.substeps >= {} keeps \
+         {:.0} %, one a frame holds a rest shape",
+        kept * 100.0,
+        substeps_to_keep(omega, s.dt),
+        KEEP * 100.0
+    )
+}
 
 /// One cloth's stability verdict.
 pub struct Verdict {
@@ -19,6 +84,12 @@ pub fn verdict(solver: &Solver, cloth: usize) -> Option<Verdict> {
     let name = &solver.cloths().get(cloth)?.name;
     let s = solver.settings();
     let (h, limit, sure) = (s.h(), bound.mode_max_substep(), bound.max_substep());
+    if s.method == Method::ImplicitMassSpring {
+        return Some(Verdict {
+            text: implicit_advice(solver, cloth, limit),
+            ok: true,
+        });
+    }
     if !s.method.is_explicit() {
         return Some(Verdict {
             text: format!(
@@ -114,5 +185,72 @@ mod tests {
             lines[0]
         );
         assert!(warnings(&groups("implicit-mass-spring")).is_empty());
+    }
+
+    #[test]
+    fn the_fewest_substeps_that_keep_the_swing_are_found() {
+        let (omega, dt) = (4.0, 1.0 / 60.0);
+        let n = substeps_to_keep(omega, dt);
+        assert!(backward_euler_keep(omega, dt / n as f64) >= KEEP);
+        assert!(
+            backward_euler_keep(omega, dt / (n - 1) as f64) < KEEP,
+            "{n}"
+        );
+        // Small ωh: keep ≈ e^(−ω²h/2), so h ≈ 2 ln(1/0.9) / ω² = 13.2 ms: 2 substeps of 16.7 ms.
+        assert_eq!(n, 2);
+        assert_eq!(substeps_to_keep(0.5, dt), 1);
+        // The damping grows as ω²: 10× the frequency needs about 100× the substeps.
+        let stiff = substeps_to_keep(40.0, dt);
+        assert!((120..=130).contains(&stiff), "{stiff}");
+    }
+
+    #[test]
+    fn check_tells_implicit_users_the_substeps_that_keep_the_swing() {
+        let set = |key: &str, value: &str| weft_scene::Override {
+            key: key.into(),
+            value: value.into(),
+        };
+        let scene = |substeps: &str| {
+            weft_scene::load(
+                std::path::Path::new("assets/scenes/hanging.toml"),
+                &[
+                    set("sim.method", "\"implicit-mass-spring\""),
+                    set("sim.substeps", substeps),
+                ],
+            )
+            .expect("scene loads")
+            .build()
+            .expect("solvers")
+        };
+        let suggested = |text: &str| -> u64 {
+            let tail = text.split("sim.substeps >= ").nth(1).expect("a suggestion");
+            tail.split(' ')
+                .next()
+                .and_then(|n| n.parse().ok())
+                .expect("a count")
+        };
+        let one = verdict(&scene("1")[0].solver, 0).expect("a line");
+        assert!(one.ok, "{}", one.text);
+        assert!(one.text.contains("stable at any substep"), "{}", one.text);
+        let n = suggested(&one.text);
+        // A 1 m cloth: ω = 1.2024 √9.81 = 3.77 rad/s; one substep of 1/60 s keeps
+        // e^(−ω²h/2) ≈ 89 % a second, two keep 94 %.
+        assert!(one.text.contains("keeps 89 %"), "{}", one.text);
+        assert_eq!(n, 2, "{}", one.text);
+        // At the suggested count the line's own figure is at least 90 %.
+        let at_n = verdict(&scene(&n.to_string())[0].solver, 0).expect("a line");
+        let kept: f64 = at_n
+            .text
+            .split("keeps ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|k| k.parse().ok())
+            .expect("a share");
+        assert!(kept >= 90.0, "{}", at_n.text);
+        assert_eq!(
+            suggested(&at_n.text),
+            n,
+            "the advice does not depend on the substep"
+        );
     }
 }
