@@ -5,6 +5,8 @@
 use weft_scene::SolverGroup;
 use weft_solver::{Method, Solver};
 
+use crate::framing::Bounds;
+
 /// The share of its amplitude a swing should keep over a second under backward Euler.
 const KEEP: f64 = 0.9;
 
@@ -44,17 +46,13 @@ fn implicit_advice(solver: &Solver, cloth: usize, explicit_limit: f64) -> String
         s.method.name(),
         millis(explicit_limit)
     );
-    let x = &solver.particles().positions[c.particles.clone()];
-    let (lo, hi) = x.iter().fold(
-        (
-            glam::DVec3::splat(f64::INFINITY),
-            glam::DVec3::splat(f64::NEG_INFINITY),
-        ),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let length = (hi - lo).max_element();
+    let mut bounds = Bounds::default();
+    for p in &solver.particles().positions[c.particles.clone()] {
+        bounds.add(p.as_vec3());
+    }
+    let length = f64::from((bounds.hi - bounds.lo).max_element());
     let g = solver.forces().gravity.length();
-    if !(length > 0.0 && g > 0.0 && length.is_finite()) {
+    if bounds.is_empty() || !(length > 0.0 && g > 0.0) {
         return head;
     }
     let omega = 0.5 * 2.4048 * (g / length).sqrt();

@@ -277,13 +277,7 @@ impl ConstraintSet {
         out: &mut Springs,
         rhs: &mut Vec<SlotRhs>,
     ) {
-        let [d, b, i, t, s] = self.spring_counts();
-        let total = 2 * d + 4 * b + 4 * i + 2 * t + 2 * s;
-        rhs.resize(total, SlotRhs::default());
-        let (r_d, rest) = rhs.split_at_mut(2 * d);
-        let (r_b, rest) = rest.split_at_mut(4 * b);
-        let (r_i, rest) = rest.split_at_mut(4 * i);
-        let (r_t, r_s) = rest.split_at_mut(2 * t);
+        let [r_d, r_b, r_i, r_t, r_s] = slot_blocks(self.spring_counts(), rhs);
         linearize(&self.distance, params, st, &mut out.distance, r_d);
         linearize(&self.dihedral, params, st, &mut out.dihedral, r_b);
         linearize(&self.isometric, params, st, &mut out.isometric, r_i);
@@ -292,21 +286,37 @@ impl ConstraintSet {
     }
 }
 
+/// Slots each spring of a block owns, block by block in slot order: distance, dihedral,
+/// isometric, tethers, seams (the order of [`ConstraintSet::spring_rows`]).
+const SLOTS_PER_SPRING: [usize; 5] = [2, 4, 4, 2, 2];
+
+/// `slots` resized to hold every slot of `counts` springs per block, cut into the blocks'
+/// slots, in slot order.
+pub(super) fn slot_blocks<T: Clone + Default>(
+    counts: [usize; 5],
+    slots: &mut Vec<T>,
+) -> [&mut [T]; 5] {
+    let lens = std::array::from_fn::<_, 5, _>(|k| counts[k] * SLOTS_PER_SPRING[k]);
+    slots.resize(lens.iter().sum(), T::default());
+    let mut rest = &mut slots[..];
+    lens.map(|len| {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        rest = tail;
+        head
+    })
+}
+
 impl Springs {
     /// Writes (A − M) p = (h D + h² K) p into the slots `y` (one per slot).
     pub(crate) fn product(&self, p: &[DVec3], y: &mut Vec<DVec3>) {
-        let lens = [
-            2 * self.distance.len(),
-            4 * self.dihedral.len(),
-            4 * self.isometric.len(),
-            2 * self.tethers.len(),
-            2 * self.seams.len(),
+        let counts = [
+            self.distance.len(),
+            self.dihedral.len(),
+            self.isometric.len(),
+            self.tethers.len(),
+            self.seams.len(),
         ];
-        y.resize(lens.iter().sum(), DVec3::ZERO);
-        let (y_d, rest) = y.split_at_mut(lens[0]);
-        let (y_b, rest) = rest.split_at_mut(lens[1]);
-        let (y_i, rest) = rest.split_at_mut(lens[2]);
-        let (y_t, y_s) = rest.split_at_mut(lens[3]);
+        let [y_d, y_b, y_i, y_t, y_s] = slot_blocks(counts, y);
         product(&self.distance, p, y_d);
         product(&self.dihedral, p, y_b);
         product(&self.isometric, p, y_i);

@@ -7,6 +7,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::linear::slot_blocks;
 use super::{Block, ConstraintSet, Shape};
 use crate::params::FamilyParams;
 
@@ -59,12 +60,7 @@ impl ConstraintSet {
         params: &[FamilyParams],
         y: &mut Vec<DVec3>,
     ) {
-        let [d, b, i, t, s] = self.spring_counts();
-        y.resize(2 * d + 4 * b + 4 * i + 2 * t + 2 * s, DVec3::ZERO);
-        let (y_d, rest) = y.split_at_mut(2 * d);
-        let (y_b, rest) = rest.split_at_mut(4 * b);
-        let (y_i, rest) = rest.split_at_mut(4 * i);
-        let (y_t, y_s) = rest.split_at_mut(2 * t);
+        let [y_d, y_b, y_i, y_t, y_s] = slot_blocks(self.spring_counts(), y);
         self.distance.spring_force_slots(x, v, params, y_d);
         self.dihedral.spring_force_slots(x, v, params, y_b);
         self.isometric.spring_force_slots(x, v, params, y_i);
