@@ -18,6 +18,8 @@
 //!   kernel.
 //! - `quad_cg`: XPBD's bending step, alone or with the distance constraints, by conjugate
 //!   gradients where one sweep leaves it soft, and its residual.
+//! - `spring_stencil`: explicit distance springs on a grid as fixed index offsets, their
+//!   forces in f32 lanes.
 //! - `parts`: contiguous particle ranges that let one colour be projected in parallel.
 
 mod block;
@@ -36,6 +38,7 @@ mod quad_lanes;
 mod quad_sweep;
 mod seam;
 mod spring_force;
+mod spring_stencil;
 mod tether;
 
 pub(crate) use block::{Block, BlockBuilder, Rule};
@@ -44,6 +47,7 @@ pub use distance::Distance;
 pub use isometric::Isometric;
 pub(crate) use linear::{SlotRhs, Springs, State as LinearState};
 pub use seam::Seam;
+pub(crate) use spring_stencil::{Mirror, SpringStencil};
 pub use tether::Tether;
 
 use glam::DVec3;

@@ -1,5 +1,6 @@
 //! One small strategy per method.
 
+mod explicit_lanes;
 mod implicit_mass_spring;
 mod mass_spring;
 mod pbd;
@@ -7,6 +8,7 @@ mod spring_work;
 mod strategy;
 mod xpbd;
 
+pub(crate) use explicit_lanes::{LaneState, Part, Step, step_part};
 pub(crate) use implicit_mass_spring::ImplicitMassSpring;
 pub(crate) use mass_spring::MassSpring;
 pub(crate) use pbd::Pbd;

@@ -347,7 +347,7 @@ impl Solver {
 /// v ← v·e^(−c h) of a free particle (`keep`), the fused loop's order
 /// (`Domain::finish_velocities`).
 #[inline(always)]
-fn end_velocity(x: DVec3, prev: DVec3, w: f64, inv_h: f64, keep: Option<f64>) -> DVec3 {
+pub(super) fn end_velocity(x: DVec3, prev: DVec3, w: f64, inv_h: f64, keep: Option<f64>) -> DVec3 {
     let v = (x - prev) * inv_h;
     match keep {
         Some(keep) if w > 0.0 => v * keep,

@@ -2,6 +2,7 @@
 //! in `frame.rs`).
 
 mod frame;
+mod frame_springs;
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -91,6 +92,8 @@ pub struct Solver {
     accel: Vec<DVec3>,
     /// The spring methods' rows, warm start and scratch.
     spring_work: SpringWork,
+    /// The explicit springs' stencil, when they form one (see `frame_springs.rs`).
+    stencil: frame_springs::Stencil,
     time: f64,
     frame: u64,
     /// Raised by the caller to abandon the frame in progress (polled once per substep).
@@ -144,6 +147,7 @@ impl Solver {
             grab: None,
             accel: scratch,
             spring_work: SpringWork::default(),
+            stencil: frame_springs::Stencil::default(),
             time: 0.0,
             frame: 0,
             stop: None,
@@ -465,12 +469,14 @@ impl Solver {
     pub fn step_with(&mut self, hook: &mut dyn SubstepHook) -> Result<StepStats, SolverError> {
         let s = self.settings;
         let rule = s.method.strategy().rule(s.h());
+        let springs = s.method.is_explicit() && !hook.is_active() && self.stencil_ready();
         let done = rayon::scope(|_| match rule {
             Some(rule)
                 if self.fusable() && (!hook.is_active() || hook.particle_contacts().is_some()) =>
             {
                 self.frame_fused(rule, hook)
             }
+            None if springs => self.frame_springs(),
             _ => self.frame_general(hook),
         });
         let frame::Frame {
@@ -507,6 +513,14 @@ impl Solver {
     /// seams, aerodynamics).
     pub fn runs_fused(&self) -> bool {
         self.fusable()
+    }
+
+    /// Whether an explicit mass-spring frame of this solver takes its spring forces by
+    /// stencil, in f32 lanes inside one parallel pass per substep, when no hook is at work:
+    /// [`Solver::runs_fused`]'s conditions, on springs that join each particle to the ones a
+    /// few fixed index offsets away (a grid; see `frame_springs.rs`).
+    pub fn runs_springs_by_stencil(&mut self) -> bool {
+        self.stencil_ready()
     }
 
     /// Whether a frame can run fused (see [`Solver::step_with`]).

@@ -9,6 +9,7 @@ mod cusick;
 mod determinism;
 mod dihedral_energy;
 mod driven_pins;
+mod explicit_stencil;
 mod features;
 mod free_fall;
 mod hanging_cloth;

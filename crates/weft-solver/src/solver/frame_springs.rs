@@ -1,0 +1,171 @@
+//! The explicit mass-spring frame by stencil: when the springs form a stencil (a grid's
+//! distance springs, see [`SpringStencil`]) and nothing else needs the particle store between a
+//! substep's phases, each substep is one parallel pass in which every particle takes its spring
+//! force in f32 lanes from the last substep's [`Mirror`] and integrates in f64, writing its
+//! next mirror entry. The general loop does the same f64 integration from f64 forces: the two
+//! agree to the f32 rounding of the forces, and either gives the same bits on every thread
+//! count and kernel path.
+
+use rayon::prelude::*;
+
+use super::frame::{Frame, end_velocity};
+use super::{Solver, StepStats};
+use crate::chunk::CHUNK;
+use crate::constraints::{Mirror, SpringStencil};
+use crate::methods::{LaneState, Part, Step, step_part};
+
+/// The stencil, the particles' state in lanes and the two mirrors (a substep reads one and
+/// writes the other).
+#[derive(Clone, Debug)]
+pub(super) struct StencilFrame {
+    stencil: SpringStencil,
+    state: LaneState,
+    front: Mirror,
+    back: Mirror,
+}
+
+/// Whether the solver's springs form a stencil, found out on the first explicit frame.
+#[derive(Clone, Debug, Default)]
+pub(super) enum Stencil {
+    /// Not looked at yet.
+    #[default]
+    Unknown,
+    /// The springs form no stencil: the general loop runs.
+    Absent,
+    /// The springs' stencil.
+    Built(Box<StencilFrame>),
+}
+
+impl Solver {
+    /// Whether an explicit frame can run by stencil: no hook at work, only distance springs
+    /// and per-particle external forces ([`Solver::runs_fused`]'s conditions), and springs
+    /// that form a stencil (built here on first use).
+    pub(super) fn stencil_ready(&mut self) -> bool {
+        if !self.fusable() {
+            return false;
+        }
+        if let Stencil::Unknown = self.stencil {
+            let n = self.particles.len();
+            self.stencil = match SpringStencil::build(&self.constraints.distance, n) {
+                Some(stencil) => Stencil::Built(Box::new(StencilFrame {
+                    stencil,
+                    state: LaneState::default(),
+                    front: Mirror::default(),
+                    back: Mirror::default(),
+                })),
+                None => Stencil::Absent,
+            };
+        }
+        matches!(self.stencil, Stencil::Built(_))
+    }
+
+    /// One explicit frame by stencil (see the module documentation); the caller has checked
+    /// [`Solver::stencil_ready`].
+    pub(super) fn frame_springs(&mut self) -> Frame {
+        let s = self.settings;
+        let h = s.h();
+        let inv_h = 1.0 / h;
+        let keep = (self.forces.damping > 0.0).then(|| (-self.forces.damping * h).exp());
+        let step = Step {
+            h,
+            inv_h,
+            keep: keep.unwrap_or(1.0),
+            gravity: self.forces.gravity,
+            drag: self.forces.wind.drag,
+            wind: self.forces.wind.velocity,
+        };
+        let path = self.domains.path();
+        let Stencil::Built(mut st) = std::mem::take(&mut self.stencil) else {
+            unreachable!("frame_springs runs only after stencil_ready");
+        };
+        let StencilFrame {
+            stencil,
+            state,
+            front,
+            back,
+        } = &mut *st;
+        let coef = stencil.coefficients(&self.params);
+        let (m, stride) = (stencil.margin(), stencil.stride());
+        let p = &self.particles;
+        stencil.load(front, &p.positions, &p.velocities);
+        back.clone_from(front);
+        state.load(stride, &p.positions, &p.velocities, &p.inv_masses);
+        let mut whole = true;
+        let mut ran = false;
+        for k in 0..s.substeps {
+            if self.stopping() {
+                whole = false;
+                break;
+            }
+            self.substep_targets(k);
+            let stencil = &*stencil;
+            let from = &*front;
+            parts(state, back, m, stride)
+                .into_par_iter()
+                .for_each(|mut part| step_part(path, stencil, &coef, from, &step, &mut part));
+            ran = true;
+            for &(i, t) in &self.targets {
+                let [_, _, prev] = state.get(i);
+                let v = end_velocity(t, prev, state.w[i], inv_h, keep);
+                state.set(i, t, v);
+            }
+            // Driven pins report the velocity of what carries them, not the chord.
+            for &(i, v) in &self.driven_velocities {
+                let [x, _, _] = state.get(i);
+                state.set(i, x, v);
+            }
+            for &(i, _) in self.targets.iter().chain(&self.driven_velocities) {
+                let [x, v, _] = state.get(i);
+                back.set(m, i, x, v);
+            }
+            std::mem::swap(front, back);
+        }
+        if ran {
+            let p = &mut self.particles;
+            for (i, ((x, v), prev)) in (p.positions.iter_mut())
+                .zip(&mut p.velocities)
+                .zip(&mut p.prev_positions)
+                .enumerate()
+            {
+                [*x, *v, *prev] = state.get(i);
+            }
+        }
+        self.stencil = Stencil::Built(st);
+        Frame {
+            stats: StepStats::default(),
+            whole,
+            within: false,
+        }
+    }
+}
+
+/// The state and the next mirror cut into parallel tasks of [`CHUNK`] particles.
+fn parts<'a>(
+    state: &'a mut LaneState,
+    next: &'a mut Mirror,
+    m: usize,
+    stride: usize,
+) -> Vec<Part<'a>> {
+    let [x0, x1, x2] = &mut state.x;
+    let [v0, v1, v2] = &mut state.v;
+    let [p0, p1, p2] = &mut state.prev;
+    let mut f64s = [x0, x1, x2, v0, v1, v2, p0, p1, p2].map(|a| a.chunks_mut(CHUNK));
+    let [nx0, nx1, nx2] = &mut next.x;
+    let [nv0, nv1, nv2] = &mut next.v;
+    let mut f32s = [nx0, nx1, nx2, nv0, nv1, nv2].map(|a| a[m..m + stride].chunks_mut(CHUNK));
+    let mut out = Vec::with_capacity(stride.div_ceil(CHUNK));
+    for w in state.w.chunks(CHUNK) {
+        let mut d = f64s.each_mut().map(|it| it.next().expect("one length"));
+        let mut f = f32s.each_mut().map(|it| it.next().expect("one length"));
+        let take = |s: &mut &'a mut [f64]| std::mem::take(s);
+        out.push(Part {
+            start: out.len() * CHUNK,
+            x: [take(&mut d[0]), take(&mut d[1]), take(&mut d[2])],
+            v: [take(&mut d[3]), take(&mut d[4]), take(&mut d[5])],
+            prev: [take(&mut d[6]), take(&mut d[7]), take(&mut d[8])],
+            w,
+            next: f.each_mut().map(std::mem::take),
+        });
+    }
+    out
+}

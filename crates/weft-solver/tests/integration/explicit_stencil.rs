@@ -1,0 +1,110 @@
+//! The explicit frame by stencil (f32 spring forces in lanes, one pass a substep) against the
+//! general loop (f64 forces by slots): the same motion to the forces' f32 rounding, and the
+//! same bits on every thread count and kernel path.
+
+use crate::common;
+
+use common::flag::{flag_settings, fusable_flag, in_pool, state_bits, step, windy_flag};
+use weft_solver::glam::DVec3;
+use weft_solver::{Family, Method, Motion, Settings, SimdPath, Solver, Wind};
+
+/// The fusable windy flag (stretch, shear and bend-distance springs) under explicit
+/// mass-spring, soft enough for h = 1/240 s, with a moving pin if `moving`.
+fn flag(path: SimdPath, moving: bool) -> Solver {
+    let settings = Settings {
+        simd: Some(path),
+        ..flag_settings(Method::MassSpring, 256)
+    };
+    let (mut b, _) = fusable_flag((40, 40), settings);
+    if moving {
+        b.add_kinematic_pin(
+            0,
+            0,
+            Motion::Linear {
+                velocity: DVec3::new(0.5, 0.0, 0.0),
+            },
+        )
+        .expect("valid pin");
+    }
+    let mut s = b.build();
+    let mut params = s.cloth_params(0).expect("one cloth");
+    for f in Family::ALL {
+        params.get_mut(f).spring_stiffness = 5.0;
+        params.get_mut(f).spring_damping = 0.001;
+    }
+    s.set_cloth_params(0, params).expect("valid");
+    s
+}
+
+/// 30 frames of [`flag`] on `threads` threads, through the general loop when `general`, the
+/// corner grabbed and dragged in between: the final state's bits and positions.
+fn run(path: SimdPath, threads: usize, general: bool) -> (Vec<[u64; 3]>, Vec<DVec3>) {
+    in_pool(threads, || {
+        let mut s = flag(path, true);
+        assert!(s.runs_springs_by_stencil());
+        let corner = 40 * 40 - 1;
+        let start = s.particles().positions[corner];
+        for frame in 0..30 {
+            match frame {
+                5 => s.grab(corner).expect("particle exists"),
+                6..15 => s.drag_to(DVec3::new(0.3, -0.6 + 0.02 * frame as f64, 0.4)),
+                15 => s.release(),
+                _ => {}
+            }
+            step(&mut s, general);
+        }
+        assert!((s.particles().positions[corner] - start).length() > 0.1);
+        (state_bits(&s), s.particles().positions.clone())
+    })
+}
+
+#[test]
+fn the_stencil_frame_follows_the_general_loop_to_the_forces_rounding() {
+    // In still air, hanging from its pins: a motion that does not amplify small differences
+    // (the flag in wind and dragged flaps chaotically, and both runs part by centimetres).
+    let still = |general: bool| {
+        let mut s = flag(SimdPath::Scalar, false);
+        let mut forces = *s.forces();
+        forces.wind = Wind::default();
+        s.set_forces(forces).expect("valid forces");
+        for _ in 0..60 {
+            step(&mut s, general);
+        }
+        s.particles().positions.clone()
+    };
+    let (general, stencil) = (still(true), still(false));
+    let start = flag(SimdPath::Scalar, false).particles().positions.clone();
+    let fell = (general.iter().zip(&start).map(|(a, b)| (*a - *b).length())).fold(0.0, f64::max);
+    let apart = (general
+        .iter()
+        .zip(&stencil)
+        .map(|(a, b)| (*a - *b).length()))
+    .fold(0.0, f64::max);
+    println!("after 60 frames: fell {fell:.3} m, runs {apart:e} m apart");
+    assert!(fell > 0.05, "{fell} m");
+    // Positions rounded to f32 relative to a corner of a 1 m flag (~6e-8 m) in every force.
+    assert!(apart < 1e-5, "{apart:e} m");
+    assert!(apart > 0.0, "the stencil frame really ran");
+}
+
+#[test]
+fn the_stencil_frame_gives_the_same_bits_on_every_thread_count_and_path() {
+    let (baseline, _) = run(SimdPath::Scalar, 1, false);
+    for path in SimdPath::ALL.into_iter().filter(|p| p.supported()) {
+        for threads in [1, 2, 3] {
+            assert!(
+                run(path, threads, false).0 == baseline,
+                "{path}, {threads} thread(s)"
+            );
+        }
+    }
+}
+
+#[test]
+fn springs_that_form_no_stencil_run_the_general_loop() {
+    // Dihedral bending is no distance spring: the general loop takes every force.
+    let (b, _) = windy_flag((12, 12), flag_settings(Method::MassSpring, 256));
+    assert!(!b.build().runs_springs_by_stencil());
+    let (b, _) = fusable_flag((12, 12), flag_settings(Method::MassSpring, 256));
+    assert!(b.build().runs_springs_by_stencil());
+}
