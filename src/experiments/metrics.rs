@@ -62,6 +62,15 @@ impl Metric {
         }
     }
 
+    /// Whether the metric measures the cloth's state (a diverged run's value then describes a
+    /// blown-up cloth), rather than the run's cost, length or reference.
+    pub fn measures_state(self) -> bool {
+        !matches!(
+            self,
+            Metric::MsPerFrame | Metric::Cost | Metric::Frames | Metric::ElasticaAngle
+        )
+    }
+
     /// Unit for axis labels.
     pub fn unit(self) -> &'static str {
         match self {

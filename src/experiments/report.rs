@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
+use crate::experiments::metrics::Metric;
 use crate::experiments::spec::{PlannedRun, Spec};
 use crate::experiments::{NOT_RUN, Row, RunResult, result_path};
 use crate::experiments::{front, plot};
@@ -21,6 +22,16 @@ fn fmt(v: Option<f64>) -> String {
     }
 }
 
+/// The value of `m` the summary shows for `result`: none where the run diverged and `m`
+/// measures the cloth's state (its last value describes a blown-up cloth, e.g. a sag of 1e12 m).
+fn shown(m: Metric, result: &RunResult) -> Option<f64> {
+    let value = result.metrics.get(m.name()).copied().flatten();
+    match result.status.starts_with("diverged") && m.measures_state() {
+        true => None,
+        false => value,
+    }
+}
+
 /// The files the report writes under `out`, with what they are called in messages.
 pub fn files(spec: &Spec, out: &Path) -> Vec<(&'static str, PathBuf)> {
     let mut v = vec![
@@ -32,7 +43,8 @@ pub fn files(spec: &Spec, out: &Path) -> Vec<(&'static str, PathBuf)> {
 }
 
 /// Reads `results/run-*.json` under `out` and writes `summary.csv`, `summary.md` and the plots;
-/// a planned run with no result is listed as `not run`, with no values.
+/// a planned run with no result is listed as `not run`, with no values, and a diverged run with
+/// its cost and length only (see [`shown`]).
 pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let mut with_results = 0;
@@ -73,7 +85,7 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
         let values: Vec<Option<f64>> = spec
             .metrics
             .iter()
-            .map(|m| row.result.metrics.get(m.name()).copied().flatten())
+            .map(|&m| shown(m, &row.result))
             .collect();
         let status = row.result.status.split(':').next().unwrap_or("");
         let _ = writeln!(
@@ -140,7 +152,27 @@ pub fn write(spec: &Spec, runs: &[PlannedRun], out: &Path) -> anyhow::Result<()>
 
 #[cfg(test)]
 mod tests {
-    use super::fmt;
+    use super::*;
+
+    #[test]
+    fn a_diverged_run_shows_its_cost_and_length_but_no_state() {
+        let mut result = RunResult {
+            index: 0,
+            series: "s".into(),
+            label: "k=1e7".into(),
+            status: "diverged: particle 3 at frame 12".into(),
+            metrics: Default::default(),
+            mcap: None,
+        };
+        result.metrics.insert("sag".into(), Some(3.2e12));
+        result.metrics.insert("frames".into(), Some(12.0));
+        result.metrics.insert("ms_per_frame".into(), Some(0.5));
+        assert_eq!(shown(Metric::Sag, &result), None);
+        assert_eq!(shown(Metric::Frames, &result), Some(12.0));
+        assert_eq!(shown(Metric::MsPerFrame, &result), Some(0.5));
+        result.status = "complete".into();
+        assert_eq!(shown(Metric::Sag, &result), Some(3.2e12));
+    }
 
     #[test]
     fn counts_are_integers_and_measures_keep_their_decimals() {
