@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::flag::{flag_settings, fusable_flag, in_pool, state_bits, step};
+use common::flag::{drag_corner, flag_settings, fusable_flag, in_pool, state_bits};
 use common::*;
 use weft_solver::glam::DVec3;
 use weft_solver::{
@@ -115,15 +115,7 @@ fn fusable_in(method: Method, threads: usize, active: bool, still: bool) -> Vec<
         assert!(s.runs_fused(), "the fused side really runs fused");
         assert!(s.domain_stats().domains > 1 && s.domain_stats().links > 0);
         let corner = 40 * 40 - 1;
-        for frame in 0..30 {
-            match frame {
-                5 => s.grab(corner).expect("particle exists"),
-                6..15 => s.drag_to(DVec3::new(0.3, -0.6 + 0.02 * frame as f64, 0.4)),
-                15 => s.release(),
-                _ => {}
-            }
-            step(&mut s, active);
-        }
+        drag_corner(&mut s, corner, active);
         let p = s.particles();
         assert!((p.positions[corner] - mesh.positions[corner]).length() > 0.1);
         state_bits(&s)

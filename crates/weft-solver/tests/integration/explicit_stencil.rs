@@ -4,7 +4,9 @@
 
 use crate::common;
 
-use common::flag::{flag_settings, fusable_flag, in_pool, state_bits, step, windy_flag};
+use common::flag::{
+    drag_corner, flag_settings, fusable_flag, in_pool, state_bits, step, windy_flag,
+};
 use weft_solver::glam::DVec3;
 use weft_solver::{Family, Method, Motion, Settings, SimdPath, Solver, Wind};
 
@@ -44,15 +46,7 @@ fn run(path: SimdPath, threads: usize, general: bool) -> (Vec<[u64; 3]>, Vec<DVe
         assert!(s.runs_springs_by_stencil());
         let corner = 40 * 40 - 1;
         let start = s.particles().positions[corner];
-        for frame in 0..30 {
-            match frame {
-                5 => s.grab(corner).expect("particle exists"),
-                6..15 => s.drag_to(DVec3::new(0.3, -0.6 + 0.02 * frame as f64, 0.4)),
-                15 => s.release(),
-                _ => {}
-            }
-            step(&mut s, general);
-        }
+        drag_corner(&mut s, corner, general);
         assert!((s.particles().positions[corner] - start).length() > 0.1);
         (state_bits(&s), s.particles().positions.clone())
     })

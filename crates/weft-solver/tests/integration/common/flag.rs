@@ -87,6 +87,20 @@ pub fn step(s: &mut Solver, general: bool) {
     }
 }
 
+/// 30 frames ([`step`]) with particle `corner` grabbed at frame 5, dragged through frame 14
+/// and released at 15.
+pub fn drag_corner(s: &mut Solver, corner: usize, general: bool) {
+    for frame in 0..30 {
+        match frame {
+            5 => s.grab(corner).expect("particle exists"),
+            6..15 => s.drag_to(DVec3::new(0.3, -0.6 + 0.02 * frame as f64, 0.4)),
+            15 => s.release(),
+            _ => {}
+        }
+        step(s, general);
+    }
+}
+
 /// The bits of every position, then every velocity.
 pub fn state_bits(s: &Solver) -> Vec<[u64; 3]> {
     let p = s.particles();
