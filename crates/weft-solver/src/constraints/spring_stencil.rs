@@ -1,9 +1,8 @@
 //! Explicit distance springs as a stencil: on a mesh whose particle numbering repeats (a grid),
 //! every spring joins a particle i to i + o for one of a few offsets o. Each offset and
-//! parameter group is a slot;
-//! a particle's force is the sum over the slots of its spring there, each taken from its own
-//! end, so `W` consecutive particles load their neighbours with unit stride and need no
-//! scatter. The forces are taken in f32 lanes on a [`Mirror`] of the state; a spring seen
+//! parameter group is a slot; a particle's force is the sum over the slots of its spring
+//! there, each taken from its own end, so `W` consecutive particles load their neighbours with
+//! unit stride and need no scatter. The forces are taken in f32 lanes on a [`Mirror`] of the state; a spring seen
 //! from its two ends gives exactly opposite forces (every operation is symmetric or negated
 //! exactly), so momentum is kept to the bit, and the sum order is fixed by the slots alone:
 //! the same bits on every thread count and kernel path.
