@@ -47,7 +47,7 @@ pub use distance::Distance;
 pub use isometric::Isometric;
 pub(crate) use linear::{SlotRhs, Springs, State as LinearState};
 pub use seam::Seam;
-pub(crate) use spring_stencil::{Mirror, SpringStencil};
+pub(crate) use spring_stencil::{Mirror, Ring, SpringStencil, WIDEST};
 pub use tether::Tether;
 
 use glam::DVec3;

@@ -1,8 +1,8 @@
-//! Explicit mass-spring's substep in lanes: each group of particles takes its spring forces
-//! from the stencil ([`SpringStencil::group_forces`], f32) and integrates in f64 with
-//! semi-implicit Euler, v ← v + h a, x ← x + h v, then v ← (x − x_prev)/h and the global
-//! damping, the general loop's operations in its order (`solver/frame.rs`), one particle per
-//! lane.
+//! Explicit mass-spring's substep in lanes, one part of the particles at a time: the part's
+//! spring forces from the stencil, `W` particles at a time ([`SpringStencil::group_forces`],
+//! f32), then its integration in f64 with semi-implicit Euler, v ← v + h a, x ← x + h v, then
+//! v ← (x − x_prev)/h and the global damping, the general loop's operations in its order
+//! (`solver/frame.rs`), in one loop per axis over the part.
 
 // Lane and axis loops index several arrays in step; written as index loops on purpose so
 // that each compiles to one vector operation per axis.
@@ -11,8 +11,7 @@
 use glam::DVec3;
 use multiversion::multiversion;
 
-use crate::constraints::lanes::LANES;
-use crate::constraints::{Mirror, SpringStencil};
+use crate::constraints::{Mirror, Ring, SpringStencil, WIDEST};
 use weft_simd::SimdPath;
 
 /// The particles' f64 state as struct-of-arrays, padded to the stencil's stride (the padding
@@ -45,6 +44,20 @@ impl LaneState {
         self.w.resize(stride, 0.0);
     }
 
+    /// Writes the particles' positions, velocities and positions at the last substep's
+    /// start back (one pass, the arrays cut to the particle count first so that no index is
+    /// checked in the loop).
+    pub fn store(&self, x: &mut [DVec3], v: &mut [DVec3], prev: &mut [DVec3]) {
+        let n = x.len().min(v.len()).min(prev.len());
+        let (sx, sv, sp) = (cut(&self.x, n), cut(&self.v, n), cut(&self.prev, n));
+        let at = |s: [&[f64]; 3], i: usize| DVec3::new(s[0][i], s[1][i], s[2][i]);
+        for (i, ((x, v), prev)) in x.iter_mut().zip(v).zip(prev).enumerate() {
+            *x = at(sx, i);
+            *v = at(sv, i);
+            *prev = at(sp, i);
+        }
+    }
+
     /// Particle `i`'s position, velocity and position at the last substep's start.
     pub fn get(&self, i: usize) -> [DVec3; 3] {
         let at = |s: &[Vec<f64>; 3]| DVec3::new(s[0][i], s[1][i], s[2][i]);
@@ -58,6 +71,11 @@ impl LaneState {
             self.v[a][i] = v[a];
         }
     }
+}
+
+/// The first `n` values of each axis.
+fn cut(s: &[Vec<f64>; 3], n: usize) -> [&[f64]; 3] {
+    [&s[0][..n], &s[1][..n], &s[2][..n]]
 }
 
 /// What a substep's integration needs besides the particles.
@@ -77,9 +95,9 @@ pub(crate) struct Step {
     pub wind: DVec3,
 }
 
-/// One task's particles: `start` (a multiple of [`LANES`]) and, from there, its share of the
+/// One task's particles: `start` (a multiple of [`WIDEST`]) and, from there, its share of the
 /// state and of the next mirror (x then v, per axis), all of one length, a multiple of
-/// [`LANES`].
+/// [`WIDEST`].
 pub(crate) struct Part<'a> {
     /// Index of the first particle.
     pub start: usize,
@@ -87,12 +105,35 @@ pub(crate) struct Part<'a> {
     pub x: [&'a mut [f64]; 3],
     /// Velocities per axis.
     pub v: [&'a mut [f64]; 3],
-    /// Positions at the substep's start per axis (written).
+    /// Positions at the substep's start per axis (written on the frame's last substep).
     pub prev: [&'a mut [f64]; 3],
     /// Inverse masses.
     pub w: &'a [f64],
     /// The next mirror's x − origin, then v, per axis (written).
     pub next: [&'a mut [f32]; 6],
+    /// The task's working memory.
+    pub scratch: &'a mut Scratch,
+    /// Whether this is the frame's last substep (the only one whose start is kept in `prev`).
+    pub last: bool,
+}
+
+/// A task's working memory, kept from substep to substep (its content is rewritten by each).
+#[derive(Clone, Debug)]
+pub(crate) struct Scratch {
+    /// The ring of spring forces.
+    ring: Ring,
+    /// The part's spring forces per axis (N).
+    force: [Vec<f32>; 3],
+}
+
+impl Scratch {
+    /// Working memory for `stencil`'s parts.
+    pub fn new(stencil: &SpringStencil) -> Self {
+        Self {
+            ring: stencil.ring(),
+            force: Default::default(),
+        }
+    }
 }
 
 /// One substep for `part`: forces from the mirror `from`, integration, the next mirror's
@@ -105,7 +146,7 @@ pub(crate) fn step_part(
     step: &Step,
     part: &mut Part<'_>,
 ) {
-    assert!(part.start % LANES == 0 && part.w.len() % LANES == 0);
+    assert!(part.start % WIDEST == 0 && part.w.len() % WIDEST == 0);
     match path {
         SimdPath::Avx512 => step_avx512(stencil, coef, from, step, part),
         SimdPath::Avx2 => step_avx2(stencil, coef, from, step, part),
@@ -117,7 +158,7 @@ pub(crate) fn step_part(
 /// [`step_part`] compiled for AVX-512 (the baseline build where the CPU lacks it).
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx512dq+avx2+fma"))]
 fn step_avx512(st: &SpringStencil, coef: &[[f32; 2]], from: &Mirror, s: &Step, p: &mut Part) {
-    step_in::<LANES>(st, coef, from, s, p);
+    step_in::<16>(st, coef, from, s, p);
 }
 
 /// [`step_part`] compiled for AVX2 and FMA.
@@ -138,6 +179,7 @@ fn step_scalar(st: &SpringStencil, coef: &[[f32; 2]], from: &Mirror, s: &Step, p
     step_in::<4>(st, coef, from, s, p);
 }
 
+/// [`step_part`] at `W` lanes: spring forces for the part, then its integration.
 #[inline(always)]
 fn step_in<const W: usize>(
     st: &SpringStencil,
@@ -146,34 +188,76 @@ fn step_in<const W: usize>(
     s: &Step,
     p: &mut Part<'_>,
 ) {
-    let (h, inv_h, keep) = (s.h, s.inv_h, s.keep);
-    let (g, drag, wind) = (s.gravity, s.drag, s.wind);
-    let origin = from.origin;
+    // Without damping the springs need no velocities: the mirror's are neither read nor
+    // written.
+    match coef.iter().any(|&[_, c]| c != 0.0) {
+        true => {
+            forces::<W, true>(st, coef, from, p);
+            integrate::<true>(s, from, p);
+        }
+        false => {
+            forces::<W, false>(st, coef, from, p);
+            integrate::<false>(s, from, p);
+        }
+    }
+}
+
+/// The part's spring forces into its scratch.
+#[inline(always)]
+fn forces<const W: usize, const DAMPED: bool>(
+    st: &SpringStencil,
+    coef: &[[f32; 2]],
+    from: &Mirror,
+    p: &mut Part<'_>,
+) {
     let len = p.w.len();
+    let Scratch { ring, force } = &mut *p.scratch;
+    st.warm_ring::<W, DAMPED>(coef, from, ring, p.start);
+    for f in force.iter_mut() {
+        f.resize(len, 0.0);
+    }
     for j in (0..len).step_by(W) {
-        let f = st.group_forces::<W>(coef, from, p.start + j);
-        let w = &p.w[j..j + W];
+        let f = st.group_forces::<W, DAMPED>(coef, from, ring, p.start + j);
         for a in 0..3 {
-            let x = &mut p.x[a][j..j + W];
-            let v = &mut p.v[a][j..j + W];
-            let prev = &mut p.prev[a][j..j + W];
-            let (nx, nv) = {
-                let (nx, rest) = p.next.split_at_mut(3);
-                (&mut nx[a][j..j + W], &mut rest[a][j..j + W])
-            };
-            for l in 0..W {
-                let (x0, v0) = (x[l], v[l]);
-                // a = g + c_d (v_wind − v) + f w (`Forces::acceleration_of`, then the springs).
-                let acc = (g[a] + drag * (wind[a] - v0)) + f64::from(f[a][l]) * w[l];
-                let free = w[l] > 0.0;
-                let x1 = if free { x0 + (v0 + acc * h) * h } else { x0 };
-                let v1 = (x1 - x0) * inv_h;
-                let v1 = if free { v1 * keep } else { v1 };
-                prev[l] = x0;
-                x[l] = x1;
-                v[l] = v1;
-                nx[l] = (x1 - origin[a]) as f32;
-                nv[l] = v1 as f32;
+            force[a][j..j + W].copy_from_slice(&f[a]);
+        }
+    }
+}
+
+/// The part's integration from the forces in its scratch, one loop per axis over the part
+/// (the compiler vectorizes it, selects included); the next mirror's velocities only where
+/// `DAMPED` springs read them.
+#[inline(always)]
+fn integrate<const DAMPED: bool>(s: &Step, from: &Mirror, p: &mut Part<'_>) {
+    let (h, inv_h, keep) = (s.h, s.inv_h, s.keep);
+    let (g, drag, wind) = (s.gravity.to_array(), s.drag, s.wind.to_array());
+    let origin = from.origin.to_array();
+    for a in 0..3 {
+        let (nx, nv) = {
+            let (nx, rest) = p.next.split_at_mut(3);
+            (&mut *nx[a], &mut *rest[a])
+        };
+        let (x, v) = (&mut *p.x[a], &mut *p.v[a]);
+        if p.last {
+            p.prev[a].copy_from_slice(x);
+        }
+        let (g, wind, origin) = (g[a], wind[a], origin[a]);
+        let state = x.iter_mut().zip(v.iter_mut());
+        let next = nx.iter_mut().zip(nv.iter_mut());
+        let given = p.w.iter().zip(&p.scratch.force[a]);
+        for ((x, v), ((nx, nv), (&w, &f))) in state.zip(next.zip(given)) {
+            let (x0, v0) = (*x, *v);
+            // a = g + c_d (v_wind − v) + f w (`Forces::acceleration_of`, then the springs).
+            let acc = (g + drag * (wind - v0)) + f64::from(f) * w;
+            let free = w > 0.0;
+            let x1 = if free { x0 + (v0 + acc * h) * h } else { x0 };
+            let v1 = (x1 - x0) * inv_h;
+            let v1 = if free { v1 * keep } else { v1 };
+            *x = x1;
+            *v = v1;
+            *nx = (x1 - origin) as f32;
+            if DAMPED {
+                *nv = v1 as f32;
             }
         }
     }

@@ -8,7 +8,7 @@ mod spring_work;
 mod strategy;
 mod xpbd;
 
-pub(crate) use explicit_lanes::{LaneState, Part, Step, step_part};
+pub(crate) use explicit_lanes::{LaneState, Part, Scratch, Step, step_part};
 pub(crate) use implicit_mass_spring::ImplicitMassSpring;
 pub(crate) use mass_spring::MassSpring;
 pub(crate) use pbd::Pbd;

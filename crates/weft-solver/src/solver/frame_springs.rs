@@ -6,22 +6,26 @@
 //! agree to the f32 rounding of the forces, and either gives the same bits on every thread
 //! count and kernel path.
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::frame::{Frame, end_velocity};
 use super::{Solver, StepStats};
 use crate::chunk::CHUNK;
 use crate::constraints::{Mirror, SpringStencil};
-use crate::methods::{LaneState, Part, Step, step_part};
+use crate::methods::{LaneState, Part, Scratch, Step, step_part};
 
-/// The stencil, the particles' state in lanes and the two mirrors (a substep reads one and
-/// writes the other).
+/// The stencil, the particles' state in lanes, the two mirrors (a substep reads one and
+/// writes the other) and each task's working memory.
 #[derive(Clone, Debug)]
 pub(super) struct StencilFrame {
     stencil: SpringStencil,
     state: LaneState,
     front: Mirror,
     back: Mirror,
+    scratch: Vec<Scratch>,
+    /// The targets' positions at the substep's start.
+    starts: Vec<DVec3>,
 }
 
 /// Whether the solver's springs form a stencil, found out on the first explicit frame.
@@ -48,6 +52,8 @@ impl Solver {
             let n = self.particles.len();
             self.stencil = match SpringStencil::build(&self.constraints.distance, n) {
                 Some(stencil) => Stencil::Built(Box::new(StencilFrame {
+                    scratch: vec![Scratch::new(&stencil); stencil.stride().div_ceil(CHUNK)],
+                    starts: Vec::new(),
                     stencil,
                     state: LaneState::default(),
                     front: Mirror::default(),
@@ -83,12 +89,24 @@ impl Solver {
             state,
             front,
             back,
+            scratch,
+            starts,
         } = &mut *st;
         let coef = stencil.coefficients(&self.params);
         let (m, stride) = (stencil.margin(), stencil.stride());
         let p = &self.particles;
         stencil.load(front, &p.positions, &p.velocities);
-        back.clone_from(front);
+        // The pass writes every particle's entry of the next mirror; its margins stay as
+        // loaded (zero: finite, as the masked neighbour loads past the ends need).
+        back.origin = front.origin;
+        for (b, f) in back
+            .x
+            .iter_mut()
+            .chain(&mut back.v)
+            .zip(front.x.iter().chain(&front.v))
+        {
+            b.resize(f.len(), 0.0);
+        }
         state.load(stride, &p.positions, &p.velocities, &p.inv_masses);
         let mut whole = true;
         let mut ran = false;
@@ -98,15 +116,19 @@ impl Solver {
                 break;
             }
             self.substep_targets(k);
+            // The pass keeps the substep's start positions only on the last substep; the
+            // targets' velocities need theirs on every one.
+            starts.clear();
+            starts.extend(self.targets.iter().map(|&(i, _)| state.get(i)[0]));
             let stencil = &*stencil;
             let from = &*front;
-            parts(state, back, m, stride)
+            let last = k + 1 == s.substeps;
+            parts(state, back, scratch, m, stride, last)
                 .into_par_iter()
                 .for_each(|mut part| step_part(path, stencil, &coef, from, &step, &mut part));
             ran = true;
-            for &(i, t) in &self.targets {
-                let [_, _, prev] = state.get(i);
-                let v = end_velocity(t, prev, state.w[i], inv_h, keep);
+            for (&(i, t), &start) in self.targets.iter().zip(&*starts) {
+                let v = end_velocity(t, start, state.w[i], inv_h, keep);
                 state.set(i, t, v);
             }
             // Driven pins report the velocity of what carries them, not the chord.
@@ -122,13 +144,7 @@ impl Solver {
         }
         if ran {
             let p = &mut self.particles;
-            for (i, ((x, v), prev)) in (p.positions.iter_mut())
-                .zip(&mut p.velocities)
-                .zip(&mut p.prev_positions)
-                .enumerate()
-            {
-                [*x, *v, *prev] = state.get(i);
-            }
+            state.store(&mut p.positions, &mut p.velocities, &mut p.prev_positions);
         }
         self.stencil = Stencil::Built(st);
         Frame {
@@ -139,12 +155,15 @@ impl Solver {
     }
 }
 
-/// The state and the next mirror cut into parallel tasks of [`CHUNK`] particles.
+/// The state and the next mirror cut into parallel tasks of [`CHUNK`] particles, each with
+/// its working memory.
 fn parts<'a>(
     state: &'a mut LaneState,
     next: &'a mut Mirror,
+    scratch: &'a mut [Scratch],
     m: usize,
     stride: usize,
+    last: bool,
 ) -> Vec<Part<'a>> {
     let [x0, x1, x2] = &mut state.x;
     let [v0, v1, v2] = &mut state.v;
@@ -154,7 +173,7 @@ fn parts<'a>(
     let [nv0, nv1, nv2] = &mut next.v;
     let mut f32s = [nx0, nx1, nx2, nv0, nv1, nv2].map(|a| a[m..m + stride].chunks_mut(CHUNK));
     let mut out = Vec::with_capacity(stride.div_ceil(CHUNK));
-    for w in state.w.chunks(CHUNK) {
+    for (w, scratch) in state.w.chunks(CHUNK).zip(scratch) {
         let mut d = f64s.each_mut().map(|it| it.next().expect("one length"));
         let mut f = f32s.each_mut().map(|it| it.next().expect("one length"));
         let take = |s: &mut &'a mut [f64]| std::mem::take(s);
@@ -165,6 +184,8 @@ fn parts<'a>(
             prev: [take(&mut d[6]), take(&mut d[7]), take(&mut d[8])],
             w,
             next: f.each_mut().map(std::mem::take),
+            scratch,
+            last,
         });
     }
     out

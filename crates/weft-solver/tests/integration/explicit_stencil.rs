@@ -11,8 +11,9 @@ use weft_solver::glam::DVec3;
 use weft_solver::{Family, Method, Motion, Settings, SimdPath, Solver, Wind};
 
 /// The fusable windy flag (stretch, shear and bend-distance springs) under explicit
-/// mass-spring, soft enough for h = 1/240 s, with a moving pin if `moving`.
-fn flag(path: SimdPath, moving: bool) -> Solver {
+/// mass-spring, soft enough for h = 1/240 s, springs damped by `damping` (N·s/m), with a
+/// moving pin if `moving`.
+fn flag(path: SimdPath, damping: f64, moving: bool) -> Solver {
     let settings = Settings {
         simd: Some(path),
         ..flag_settings(Method::MassSpring, 256)
@@ -32,7 +33,7 @@ fn flag(path: SimdPath, moving: bool) -> Solver {
     let mut params = s.cloth_params(0).expect("one cloth");
     for f in Family::ALL {
         params.get_mut(f).spring_stiffness = 5.0;
-        params.get_mut(f).spring_damping = 0.001;
+        params.get_mut(f).spring_damping = damping;
     }
     s.set_cloth_params(0, params).expect("valid");
     s
@@ -42,7 +43,7 @@ fn flag(path: SimdPath, moving: bool) -> Solver {
 /// corner grabbed and dragged in between: the final state's bits and positions.
 fn run(path: SimdPath, threads: usize, general: bool) -> (Vec<[u64; 3]>, Vec<DVec3>) {
     in_pool(threads, || {
-        let mut s = flag(path, true);
+        let mut s = flag(path, 0.001, true);
         assert!(s.runs_springs_by_stencil());
         let corner = 40 * 40 - 1;
         let start = s.particles().positions[corner];
@@ -56,29 +57,40 @@ fn run(path: SimdPath, threads: usize, general: bool) -> (Vec<[u64; 3]>, Vec<DVe
 fn the_stencil_frame_follows_the_general_loop_to_the_forces_rounding() {
     // In still air, hanging from its pins: a motion that does not amplify small differences
     // (the flag in wind and dragged flaps chaotically, and both runs part by centimetres).
-    let still = |general: bool| {
-        let mut s = flag(SimdPath::Scalar, false);
-        let mut forces = *s.forces();
-        forces.wind = Wind::default();
-        s.set_forces(forces).expect("valid forces");
-        for _ in 0..60 {
-            step(&mut s, general);
-        }
-        s.particles().positions.clone()
-    };
-    let (general, stencil) = (still(true), still(false));
-    let start = flag(SimdPath::Scalar, false).particles().positions.clone();
-    let fell = (general.iter().zip(&start).map(|(a, b)| (*a - *b).length())).fold(0.0, f64::max);
-    let apart = (general
-        .iter()
-        .zip(&stencil)
-        .map(|(a, b)| (*a - *b).length()))
-    .fold(0.0, f64::max);
-    println!("after 60 frames: fell {fell:.3} m, runs {apart:e} m apart");
-    assert!(fell > 0.05, "{fell} m");
-    // Positions rounded to f32 relative to a corner of a 1 m flag (~6e-8 m) in every force.
-    assert!(apart < 1e-5, "{apart:e} m");
-    assert!(apart > 0.0, "the stencil frame really ran");
+    // Damped springs read the velocities, undamped ones do not: both kernels.
+    for damping in [0.001, 0.0] {
+        let still = |general: bool| {
+            let mut s = flag(SimdPath::Scalar, damping, false);
+            let mut forces = *s.forces();
+            forces.wind = Wind::default();
+            s.set_forces(forces).expect("valid forces");
+            for _ in 0..60 {
+                step(&mut s, general);
+            }
+            s.particles().clone()
+        };
+        let (general, stencil) = (still(true), still(false));
+        let start = flag(SimdPath::Scalar, damping, false)
+            .particles()
+            .positions
+            .clone();
+        let most = |a: &[DVec3], b: &[DVec3]| {
+            (a.iter().zip(b).map(|(a, b)| (*a - *b).length())).fold(0.0, f64::max)
+        };
+        let fell = most(&general.positions, &start);
+        let apart = most(&general.positions, &stencil.positions);
+        // The positions at the last substep's start and the velocities follow too (h = 1/240
+        // s: a position at another substep's start is ~1e-4 m away at these speeds).
+        let apart_prev = most(&general.prev_positions, &stencil.prev_positions);
+        let apart_v = most(&general.velocities, &stencil.velocities);
+        println!("damping {damping}, after 60 frames: fell {fell:.3} m, runs {apart:e} m apart");
+        assert!(fell > 0.05, "{fell} m");
+        // Positions rounded to f32 relative to a corner of a 1 m flag (~6e-8 m) in every force.
+        assert!(apart < 1e-5, "{apart:e} m");
+        assert!(apart > 0.0, "the stencil frame really ran");
+        assert!(apart_prev < 1e-5, "{apart_prev:e} m");
+        assert!(apart_v < 1e-3, "{apart_v:e} m/s");
+    }
 }
 
 #[test]
