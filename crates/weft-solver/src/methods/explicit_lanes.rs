@@ -29,32 +29,42 @@ pub(crate) struct LaneState {
 }
 
 impl LaneState {
-    /// Loads the particles' positions, velocities and inverse masses, padded to `stride`.
+    /// Loads the particles' positions, velocities and inverse masses, padded to `stride`
+    /// (one pass over the particles).
     pub fn load(&mut self, stride: usize, x: &[DVec3], v: &[DVec3], w: &[f64]) {
+        let n = x.len().min(v.len());
         for a in 0..3 {
-            for (dst, src) in [(&mut self.x[a], x), (&mut self.v[a], v)] {
-                dst.clear();
-                dst.extend(src.iter().map(|p| p[a]));
-                dst.resize(stride, 0.0);
+            for s in [&mut self.x[a], &mut self.v[a], &mut self.prev[a]] {
+                s.resize(stride, 0.0);
+                s[n..].fill(0.0);
             }
-            self.prev[a].resize(stride, 0.0);
+        }
+        let [x0, x1, x2] = self.x.each_mut().map(|s| &mut s[..n]);
+        let [v0, v1, v2] = self.v.each_mut().map(|s| &mut s[..n]);
+        for (i, (x, v)) in x.iter().zip(v).enumerate() {
+            (x0[i], x1[i], x2[i]) = (x.x, x.y, x.z);
+            (v0[i], v1[i], v2[i]) = (v.x, v.y, v.z);
         }
         self.w.clear();
         self.w.extend_from_slice(w);
         self.w.resize(stride, 0.0);
     }
 
-    /// Writes the particles' positions, velocities and positions at the last substep's
-    /// start back (one pass, the arrays cut to the particle count first so that no index is
-    /// checked in the loop).
-    pub fn store(&self, x: &mut [DVec3], v: &mut [DVec3], prev: &mut [DVec3]) {
+    /// Writes the particles from `start` on back: positions, velocities and positions at the
+    /// last substep's start (one pass, the arrays cut to the particles first so that no index
+    /// is checked in the loop).
+    pub fn store(&self, start: usize, x: &mut [DVec3], v: &mut [DVec3], prev: &mut [DVec3]) {
         let n = x.len().min(v.len()).min(prev.len());
-        let (sx, sv, sp) = (cut(&self.x, n), cut(&self.v, n), cut(&self.prev, n));
-        let at = |s: [&[f64]; 3], i: usize| DVec3::new(s[0][i], s[1][i], s[2][i]);
+        let (sx, sv, sp) = (
+            cut(&self.x, start, n),
+            cut(&self.v, start, n),
+            cut(&self.prev, start, n),
+        );
+        let at = |s: &[&[f64]; 3], i: usize| DVec3::new(s[0][i], s[1][i], s[2][i]);
         for (i, ((x, v), prev)) in x.iter_mut().zip(v).zip(prev).enumerate() {
-            *x = at(sx, i);
-            *v = at(sv, i);
-            *prev = at(sp, i);
+            *x = at(&sx, i);
+            *v = at(&sv, i);
+            *prev = at(&sp, i);
         }
     }
 
@@ -73,9 +83,10 @@ impl LaneState {
     }
 }
 
-/// The first `n` values of each axis.
-fn cut(s: &[Vec<f64>; 3], n: usize) -> [&[f64]; 3] {
-    [&s[0][..n], &s[1][..n], &s[2][..n]]
+/// Values `start .. start + n` of each axis.
+fn cut(s: &[Vec<f64>; 3], start: usize, n: usize) -> [&[f64]; 3] {
+    let r = start..start + n;
+    [&s[0][r.clone()], &s[1][r.clone()], &s[2][r]]
 }
 
 /// What a substep's integration needs besides the particles.
@@ -164,7 +175,7 @@ fn step_avx512(st: &SpringStencil, coef: &[[f32; 2]], from: &Mirror, s: &Step, p
 /// [`step_part`] compiled for AVX2 and FMA.
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn step_avx2(st: &SpringStencil, coef: &[[f32; 2]], from: &Mirror, s: &Step, p: &mut Part) {
-    step_in::<8>(st, coef, from, s, p);
+    step_in::<16>(st, coef, from, s, p);
 }
 
 /// [`step_part`] compiled for NEON.

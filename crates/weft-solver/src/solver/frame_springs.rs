@@ -95,7 +95,10 @@ impl Solver {
         let coef = stencil.coefficients(&self.params);
         let (m, stride) = (stencil.margin(), stencil.stride());
         let p = &self.particles;
-        stencil.load(front, &p.positions, &p.velocities);
+        let ((), ()) = rayon::join(
+            || stencil.load(front, &p.positions, &p.velocities),
+            || state.load(stride, &p.positions, &p.velocities, &p.inv_masses),
+        );
         // The pass writes every particle's entry of the next mirror; its margins stay as
         // loaded (zero: finite, as the masked neighbour loads past the ends need).
         back.origin = front.origin;
@@ -107,7 +110,6 @@ impl Solver {
         {
             b.resize(f.len(), 0.0);
         }
-        state.load(stride, &p.positions, &p.velocities, &p.inv_masses);
         let mut whole = true;
         let mut ran = false;
         for k in 0..s.substeps {
@@ -144,7 +146,12 @@ impl Solver {
         }
         if ran {
             let p = &mut self.particles;
-            state.store(&mut p.positions, &mut p.velocities, &mut p.prev_positions);
+            let state = &*state;
+            (p.positions.par_chunks_mut(CHUNK))
+                .zip(p.velocities.par_chunks_mut(CHUNK))
+                .zip(p.prev_positions.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(|(c, ((x, v), prev))| state.store(c * CHUNK, x, v, prev));
         }
         self.stencil = Stencil::Built(st);
         Frame {
