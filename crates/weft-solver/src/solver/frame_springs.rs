@@ -112,19 +112,26 @@ impl Solver {
         }
         let mut whole = true;
         let mut ran = false;
+        // Whether the last pass kept its start positions (no pass yet: nothing to keep).
+        let mut kept = true;
         for k in 0..s.substeps {
-            if self.stopping() {
+            // A stop ends the frame after a pass that kept its start positions: at once, or
+            // after one more substep that keeps them.
+            let stop = self.stopping();
+            if stop && kept {
                 whole = false;
                 break;
             }
             self.substep_targets(k);
-            // The pass keeps the substep's start positions only on the last substep; the
-            // targets' velocities need theirs on every one.
+            // The pass keeps the substep's start positions only on the frame's last substep;
+            // the targets' velocities need theirs on every one.
             starts.clear();
             starts.extend(self.targets.iter().map(|&(i, _)| state.get(i)[0]));
             let stencil = &*stencil;
             let from = &*front;
-            let last = k + 1 == s.substeps;
+            let last_of_frame = k + 1 == s.substeps;
+            let last = last_of_frame || stop;
+            kept = last;
             parts(state, back, scratch, m, stride, last)
                 .into_par_iter()
                 .for_each(|mut part| step_part(path, stencil, &coef, from, &step, &mut part));
@@ -143,6 +150,10 @@ impl Solver {
                 back.set(m, i, x, v);
             }
             std::mem::swap(front, back);
+            if stop && !last_of_frame {
+                whole = false;
+                break;
+            }
         }
         if ran {
             let p = &mut self.particles;

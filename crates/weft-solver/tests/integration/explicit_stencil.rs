@@ -4,6 +4,10 @@
 
 use crate::common;
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
 use common::flag::{
     drag_corner, flag_settings, fusable_flag, in_pool, state_bits, step, windy_flag,
 };
@@ -113,4 +117,50 @@ fn springs_that_form_no_stencil_run_the_general_loop() {
     assert!(!b.build().runs_springs_by_stencil());
     let (b, _) = fusable_flag((12, 12), flag_settings(Method::MassSpring, 256));
     assert!(b.build().runs_springs_by_stencil());
+}
+
+#[test]
+fn a_stop_inside_a_stencil_frame_keeps_the_last_substeps_start() {
+    // Undamped springs and no global damping: every free particle's velocity is its last
+    // substep's chord, v = (x − x_prev)/h, whether the frame ran whole or stopped inside.
+    let mut s = flag(SimdPath::Scalar, 0.0, false);
+    let mut forces = *s.forces();
+    forces.damping = 0.0;
+    s.set_forces(forces).expect("valid forces");
+    let mut settings = *s.settings();
+    settings.substeps = 2000;
+    s.set_settings(settings).expect("valid settings");
+    let h = s.settings().h();
+    let flag = Arc::new(AtomicBool::new(false));
+    s.set_stop(Arc::clone(&flag));
+    let chords_hold = |s: &Solver| {
+        let p = s.particles();
+        (p.positions.iter().zip(&p.prev_positions).zip(&p.velocities))
+            .zip(&p.inv_masses)
+            .filter(|(_, w)| **w > 0.0)
+            .all(|(((x, prev), v), _)| (*v - (*x - *prev) / h).length() <= 1e-6 * v.length())
+    };
+    let started = Instant::now();
+    s.step().expect("the flag is down");
+    let frame = started.elapsed();
+    assert!(chords_hold(&s), "after a whole frame");
+    // Raise the flag halfway through a frame until a frame is stopped after it moved.
+    let mut stopped_inside = false;
+    for _ in 0..20 {
+        flag.store(false, Ordering::SeqCst);
+        let before = s.particles().positions.clone();
+        let raise = Arc::clone(&flag);
+        let raiser = std::thread::spawn(move || {
+            std::thread::sleep(frame / 2);
+            raise.store(true, Ordering::SeqCst);
+        });
+        let result = s.step();
+        raiser.join().expect("the raiser ends");
+        if result.is_err() && s.particles().positions != before {
+            stopped_inside = true;
+            assert!(chords_hold(&s), "after a stop inside the frame");
+            break;
+        }
+    }
+    assert!(stopped_inside, "no frame was stopped inside in 20 tries");
 }
