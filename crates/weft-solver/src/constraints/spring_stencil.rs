@@ -250,11 +250,11 @@ impl SpringStencil {
         let mask = ring.len - 1;
         let mut f = [[0.0f32; W]; 3];
         for (&source, &o) in self.sources.iter().zip(&self.offsets) {
-            let (p, own) = match source {
-                Source::Own(p) => (p, true),
-                Source::Twin(p) => (p, false),
+            // A twin's spring sits in the ring at its lower end, i + o (o < 0).
+            let (p, at, own) = match source {
+                Source::Own(p) => (p, i & mask, true),
+                Source::Twin(p) => (p, i.wrapping_add_signed(o) & mask, false),
             };
-            let at = i.wrapping_add_signed(o * isize::from(!own)) & mask;
             for a in 0..3 {
                 let b = ring.base(p, a) + at;
                 let r = &ring.data[b..b + W];
@@ -273,9 +273,9 @@ impl SpringStencil {
     }
 
     /// Evaluates the positive slots' springs at the `W` particles from `i` on (velocities
-    /// read only where `DAMPED`), each as the force on its lower end, f = (k C + c Ċ) n with C = |d| − rest, n = d/|d|,
-    /// Ċ = n·(v_j − v_i) and d = x_j − x_i (Müller et al. 2007, eq. 9, as forces
-    /// −(k C + c Ċ)∇C), into `ring` at `i`.
+    /// read only where `DAMPED`), each as the force on its lower end, f = (k C + c Ċ) n with
+    /// C = |d| − rest, n = d/|d|, Ċ = n·(v_j − v_i) and d = x_j − x_i (Müller et al. 2007,
+    /// eq. 9, as forces −(k C + c Ċ)∇C), into `ring` at `i`.
     #[inline(always)]
     fn evaluate<const W: usize, const DAMPED: bool>(
         &self,

@@ -4,10 +4,6 @@
 //! v ← (x − x_prev)/h and the global damping, the general loop's operations in its order
 //! (`solver/frame.rs`), in one loop per axis over the part.
 
-// Lane and axis loops index several arrays in step; written as index loops on purpose so
-// that each compiles to one vector operation per axis.
-#![allow(clippy::needless_range_loop)]
-
 use glam::DVec3;
 use multiversion::multiversion;
 
