@@ -1,6 +1,6 @@
-//! Tests of the linearised springs: the curvature frames against the shapes' own Hessian
-//! products, and the slots summed by rows against a serial spring-by-spring reference (the
-//! method's first, single-threaded form).
+//! Tests of the linearised springs: the rank-one shapes' weights against their own gradients
+//! and Hessian products, and the terms summed by rows against a serial spring-by-spring
+//! reference (the method's first, single-threaded form).
 
 use glam::DVec3;
 
@@ -123,21 +123,22 @@ fn close(a: DVec3, b: DVec3, scale: f64) -> bool {
 }
 
 #[test]
-fn frames_apply_the_shapes_hessians() {
+fn rank_one_shapes_have_the_gradient_and_hessian_their_coefficients_give() {
     let mut rnd = rng(0x1234_5678_9abc_def1);
     let mut r3 = || DVec3::new(rnd(), rnd(), rnd());
-    fn check<const N: usize, S: Curved<N>>(s: S, p: [DVec3; N], dp: [DVec3; N]) {
+    fn check<const N: usize, S: RankOne<N>>(s: S, p: [DVec3; N], dp: [DVec3; N]) {
+        let a = s.coefficients();
+        let u: DVec3 = (0..N).map(|m| p[m] * a[m]).sum();
+        let (len, n) = (u.length(), u.normalize());
+        let (c, grad) = s.evaluate(&p).expect("active");
+        assert_eq!(s.value(len), Some(c), "C from ℓ");
         let want = s.curvature_product(&p, &dp);
-        let (a, n, inv_len) = s.frame(&p).expect("curved");
-        let u: DVec3 = (0..N).map(|m| dp[m] * a[m]).sum();
-        let t = (u - n * n.dot(u)) * inv_len;
+        let du: DVec3 = (0..N).map(|m| dp[m] * a[m]).sum();
+        let t = (du - n * n.dot(du)) / len;
         for k in 0..N {
-            assert!(
-                (want[k] - t * a[k]).length() < 1e-12,
-                "{k}: {} {}",
-                want[k],
-                t * a[k]
-            );
+            assert!((grad[k] - n * a[k]).length() < 1e-12, "∇C {k}");
+            let got = t * a[k];
+            assert!((want[k] - got).length() < 1e-12, "{k}: {} {got}", want[k]);
         }
     }
     for _ in 0..20 {
@@ -145,6 +146,19 @@ fn frames_apply_the_shapes_hessians() {
         let d2 = [r3(), r3()];
         check(Distance { rest: 0.1 }, p2, d2);
         check(Tether { max_length: 0.0 }, p2, d2);
+        let slack = Tether { max_length: 100.0 };
+        assert_eq!(slack.evaluate(&p2), None);
+        assert_eq!(
+            slack.value((p2[0] - p2[1]).length()),
+            None,
+            "a slack tether"
+        );
+        let seam = Seam {
+            gap: 0.1,
+            closing_time: 1.0,
+            rest: 0.05,
+        };
+        check(seam, p2, d2);
         let p4 = [r3(), r3(), r3(), r3()];
         let d4 = [r3(), r3(), r3(), r3()];
         let iso = Isometric {
@@ -155,14 +169,14 @@ fn frames_apply_the_shapes_hessians() {
 }
 
 #[test]
-fn slots_summed_by_rows_match_the_serial_springs() {
+fn terms_summed_by_rows_match_the_serial_springs() {
     for bending in [Family::BendDihedral, Family::BendIsometric] {
         let (cs, params, x, v) = crumpled(bending);
         let n = x.len();
         let h = 1e-3;
         let mut rnd = rng(0x0bad_cafe_f00d_0001);
         let x0: Vec<DVec3> = (0..n).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
-        let rows = cs.spring_rows(n);
+        let terms = cs.spring_terms(n);
         let mut springs = Springs::default();
         let mut rhs = Vec::new();
         let st = State {
@@ -172,37 +186,35 @@ fn slots_summed_by_rows_match_the_serial_springs() {
             x0: Some(&x0),
         };
         cs.linearize(&params, st, &mut springs, &mut rhs);
-        assert_eq!(rhs.len(), rows.slot_count());
+        let read = |i: usize, f: &dyn Fn(&TermRhs) -> DVec3| {
+            (terms.row(i).iter()).fold(DVec3::ZERO, |s, e| s + f(&rhs[e.term as usize]) * e.coef)
+        };
         // A − M applied to x₀, and to a fresh vector through the product pass.
         let (want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
         let (kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
-        let mut y = Vec::new();
-        springs.product(&x0, &mut y);
+        let mut t = Vec::new();
+        cs.spring_product(&springs, &x0, &mut t);
+        assert_eq!(t.len(), rhs.len(), "one product term per term");
         let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
         let mut curved = 0;
         for i in 0..n {
-            let ax = rows.sum(
-                i,
-                &rhs.iter().map(|r| r.ax).collect::<Vec<_>>(),
-                DVec3::ZERO,
-            );
+            let ax = read(i, &|r| r.ax);
             assert!(
                 close(ax, want_ax[i], scale),
                 "{bending:?} row {i}: {ax} {}",
                 want_ax[i]
             );
-            assert!(close(rows.sum(i, &y, DVec3::ZERO), want_ax[i], scale));
-            let b = rows.sum(i, &rhs.iter().map(|r| r.b).collect::<Vec<_>>(), DVec3::ZERO);
+            assert!(close(terms.sum(i, &t), want_ax[i], scale));
+            let b = read(i, &|r| r.b);
             let want_b = f[i] * h - kv[i];
             assert!(
                 close(b, want_b, scale),
                 "{bending:?} row {i}: b {b} {want_b}"
             );
             // The diagonal block: A − M applied to a vector at particle i alone, read at i.
-            let d = rows
-                .row(i)
-                .iter()
-                .fold(Sym3::default(), |s, &k| s.add(rhs[k as usize].d));
+            let d = (terms.row(i).iter()).fold(Sym3::default(), |s, e| {
+                s.add(rhs[e.term as usize].d.scale(e.coef * e.coef))
+            });
             for e in [DVec3::X, DVec3::Y, DVec3::Z] {
                 let mut p = vec![DVec3::ZERO; n];
                 p[i] = e;
@@ -213,7 +225,7 @@ fn slots_summed_by_rows_match_the_serial_springs() {
         }
         assert!(curved > n / 2, "most rows have off-axis coupling: {curved}");
         assert!(
-            springs.isometric.iter().any(|l| l.kappa > 0.0) || bending != Family::BendIsometric
+            springs.isometric.iter().any(|r| r.kappa > 0.0) || bending != Family::BendIsometric
         );
     }
 }

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::linear::slot_blocks;
 use super::{Block, ConstraintSet, Shape};
 use crate::params::FamilyParams;
+use crate::sparse::Rows;
 
 /// Springs one parallel task takes (as the linearisation's tasks, `linear.rs`).
 const SPRINGS: usize = 512;
@@ -50,7 +51,23 @@ impl<const N: usize, S: Shape<N>> Block<N, S> {
     }
 }
 
+/// Appends the particle of each of a block's slots.
+fn owners<const N: usize, S>(block: &Block<N, S>, out: &mut Vec<u32>) {
+    out.extend(block.particles.iter().flatten());
+}
+
 impl ConstraintSet {
+    /// The rows of the explicit force pass over `n` particles: each particle's slots.
+    pub(crate) fn spring_rows(&self, n: usize) -> Rows {
+        let mut o = Vec::new();
+        owners(&self.distance, &mut o);
+        owners(&self.dihedral, &mut o);
+        owners(&self.isometric, &mut o);
+        owners(&self.tethers, &mut o);
+        owners(&self.seams, &mut o);
+        Rows::new(n, &o)
+    }
+
     /// Writes every spring's force at each of its particles into its slots `y` (N), in the
     /// slot order of [`ConstraintSet::spring_rows`].
     pub(crate) fn spring_force_slots(

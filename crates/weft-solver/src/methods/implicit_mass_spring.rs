@@ -15,9 +15,10 @@
 //! pinned, kinematic and grabbed particles (inverse mass 0). The shared loop then applies
 //! v ← v + Δv, x ← x + h v.
 //!
-//! A is never assembled: each product runs spring by spring into slots, in parallel, and each
-//! particle sums its slots in a fixed order ([`crate::sparse::Rows`]); every sum across tasks is
-//! taken in a fixed order, so the result does not depend on the thread count.
+//! A is never assembled: each product runs spring by spring into terms (one 3-vector per
+//! rank-one spring), in parallel, and each particle sums its terms, weighted, in a fixed order
+//! ([`crate::sparse::Terms`]); every sum across tasks is taken in a fixed order, so the result
+//! does not depend on the thread count.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -27,25 +28,26 @@ use crate::chunk::CHUNK;
 use crate::constraints::{ConstraintSet, LinearState, Rule, Springs};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
-use crate::sparse::{Operator, Rows, Sym3, solve};
+use crate::sparse::{Operator, Sym3, Terms, solve};
 
 /// Springs integrated with backward Euler: unconditionally stable, numerically damped.
 pub(crate) struct ImplicitMassSpring;
 
 /// A = M + h D + h² K, filtered: zero on the rows of particles with inverse mass 0.
 struct System<'a> {
+    constraints: &'a ConstraintSet,
     springs: &'a Springs,
-    rows: &'a Rows,
+    terms: &'a Terms,
     w: &'a [f64],
-    y: &'a mut Vec<DVec3>,
+    t: &'a mut Vec<DVec3>,
 }
 
 impl Operator for System<'_> {
     fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64 {
-        self.springs.product(p, self.y);
+        self.constraints.spring_product(self.springs, p, self.t);
         let w = self.w;
-        self.rows.gather(
-            self.y,
+        self.terms.gather(
+            self.t,
             q,
             |i, s| {
                 if w[i] > 0.0 {
@@ -76,7 +78,7 @@ impl Strategy for ImplicitMassSpring {
         let h = pass.h;
         let n = particles.len();
         let w = &particles.inv_masses;
-        work.ensure_rows(constraints, n);
+        work.ensure_terms(constraints, n);
         let warm = work.dv.len() == n;
         if !warm {
             work.dv.clear();
@@ -90,7 +92,7 @@ impl Strategy for ImplicitMassSpring {
         };
         constraints.linearize(params, st, &mut work.springs, &mut work.rhs);
         let SpringWork {
-            rows,
+            terms,
             springs,
             rhs,
             y,
@@ -102,9 +104,9 @@ impl Strategy for ImplicitMassSpring {
         } = work;
         pinv.resize(n, Sym3::default());
         r.resize(n, DVec3::ZERO);
-        // Per particle: b = h M a_ext + Σ slots' b, r = b − A x₀, the block-Jacobi inverse;
-        // filtered particles get zeros (Baraff & Witkin's S).
-        let (rows_ref, rhs_ref, accel_ref) = (&*rows, &*rhs, &*accel);
+        // Per particle: b = h M a_ext + Σ terms' weighted b, r = b − A x₀, the block-Jacobi
+        // inverse; filtered particles get zeros (Baraff & Witkin's S).
+        let (terms_ref, rhs_ref, accel_ref) = (&*terms, &*rhs, &*accel);
         let partials: Vec<f64> = r
             .par_chunks_mut(CHUNK)
             .zip(pinv.par_chunks_mut(CHUNK))
@@ -121,11 +123,11 @@ impl Strategy for ImplicitMassSpring {
                     let m = 1.0 / w[i];
                     let (mut b, mut ax) = (accel_ref[i] * (m * h), dv[j] * m);
                     let mut d = Sym3::scaled_identity(m);
-                    for &k in rows_ref.row(i) {
-                        let s = &rhs_ref[k as usize];
-                        b += s.b;
-                        ax += s.ax;
-                        d = d.add(s.d);
+                    for e in terms_ref.row(i) {
+                        let s = &rhs_ref[e.term as usize];
+                        b += s.b * e.coef;
+                        ax += s.ax * e.coef;
+                        d = d.add(s.d.scale(e.coef * e.coef));
                     }
                     r[j] = b - ax;
                     pinv[j] = d.inverse();
@@ -136,10 +138,11 @@ impl Strategy for ImplicitMassSpring {
             .collect();
         let b_norm2: f64 = partials.iter().sum();
         let mut system = System {
+            constraints,
             springs,
-            rows,
+            terms,
             w,
-            y,
+            t: y,
         };
         let outcome = solve(&mut system, pinv, b_norm2, dv, r, pass.cg, scratch, &|| {
             pass.stopping()

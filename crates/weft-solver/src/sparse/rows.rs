@@ -1,16 +1,11 @@
-//! `Rows`: which spring slots each particle's row of the spring operator sums, built once from
-//! the constraint graph (compressed sparse rows of slots, each row in ascending slot order).
+//! `Rows`: which spring slots each particle's row of the explicit force pass sums, built once
+//! from the constraint graph (compressed sparse rows of slots, each row in ascending slot order).
 //!
 //! A slot is one spring's share at one of its particles: a spring over `N` particles owns `N`
 //! consecutive slots. A pass over the springs writes each slot's 3-vector (or block); a pass
 //! over the rows then sums, for each particle, its slots in a fixed order. Each row is written
 //! by one task and read from every slot's owner, so the sums are the same whatever the thread
 //! count.
-
-use glam::DVec3;
-use rayon::prelude::*;
-
-use crate::chunk::CHUNK;
 
 /// The slots of every particle's row (see the module documentation).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -63,34 +58,12 @@ impl Rows {
     pub fn sum<T: Copy + std::ops::Add<Output = T>>(&self, i: usize, y: &[T], zero: T) -> T {
         self.row(i).iter().fold(zero, |s, &k| s + y[k as usize])
     }
-
-    /// `out[i] = f(i, Σ slots of row i in y)` for every row, in parallel chunks; returns the
-    /// chunks' partial sums of `g(i, out[i])`, added in chunk order.
-    pub fn gather<F, G>(&self, y: &[DVec3], out: &mut [DVec3], f: F, g: G) -> f64
-    where
-        F: Fn(usize, DVec3) -> DVec3 + Sync,
-        G: Fn(usize, DVec3) -> f64 + Sync,
-    {
-        let partials: Vec<f64> = out
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(c, out)| {
-                let base = c * CHUNK;
-                let mut acc = 0.0;
-                for (j, o) in out.iter_mut().enumerate() {
-                    let i = base + j;
-                    *o = f(i, self.sum(i, y, DVec3::ZERO));
-                    acc += g(i, *o);
-                }
-                acc
-            })
-            .collect();
-        partials.iter().sum()
-    }
 }
 
 #[cfg(test)]
 mod tests {
+    use glam::DVec3;
+
     use super::*;
 
     #[test]
@@ -103,12 +76,7 @@ mod tests {
         assert_eq!(rows.row(1), &[3]);
         assert_eq!(rows.row(2), &[1, 2]);
         let y = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
-        let mut out = vec![DVec3::ZERO; 3];
-        let total = rows.gather(&y, &mut out, |_, s| s * 2.0, |_, o| o.x + o.y + o.z);
-        assert_eq!(
-            out,
-            vec![DVec3::X * 2.0, DVec3::ONE * 2.0, DVec3::new(0.0, 2.0, 2.0)]
-        );
-        assert_eq!(total, 2.0 + 6.0 + 4.0);
+        let sums: Vec<DVec3> = (0..3).map(|i| rows.sum(i, &y, DVec3::ZERO)).collect();
+        assert_eq!(sums, vec![DVec3::X, DVec3::ONE, DVec3::new(0.0, 1.0, 1.0)]);
     }
 }

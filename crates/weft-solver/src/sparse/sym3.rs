@@ -27,11 +27,10 @@ impl Sym3 {
         ])
     }
 
-    /// s (I − n nᵀ).
+    /// s M.
     #[inline]
-    pub fn projector(n: DVec3, s: f64) -> Self {
-        let o = Self::outer(n, s).0;
-        Self([s - o[0], s - o[1], s - o[2], -o[3], -o[4], -o[5]])
+    pub fn scale(self, s: f64) -> Self {
+        Self(self.0.map(|e| e * s))
     }
 
     /// The entrywise sum.
@@ -84,7 +83,7 @@ mod tests {
     fn inverse_times_block_is_identity() {
         let a = Sym3::scaled_identity(2.0)
             .add(Sym3::outer(DVec3::new(0.3, -1.0, 0.5), 4.0))
-            .add(Sym3::projector(DVec3::new(0.0, 0.6, 0.8), 0.7));
+            .add(Sym3::outer(DVec3::new(0.0, 0.6, 0.8), 0.7).scale(-0.5));
         let inv = a.inverse();
         for u in [DVec3::X, DVec3::Y, DVec3::Z] {
             let back = inv.mul(a.mul(u));
