@@ -44,6 +44,10 @@ pub(crate) trait RankOne<const N: usize>: Shape<N> {
     /// The weights a.
     fn coefficients(&self) -> [f64; N];
 
+    /// C = ℓ (no rest length): the energy ½ k |u|² has the Hessian k a aᵀ ⊗ I everywhere, at
+    /// ℓ = 0 too, where n and the damping have no direction.
+    const QUADRATIC: bool = false;
+
     /// C at ℓ = |u|, or `None` where [`Shape::evaluate`] gives none.
     fn value(&self, len: f64) -> Option<f64>;
 }
@@ -79,6 +83,8 @@ impl RankOne<2> for Seam {
 }
 
 impl RankOne<4> for Isometric {
+    const QUADRATIC: bool = true;
+
     /// C = |v|, v = Σ kᵢ pᵢ (Bergou et al. 2006): a = k.
     fn coefficients(&self) -> [f64; 4] {
         self.weights
@@ -176,6 +182,16 @@ fn linearize_rays<const N: usize, S: RankOne<N>>(
                 let len = u.length();
                 let Some(c) = p.enabled.then(|| shape.value(len)).flatten() else {
                     (*ray, *term) = (Ray::default(), TermRhs::default());
+                    if p.enabled && S::QUADRATIC {
+                        // ℓ = 0 (a flat isometric hinge): no force, no damping direction,
+                        // and the stiffness h² k a aᵀ ⊗ I; b = −h² K v.
+                        ray.kappa = h * h * p.spring_stiffness;
+                        *term = TermRhs {
+                            b: -(weighted(&a, &idx, st.v) * ray.kappa),
+                            ax: (st.x0).map_or(DVec3::ZERO, |x0| ray.apply(weighted(&a, &idx, x0))),
+                            d: Sym3::scaled_identity(ray.kappa),
+                        };
+                    }
                     continue;
                 };
                 let n = u / len;

@@ -17,6 +17,14 @@ use crate::{Forces, SolverBuilder};
 pub(crate) fn crumpled(
     bending: Family,
 ) -> (ConstraintSet, Vec<FamilyParams>, Vec<DVec3>, Vec<DVec3>) {
+    stretched(bending, 0.02)
+}
+
+/// [`crumpled`]'s grid stretched by 30 % and moved by up to `noise` (0: flat).
+fn stretched(
+    bending: Family,
+    noise: f64,
+) -> (ConstraintSet, Vec<FamilyParams>, Vec<DVec3>, Vec<DVec3>) {
     let mesh = GridDesc {
         resolution: (10, 10),
         orientation: Orientation::Horizontal,
@@ -53,7 +61,7 @@ pub(crate) fn crumpled(
         .positions
         .iter()
         // Stretched by 30 % about the origin (tethers taut) and crumpled.
-        .map(|p| *p * 1.3 + DVec3::new(rnd(), rnd(), rnd()) * 0.02)
+        .map(|p| *p * 1.3 + DVec3::new(rnd(), rnd(), rnd()) * noise)
         .collect();
     let v: Vec<DVec3> = x.iter().map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
     let params = (solver.cloth_params(0).expect("one cloth"))
@@ -227,5 +235,48 @@ fn terms_summed_by_rows_match_the_serial_springs() {
         assert!(
             springs.isometric.iter().any(|r| r.kappa > 0.0) || bending != Family::BendIsometric
         );
+    }
+}
+
+#[test]
+fn a_flat_isometric_hinge_keeps_its_stiffness_in_the_system() {
+    let (cs, params, x, v) = stretched(Family::BendIsometric, 0.0);
+    let n = x.len();
+    let h = 1e-3;
+    let mut rnd = rng(0x0bad_cafe_f00d_0002);
+    let x0: Vec<DVec3> = (0..n).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
+    let terms = cs.spring_terms(n);
+    let (mut springs, mut rhs, mut t) = (Springs::default(), Vec::new(), Vec::new());
+    let st = State {
+        x: &x,
+        v: &v,
+        h,
+        x0: Some(&x0),
+    };
+    cs.linearize(&params, st, &mut springs, &mut rhs);
+    cs.spring_product(&springs, &x0, &mut t);
+    // The reference has no term for a hinge without a direction: add h² k a aᵀ ⊗ I by hand.
+    let (mut want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
+    let (mut kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
+    let iso = &cs.isometric;
+    for s in 0..iso.particles.len() {
+        let (idx, a) = (iso.particles[s], iso.shapes[s].weights);
+        let flat = iso.shapes[s].curvature(&idx.map(|i| x[i as usize]));
+        assert!(flat.length() < 1e-12, "hinge {s} is flat: {flat}");
+        let hhk = h * h * params[iso.group[s] as usize].spring_stiffness;
+        let (u0, uv) = (weighted(&a, &idx, &x0), weighted(&a, &idx, &v));
+        for m in 0..4 {
+            want_ax[idx[m] as usize] += u0 * (hhk * a[m]);
+            kv[idx[m] as usize] += uv * (hhk * a[m]);
+        }
+    }
+    assert!(!iso.particles.is_empty());
+    let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
+    for i in 0..n {
+        let ax = terms.sum(i, &t);
+        assert!(close(ax, want_ax[i], scale), "row {i}: {ax} {}", want_ax[i]);
+        let b = (terms.row(i).iter()).fold(DVec3::ZERO, |s, e| s + rhs[e.term as usize].b * e.coef);
+        let want_b = f[i] * h - kv[i];
+        assert!(close(b, want_b, scale), "row {i}: b {b} {want_b}");
     }
 }
