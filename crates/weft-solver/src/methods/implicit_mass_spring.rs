@@ -153,6 +153,7 @@ impl Strategy for ImplicitMassSpring {
             }
         }
         work.iterations += outcome.iterations;
+        work.worst = work.worst.max(outcome.residual);
         work.last = outcome;
     }
 

@@ -33,6 +33,8 @@ pub(crate) struct SpringWork {
     pub scratch: PcgScratch,
     /// Conjugate-gradient iterations over the frame so far.
     pub iterations: u32,
+    /// The largest relative residual a solve of the frame so far ended at.
+    pub worst: f64,
     /// The last solve's outcome.
     pub last: Outcome,
 }

@@ -182,6 +182,7 @@ impl Solver {
         let strategy = s.method.strategy();
         let mut stats = StepStats::default();
         self.spring_work.iterations = 0;
+        self.spring_work.worst = 0.0;
         let rule = strategy.rule(h);
         if let Some(rule) = rule {
             self.domains.prepare(&self.params, rule);
@@ -314,6 +315,7 @@ impl Solver {
             hook.end_substep(&ctx, &mut self.particles);
         }
         stats.cg_iterations = self.spring_work.iterations + cg_iterations as u32;
+        stats.cg_residual = self.spring_work.worst;
         Frame {
             stats,
             whole,

@@ -49,6 +49,10 @@ pub struct StepStats {
     /// Conjugate-gradient iterations over the frame's substeps: implicit mass-spring's, and
     /// XPBD's bending or joint solves (see [`Solver::solves_jointly`]); 0 otherwise.
     pub cg_iterations: u32,
+    /// The largest relative residual ‖b − A Δv‖/‖b‖ that implicit mass-spring's solves ended
+    /// the frame's substeps at (at most `Settings::cg_tolerance` unless a solve hit
+    /// `cg_max_iterations`); 0 under the other methods.
+    pub cg_residual: f64,
 }
 
 /// A particle held by the user, dragged toward a target.
