@@ -180,27 +180,24 @@ fn linearize_rays<const N: usize, S: RankOne<N>>(
                 let a = shape.coefficients();
                 let u = weighted(&a, &idx, st.x);
                 let len = u.length();
-                let Some(c) = p.enabled.then(|| shape.value(len)).flatten() else {
-                    (*ray, *term) = (Ray::default(), TermRhs::default());
-                    if p.enabled && S::QUADRATIC {
-                        // ℓ = 0 (a flat isometric hinge): no force, no damping direction,
-                        // and the stiffness h² k a aᵀ ⊗ I; b = −h² K v.
-                        ray.kappa = h * h * p.spring_stiffness;
-                        *term = TermRhs {
-                            b: -(weighted(&a, &idx, st.v) * ray.kappa),
-                            ax: (st.x0).map_or(DVec3::ZERO, |x0| ray.apply(weighted(&a, &idx, x0))),
-                            d: Sym3::scaled_identity(ray.kappa),
-                        };
-                    }
-                    continue;
-                };
-                let n = u / len;
                 let (k, damping) = (p.spring_stiffness, p.spring_damping);
                 let hhk = h * h * k;
-                let kappa = if c > 0.0 && k > 0.0 {
-                    hhk * c / len
-                } else {
-                    0.0
+                let (c, n, kappa) = match p.enabled.then(|| shape.value(len)).flatten() {
+                    Some(c) => {
+                        let kappa = if c > 0.0 && k > 0.0 {
+                            hhk * c / len
+                        } else {
+                            0.0
+                        };
+                        (c, u / len, kappa)
+                    }
+                    // ℓ = 0 where C = ℓ (a flat isometric hinge): no direction, so no force and
+                    // no damping, and κ = h² k, the limit of h² k C/ℓ.
+                    None if p.enabled && S::QUADRATIC => (0.0, DVec3::ZERO, hhk),
+                    None => {
+                        (*ray, *term) = (Ray::default(), TermRhs::default());
+                        continue;
+                    }
                 };
                 let sigma = hhk + h * damping;
                 *ray = Ray {
