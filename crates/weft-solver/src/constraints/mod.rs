@@ -128,12 +128,8 @@ pub struct ConstraintSet {
     pub(crate) isometric_constants: FrameConstants<isometric_lanes::Prepared>,
     /// The substep of the last XPBD frame (s); 0 before any.
     pub(crate) xpbd_h: f64,
-    /// Whether the dihedral and the isometric block are solved by conjugate gradients this
-    /// frame (see `quad_cg`).
-    pub(crate) bending_cg: [bool; 2],
-    /// Whether the distance and bending constraints are solved together by conjugate
-    /// gradients this frame (see `quad_cg`).
-    pub(crate) joint_cg: bool,
+    /// Which constraints XPBD solves by conjugate gradients this frame (see `quad_cg`).
+    pub(crate) plan: quad_cg::Plan,
     /// The conjugate gradients' scratch, every block under its own id (`quad_cg::*_ROWS`).
     pub(crate) cg: quad_cg::CgScratch,
 }
@@ -204,10 +200,11 @@ impl ConstraintSet {
     /// `w` and parameters `params`: the isometric block forward only when it is soft per
     /// substep ([`Block::soft_per_substep`]).
     ///
-    /// Under XPBD, a bending block whose mean s/α̃ at `x` exceeds [`quad_cg::CG_ABOVE`] is
-    /// solved by conjugate gradients instead of swept; where either block's exceeds
-    /// [`quad_cg::JOINT_ABOVE`] and the whole system has at most [`quad_cg::JOINT_MAX_ROWS`]
-    /// rows, both blocks are solved together with the distance constraints (see `quad_cg`).
+    /// Under XPBD, a bending block whose mean s/α̃ at `x` exceeds [`quad_cg::CG_ABOVE`] and
+    /// that has at most [`quad_cg::CG_MAX_ROWS`] rows is solved by conjugate gradients instead
+    /// of swept; where either block's exceeds [`quad_cg::JOINT_ABOVE`] and the whole system
+    /// has at most [`quad_cg::JOINT_MAX_ROWS`] rows, both blocks are solved together with the
+    /// distance constraints ([`quad_cg::Plan`]).
     pub(crate) fn prepare_sweeps(
         &mut self,
         x: &[DVec3],
@@ -216,18 +213,20 @@ impl ConstraintSet {
         rule: Rule,
     ) {
         self.xpbd_h = 0.0;
-        self.bending_cg = [false; 2];
-        self.joint_cg = false;
+        self.plan = quad_cg::Plan::default();
         if let Rule::Xpbd { h } = rule {
             self.xpbd_h = h;
-            let ratios = [
-                self.dihedral.mean_stiffness_ratio(x, w, params, h),
-                self.isometric.mean_stiffness_ratio(x, w, params, h),
-            ];
-            self.bending_cg = ratios.map(|r| r > quad_cg::CG_ABOVE);
-            let rows = self.distance.len() + self.dihedral.len() + 3 * self.isometric.len();
-            self.joint_cg =
-                ratios.iter().any(|&r| r > quad_cg::JOINT_ABOVE) && rows <= quad_cg::JOINT_MAX_ROWS;
+            // The mean s/α̃ costs a pass over the hinges: only for a block the plan may solve.
+            let rows = [self.dihedral.len(), 3 * self.isometric.len()];
+            let weighs = quad_cg::Plan::weighs(rows, self.distance.len());
+            let mut ratios = [0.0; 2];
+            if weighs[0] {
+                ratios[0] = self.dihedral.mean_stiffness_ratio(x, w, params, h);
+            }
+            if weighs[1] {
+                ratios[1] = self.isometric.mean_stiffness_ratio(x, w, params, h);
+            }
+            self.plan = quad_cg::Plan::new(ratios, rows, self.distance.len());
         }
         self.isometric_forward = self.isometric.soft_per_substep(w, params, rule);
         self.isometric
@@ -259,7 +258,7 @@ impl ConstraintSet {
     pub(crate) fn reset_multipliers(&mut self) {
         // The sweep's distance multipliers live in `Domains`, which clears its own; these are
         // the joint solve's.
-        if self.joint_cg {
+        if self.plan.joint {
             self.distance.reset_multipliers();
         }
         self.dihedral.reset_multipliers();
@@ -284,7 +283,7 @@ impl ConstraintSet {
     ) {
         let h = self.xpbd_h;
         self.cg.substep_iterations = 0;
-        if self.joint_cg {
+        if self.plan.joint {
             let cg = &mut self.cg;
             cg.begin(x.len());
             let at = quad_cg::Linearised {
@@ -303,14 +302,14 @@ impl ConstraintSet {
             self.isometric.apply_rows(quad_cg::ISOMETRIC_ROWS, x, cg);
         } else {
             let none = FrameConstants::default();
-            if self.bending_cg[0] {
+            if self.plan.bending[0] {
                 self.dihedral
                     .solve_cg(x, prev, w, params, h, quad_cg::DIHEDRAL_ROWS, &mut self.cg);
             } else {
                 self.dihedral
                     .project_symmetric_lanes(x, prev, w, params, rule, path, false, &none);
             }
-            if self.bending_cg[1] {
+            if self.plan.bending[1] {
                 self.isometric.solve_cg(
                     x,
                     prev,
@@ -334,7 +333,7 @@ impl ConstraintSet {
     /// Whether this frame's distance and bending constraints are solved together by
     /// conjugate gradients (see `quad_cg`), so that the domains' sweep is skipped.
     pub(crate) fn solves_jointly(&self) -> bool {
-        self.joint_cg
+        self.plan.joint
     }
 
     /// Conjugate-gradient iterations of the last substep's solves.

@@ -24,7 +24,9 @@
 //! as the cloth's size in rows squared), so it is kept to systems of at most
 //! [`JOINT_MAX_ROWS`] rows: a garment of 6,000 particles (116,000 rows) took 170 iterations a
 //! substep, 18 times its frame, and keeps the bending solve alone. Rigid rows (α = 0) get a
-//! compliance floor ([`RIGID_FLOOR`]) so that redundant ones leave the system definite.
+//! compliance floor ([`RIGID_FLOOR`]) so that redundant ones leave the system definite. A
+//! bending block of more than [`CG_MAX_ROWS`] rows keeps its sweep ([`Plan`]): the solve
+//! runs on one thread, and a garment's costs many times its frame.
 //!
 //! Warm-starting the sweep instead (λ carried from the last substep, its force put into the
 //! prediction) is unstable: for a slow mode of stiffness k relative to the sweep's diagonal
@@ -56,6 +58,41 @@ pub(crate) const JOINT_ABOVE: f64 = 0.02;
 /// The distance constraints join a bending solve (see the module documentation) when the
 /// joint system has at most this many rows: a 40-cell Cusick disc has 15,000.
 pub(crate) const JOINT_MAX_ROWS: usize = 20_000;
+
+/// A bending block is solved by conjugate gradients alone only when it has at most this many
+/// rows; a larger one keeps the parallel lane sweep however soft that leaves it. The solve
+/// runs on one thread: the walker's T-shirt (28,807 isometric hinges, 86,421 rows, s/α̃ =
+/// 0.25) took 30–65 iterations a frame and its XPBD frame 150 ms instead of the sweep's
+/// 9 ms; the sweep leaves its hinges about 25 % soft (compliance α (1 + s/α̃)).
+pub(crate) const CG_MAX_ROWS: usize = 20_000;
+
+/// How XPBD solves a frame's bending and distance constraints.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Plan {
+    /// The dihedral and the isometric block by conjugate gradients, each alone.
+    pub bending: [bool; 2],
+    /// The distance constraints and both bending blocks in one conjugate-gradient solve.
+    pub joint: bool,
+}
+
+impl Plan {
+    /// Whether the plan needs a block's mean s/α̃ at all: only a block small enough for the
+    /// conjugate gradients, alone ([`CG_MAX_ROWS`]) or jointly ([`JOINT_MAX_ROWS`]).
+    pub(crate) fn weighs(bending_rows: [usize; 2], distance_rows: usize) -> [bool; 2] {
+        let all = distance_rows + bending_rows[0] + bending_rows[1];
+        bending_rows.map(|r| r > 0 && (r <= CG_MAX_ROWS || all <= JOINT_MAX_ROWS))
+    }
+
+    /// The plan for bending blocks of `bending_rows` rows (dihedral, isometric) with mean
+    /// s/α̃ `ratios` (0 for a block not weighed) beside `distance_rows` distance rows.
+    pub(crate) fn new(ratios: [f64; 2], bending_rows: [usize; 2], distance_rows: usize) -> Self {
+        let all = distance_rows + bending_rows[0] + bending_rows[1];
+        Self {
+            bending: [0, 1].map(|k| ratios[k] > CG_ABOVE && bending_rows[k] <= CG_MAX_ROWS),
+            joint: ratios.iter().any(|&r| r > JOINT_ABOVE) && all <= JOINT_MAX_ROWS,
+        }
+    }
+}
 
 /// The smallest α̃ of a row in the conjugate gradients, relative to its Σ wᵢ|∇ᵢC|²: cotton's
 /// stretch at 10 substeps has α̃/s ≈ 3·10⁻⁴, so only rigid rows meet the floor.
@@ -475,6 +512,46 @@ mod tests {
             spring_stiffness: 1e3,
             spring_damping: 0.0,
         }]
+    }
+
+    #[test]
+    fn a_garment_keeps_its_sweep_and_a_fabric_test_its_solve() {
+        // Rows and mean s/α̃ of the shipped scenes' cloths (`weft run`, first frame).
+        let shirt = ([0, 86_421], [0.0, 0.254], 29_699);
+        let skirt = ([0, 26_892], [0.0, 0.059], 9_258);
+        let disc = ([0, 3_888], [0.0, 0.087], 1_392);
+        let strip = ([433, 0], [70.9, 0.0], 638);
+        let plan = |(rows, ratios, distance): ([usize; 2], [f64; 2], usize)| {
+            let weighs = Plan::weighs(rows, distance);
+            Plan::new(
+                [0, 1].map(|k| if weighs[k] { ratios[k] } else { 0.0 }),
+                rows,
+                distance,
+            )
+        };
+        let sweep = Plan::default();
+        assert_eq!(Plan::weighs(shirt.0, shirt.2), [false, false]);
+        assert_eq!(plan(shirt), sweep);
+        assert_eq!(plan(skirt), sweep);
+        let joint = |bending| Plan {
+            bending,
+            joint: true,
+        };
+        assert_eq!(plan(disc), joint([false, true]));
+        assert_eq!(plan(strip), joint([true, false]));
+        // Alone, up to the bound; jointly, up to its own.
+        let alone = ([0, CG_MAX_ROWS], [0.0, 0.3], JOINT_MAX_ROWS);
+        assert_eq!(
+            plan(alone),
+            Plan {
+                bending: [false, true],
+                joint: false
+            }
+        );
+        let over = ([0, CG_MAX_ROWS + 3], [0.0, 0.3], 0);
+        assert_eq!(plan(over), sweep);
+        // Soft per substep: swept at any size.
+        assert_eq!(plan(([0, 300], [0.0, 0.01], 200)), sweep);
     }
 
     #[test]
