@@ -49,18 +49,28 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
         })
         .sum();
     let closest = if reach > 0.0 {
+        // Each task searches only as far as the closest pair it has found so far (`Near`):
+        // a pair no closer cannot lower the minimum, so the answer is the same at any split.
         let vertex_face = (0..positions.len() as u32)
             .into_par_iter()
-            .map_init(Vec::new, |found, v| {
-                bins.vertex_closest(positions, triangles, v, reach, found)
-            })
+            .map_init(
+                || Near::new(reach),
+                |near, v| {
+                    let d = bins.vertex_closest(positions, triangles, v, near);
+                    near.keep(d)
+                },
+            )
             .min_by(f64::total_cmp)
             .unwrap_or(f64::INFINITY);
         let edge_edge = edges
             .par_iter()
-            .map_init(Vec::new, |found, &e| {
-                bins.edge_closest(positions, triangles, e, reach, found)
-            })
+            .map_init(
+                || Near::new(vertex_face.min(reach)),
+                |near, &e| {
+                    let d = bins.edge_closest(positions, triangles, e, near);
+                    near.keep(d)
+                },
+            )
             .min_by(f64::total_cmp)
             .unwrap_or(f64::INFINITY);
         Some(vertex_face.min(edge_edge)).filter(|&d| d < reach)
@@ -68,6 +78,34 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
         None
     };
     Crossings { crossings, closest }
+}
+
+/// One task's search for the closest approach: its candidate buffer and the distance it
+/// searches within, the closest pair it has found so far (at most the reach).
+struct Near {
+    found: Vec<u32>,
+    within: f64,
+}
+
+impl Near {
+    fn new(reach: f64) -> Self {
+        Self {
+            found: Vec::new(),
+            within: reach,
+        }
+    }
+
+    /// Narrows the search to a pair found `d` apart; returns `d`.
+    fn keep(&mut self, d: f64) -> f64 {
+        self.within = self.within.min(d);
+        d
+    }
+}
+
+/// The distance between the boxes `lo1..hi1` and `lo2..hi2` (0 where they overlap): no point
+/// of one is closer to a point of the other.
+fn box_gap(lo1: DVec3, hi1: DVec3, lo2: DVec3, hi2: DVec3) -> f64 {
+    (lo2 - hi1).max(lo1 - hi2).max(DVec3::ZERO).length()
 }
 
 /// Every edge of the triangles once, as `[low, high]`, sorted.
@@ -153,43 +191,50 @@ impl Bins {
             .count()
     }
 
-    fn vertex_closest(
-        &self,
-        x: &[DVec3],
-        triangles: &[[u32; 3]],
-        v: u32,
-        reach: f64,
-        found: &mut Vec<u32>,
-    ) -> f64 {
-        let p = x[v as usize];
-        self.near(p - reach, p + reach, found);
-        found
-            .iter()
-            .map(|&t| triangles[t as usize])
-            .filter(|tri| !tri.contains(&v))
-            .map(|tri| point_triangle_distance(p, tri.map(|i| x[i as usize])))
-            .fold(f64::INFINITY, f64::min)
+    /// The closest triangle to vertex `v` that does not hold it, if closer than
+    /// `near.within` (else at least that, or infinity).
+    fn vertex_closest(&self, x: &[DVec3], triangles: &[[u32; 3]], v: u32, near: &mut Near) -> f64 {
+        let (p, r) = (x[v as usize], near.within);
+        self.near(p - r, p + r, &mut near.found);
+        let mut best = f64::INFINITY;
+        for &t in &near.found {
+            let tri = triangles[t as usize];
+            if tri.contains(&v) {
+                continue;
+            }
+            let corners = tri.map(|i| x[i as usize]);
+            let (lo, hi) = bounds(corners.into_iter());
+            if box_gap(p, p, lo, hi) < best.min(r) {
+                best = best.min(point_triangle_distance(p, corners));
+            }
+        }
+        best
     }
 
+    /// The closest edge to edge `a b` that shares no vertex with it, if closer than
+    /// `near.within` (else at least that, or infinity).
     fn edge_closest(
         &self,
         x: &[DVec3],
         triangles: &[[u32; 3]],
         [a, b]: [u32; 2],
-        reach: f64,
-        found: &mut Vec<u32>,
+        near: &mut Near,
     ) -> f64 {
-        let (p, q) = (x[a as usize], x[b as usize]);
-        self.near(p.min(q) - reach, p.max(q) + reach, found);
+        let (p, q, r) = (x[a as usize], x[b as usize], near.within);
+        let (lo, hi) = (p.min(q), p.max(q));
+        self.near(lo - r, hi + r, &mut near.found);
         let mut best = f64::INFINITY;
-        for &t in found.iter() {
+        for &t in &near.found {
             let tri = triangles[t as usize];
             for k in 0..3 {
                 let (c, d) = (tri[k], tri[(k + 1) % 3]);
                 if c == a || c == b || d == a || d == b {
                     continue;
                 }
-                best = best.min(segment_distance(p, q, x[c as usize], x[d as usize]));
+                let (pc, pd) = (x[c as usize], x[d as usize]);
+                if box_gap(lo, hi, pc.min(pd), pc.max(pd)) < best.min(r) {
+                    best = best.min(segment_distance(p, q, pc, pd));
+                }
             }
         }
         best
@@ -396,6 +441,47 @@ mod tests {
             .sum::<usize>();
         assert!(brute > 20, "the pair must interpenetrate: {brute}");
         assert_eq!(measure(&x, &t, 0.0).crossings, brute);
+    }
+
+    #[test]
+    fn the_closest_approach_is_the_brute_force_minimum_on_any_thread_count() {
+        // Two bumpy sheets 2 cm apart, bumped towards each other where they meet.
+        let (mut x, mut t) = sheet(6, 0.1, 0.0, 0);
+        let (x2, t2) = sheet(6, 0.1, 0.02, x.len() as u32);
+        x.extend(x2.into_iter().map(|p| p + DVec3::new(0.037, 0.021, 0.0)));
+        t.extend(t2);
+        let n = x.len() / 2;
+        for (i, p) in x.iter_mut().enumerate() {
+            let s = if i < n { 1.0 } else { -1.0 };
+            p.z += s * 0.008 * ((p.x * 17.0).sin() * (p.y * 13.0).cos()).max(0.0);
+        }
+        let edges = unique_edges(&t);
+        let p = |i: u32| x[i as usize];
+        let mut brute = f64::INFINITY;
+        for v in 0..x.len() as u32 {
+            for tri in t.iter().filter(|tri| !tri.contains(&v)) {
+                brute = brute.min(point_triangle_distance(p(v), tri.map(p)));
+            }
+        }
+        for &[a, b] in &edges {
+            for &[c, d] in &edges {
+                if c != a && c != b && d != a && d != b {
+                    brute = brute.min(segment_distance(p(a), p(b), p(c), p(d)));
+                }
+            }
+        }
+        assert!(brute > 1e-3 && brute < 0.015, "{brute}");
+        assert_eq!(measure(&x, &t, 0.05).crossings, 0);
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            let m = pool.install(|| measure(&x, &t, 0.05));
+            assert_eq!(m.closest, Some(brute), "{threads} threads");
+        }
+        // Beyond the reach: none.
+        assert_eq!(measure(&x, &t, brute * 0.99).closest, None);
     }
 
     #[test]

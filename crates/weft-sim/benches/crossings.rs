@@ -56,6 +56,7 @@ fn scene_group(c: &mut Criterion, scene: &str, warm: u64) {
 fn crossings(c: &mut Criterion) {
     scene_group(c, "layers.toml", 20);
     scene_group(c, "twist.toml", 60);
+    scene_group(c, "character.toml", 12);
 }
 
 criterion_group!(benches, crossings);
