@@ -216,17 +216,12 @@ impl ConstraintSet {
         self.plan = quad_cg::Plan::default();
         if let Rule::Xpbd { h } = rule {
             self.xpbd_h = h;
-            // The mean s/α̃ costs a pass over the hinges: only for a block the plan may solve.
             let rows = [self.dihedral.len(), 3 * self.isometric.len()];
-            let weighs = quad_cg::Plan::weighs(rows, self.distance.len());
-            let mut ratios = [0.0; 2];
-            if weighs[0] {
-                ratios[0] = self.dihedral.mean_stiffness_ratio(x, w, params, h);
-            }
-            if weighs[1] {
-                ratios[1] = self.isometric.mean_stiffness_ratio(x, w, params, h);
-            }
-            self.plan = quad_cg::Plan::new(ratios, rows, self.distance.len());
+            let (dihedral, isometric) = (&self.dihedral, &self.isometric);
+            self.plan = quad_cg::Plan::new(rows, self.distance.len(), |k| match k {
+                0 => dihedral.mean_stiffness_ratio(x, w, params, h),
+                _ => isometric.mean_stiffness_ratio(x, w, params, h),
+            });
         }
         self.isometric_forward = self.isometric.soft_per_substep(w, params, rule);
         self.isometric

@@ -76,17 +76,24 @@ pub(crate) struct Plan {
 }
 
 impl Plan {
-    /// Whether the plan needs a block's mean s/α̃ at all: only a block small enough for the
-    /// conjugate gradients, alone ([`CG_MAX_ROWS`]) or jointly ([`JOINT_MAX_ROWS`]).
-    pub(crate) fn weighs(bending_rows: [usize; 2], distance_rows: usize) -> [bool; 2] {
+    /// The plan for bending blocks of `bending_rows` rows (dihedral, isometric) beside
+    /// `distance_rows` distance rows. `ratio(k)` is block k's mean s/α̃, a pass over its
+    /// hinges: asked only of a block small enough to be solved, alone ([`CG_MAX_ROWS`]) or
+    /// jointly ([`JOINT_MAX_ROWS`]).
+    pub(crate) fn new(
+        bending_rows: [usize; 2],
+        distance_rows: usize,
+        mut ratio: impl FnMut(usize) -> f64,
+    ) -> Self {
         let all = distance_rows + bending_rows[0] + bending_rows[1];
-        bending_rows.map(|r| r > 0 && (r <= CG_MAX_ROWS || all <= JOINT_MAX_ROWS))
-    }
-
-    /// The plan for bending blocks of `bending_rows` rows (dihedral, isometric) with mean
-    /// s/α̃ `ratios` (0 for a block not weighed) beside `distance_rows` distance rows.
-    pub(crate) fn new(ratios: [f64; 2], bending_rows: [usize; 2], distance_rows: usize) -> Self {
-        let all = distance_rows + bending_rows[0] + bending_rows[1];
+        let ratios: [f64; 2] = std::array::from_fn(|k| {
+            let rows = bending_rows[k];
+            if rows > 0 && (rows <= CG_MAX_ROWS || all <= JOINT_MAX_ROWS) {
+                ratio(k)
+            } else {
+                0.0
+            }
+        });
         Self {
             bending: [0, 1].map(|k| ratios[k] > CG_ABOVE && bending_rows[k] <= CG_MAX_ROWS),
             joint: ratios.iter().any(|&r| r > JOINT_ABOVE) && all <= JOINT_MAX_ROWS,
@@ -522,15 +529,16 @@ mod tests {
         let disc = ([0, 3_888], [0.0, 0.087], 1_392);
         let strip = ([433, 0], [70.9, 0.0], 638);
         let plan = |(rows, ratios, distance): ([usize; 2], [f64; 2], usize)| {
-            let weighs = Plan::weighs(rows, distance);
-            Plan::new(
-                [0, 1].map(|k| if weighs[k] { ratios[k] } else { 0.0 }),
-                rows,
-                distance,
-            )
+            Plan::new(rows, distance, |k| ratios[k])
         };
         let sweep = Plan::default();
-        assert_eq!(Plan::weighs(shirt.0, shirt.2), [false, false]);
+        // The shirt's blocks are too large to be solved: their s/α̃ is never worked out.
+        let mut asked = 0;
+        Plan::new(shirt.0, shirt.2, |k| {
+            asked += 1;
+            shirt.1[k]
+        });
+        assert_eq!(asked, 0);
         assert_eq!(plan(shirt), sweep);
         assert_eq!(plan(skirt), sweep);
         let joint = |bending| Plan {
