@@ -414,19 +414,30 @@ mod tests {
         assert_eq!(measure(&x, &t, 0.0).crossings, 0);
     }
 
-    #[test]
-    fn crossings_match_a_brute_force_count_on_a_crumpled_pair() {
+    /// A deterministic wave over the plane, between −1 and 1.
+    fn wave(p: DVec3) -> f64 {
+        (p.x * 17.0).sin() * (p.y * 13.0).cos()
+    }
+
+    /// Two 6 × 6 sheets of 0.1 m cells, the second at height `z` and off the first one's grid
+    /// (so no edge meets a triangle's boundary), each particle `i` at `p` raised by
+    /// `bump(p, i, s)`, s = 1 in the first sheet and −1 in the second.
+    fn bumped_pair(z: f64, bump: impl Fn(DVec3, usize, f64) -> f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
         let (mut x, mut t) = sheet(6, 0.1, 0.0, 0);
-        let (x2, t2) = sheet(6, 0.1, 0.0, x.len() as u32);
-        // The second sheet off the first one's grid, so no edge meets a triangle's boundary.
+        let (x2, t2) = sheet(6, 0.1, z, x.len() as u32);
         x.extend(x2.into_iter().map(|p| p + DVec3::new(0.037, 0.021, 0.0)));
         t.extend(t2);
-        // Deterministic bumps, opposite in the two sheets, so they interpenetrate in patches.
         let n = x.len() / 2;
         for (i, p) in x.iter_mut().enumerate() {
-            let s = if i < n { 1.0 } else { -1.0 };
-            p.z = s * 0.03 * ((p.x * 17.0).sin() * (p.y * 13.0).cos()) + 0.01 * (i % 3) as f64;
+            p.z += bump(*p, i, if i < n { 1.0 } else { -1.0 });
         }
+        (x, t)
+    }
+
+    #[test]
+    fn crossings_match_a_brute_force_count_on_a_crumpled_pair() {
+        // Opposite bumps in two sheets in one plane, so they interpenetrate in patches.
+        let (x, t) = bumped_pair(0.0, |p, i, s| s * 0.03 * wave(p) + 0.01 * (i % 3) as f64);
         let edges = unique_edges(&t);
         let brute = edges
             .iter()
@@ -445,16 +456,8 @@ mod tests {
 
     #[test]
     fn the_closest_approach_is_the_brute_force_minimum_on_any_thread_count() {
-        // Two bumpy sheets 2 cm apart, bumped towards each other where they meet.
-        let (mut x, mut t) = sheet(6, 0.1, 0.0, 0);
-        let (x2, t2) = sheet(6, 0.1, 0.02, x.len() as u32);
-        x.extend(x2.into_iter().map(|p| p + DVec3::new(0.037, 0.021, 0.0)));
-        t.extend(t2);
-        let n = x.len() / 2;
-        for (i, p) in x.iter_mut().enumerate() {
-            let s = if i < n { 1.0 } else { -1.0 };
-            p.z += s * 0.008 * ((p.x * 17.0).sin() * (p.y * 13.0).cos()).max(0.0);
-        }
+        // Two sheets 2 cm apart, bumped towards each other where they meet.
+        let (x, t) = bumped_pair(0.02, |p, _, s| s * 0.008 * wave(p).max(0.0));
         let edges = unique_edges(&t);
         let p = |i: u32| x[i as usize];
         let mut brute = f64::INFINITY;
