@@ -23,35 +23,41 @@
 //! d_a − max δ (first) − max δ (second) bounds a listed pair's distance from below
 //! ([`Candidates::lower_bound`]), which spares the contacts and the check a distance.
 //!
-//! The grid only narrows the search: the elements' boxes grown by half the reach overlap
-//! exactly when the boxes lie within the reach, and a pair is taken in one cell alone, the one
-//! holding the low corner of the two boxes' overlap. A box spanning too many cells is not
-//! binned but tried against every query, and a query spanning too many tries every element.
+//! The grid ([`super::grid`]) only narrows the search: the elements' boxes grown by half the
+//! reach overlap exactly when the boxes lie within the reach.
+//!
+//! When a few particles leave their boxes the list is refreshed rather than rebuilt
+//! ([`Candidates::check`]): those particles get new boxes, anchors and radii, every pair of an
+//! element holding one is dropped and searched again (through the grid of the last build for
+//! the elements unchanged since, a small grid of the changed ones), and every other pair stays
+//! as it was: its part of the invariant involves only its own corners' boxes and balls, which
+//! did not change. A build from scratch happens when more than an eighth of the members leave,
+//! or the elements changed since the last build reach a quarter of their kind.
 //!
 //! The list is built in parallel, in an order fixed by the elements and the grid (by vertex,
-//! then the cells it touches; by edge, then its cells), so it does not depend on the thread
-//! count.
+//! then the cells it touches; by edge, then its cells), and refreshed in an order fixed by
+//! the particles that left, so it does not depend on the thread count.
 
-use glam::{DVec3, I64Vec3};
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::geometry::{point_triangle_distance, segment_distance};
-use super::topology::Elements;
-
-/// An axis-aligned box `(lo, hi)`.
-type Aabb = (DVec3, DVec3);
-
-/// A box spanning more cells than this is not binned: every query tries it.
-const BIN_LIMIT: f64 = 64.0;
-
-/// A query spanning more cells than this tries every element instead.
-const QUERY_LIMIT: f64 = 128.0;
+use super::grid::{Aabb, Binned, Grid};
+use super::topology::{Elements, Incidence};
 
 /// Slack for rounding (m), added to the listing distance and taken off every
 /// [`Candidates::lower_bound`]: distances are rounded to within a few ulps of coordinates up
 /// to kilometres (under 1e-12 m), so 1 nm keeps both sides of the invariant in floating point
 /// while listing and pruning as the exact ones would.
 pub(crate) const ROUNDING: f64 = 1e-9;
+
+/// When a member leaves its box, those within this fraction of the skin of leaving theirs are
+/// placed afresh too.
+const MARGIN: f64 = 0.25;
+
+/// A list is rebuilt rather than refreshed when more than 1 / this of the members left their
+/// boxes.
+const REBUILD_ESCAPED: usize = 8;
 
 /// A listed pair: the two elements (vertex and triangle, or two edges, the first lower), the
 /// distance the pair keeps, and their distance at the anchors.
@@ -65,6 +71,17 @@ pub(crate) struct Listed {
     pub keep: f64,
     /// Their distance at the anchors (m).
     pub apart: f64,
+}
+
+/// What the list is kept for: the largest distance a pair keeps, the skin, and each pair's
+/// own distance.
+pub(crate) struct Rule<K> {
+    /// The largest distance kept (m).
+    pub reach: f64,
+    /// The skin (m): each particle's box is its path's grown by half of it.
+    pub skin: f64,
+    /// The distance a pair keeps (at most `reach`).
+    pub keep: K,
 }
 
 /// The listed pairs and what they were listed for.
@@ -82,27 +99,122 @@ pub(crate) struct Candidates {
     boxes: Vec<Aabb>,
     /// Per particle, δᵢ at the last [`Self::measure`] (members only).
     moved: Vec<f64>,
+    /// The member vertices (by their place in `Elements::vertices`), triangles and edges.
+    vertices: Binned,
+    triangles: Binned,
+    edges: Binned,
+    /// Each particle's triangles and edges.
+    incidence: Incidence,
     /// Whether a list is built (and not dropped since).
     built: bool,
-    /// Lists built so far.
+    /// Lists built from scratch so far.
     pub builds: u64,
+    /// Lists refreshed (a few particles' pairs searched again) so far.
+    pub refreshes: u64,
+}
+
+/// The list's view of one pair search: the elements, the particles' anchors and the rule.
+struct Search<'a, K> {
+    el: &'a Elements,
+    anchors: &'a [DVec3],
+    rule: &'a Rule<K>,
+}
+
+impl<K: Fn(Pair) -> f64> Search<'_, K> {
+    /// A pair of elements at distance `apart` at the anchors, with radii summing to `r`:
+    /// listed if within the distance it keeps (the reach first, which needs no `keep`; not a
+    /// number lists nothing either).
+    #[inline]
+    fn listed(&self, pair: Pair, (a, b): (u32, u32), apart: f64, r: f64) -> Option<Listed> {
+        let within = apart <= self.rule.reach + r;
+        if !within {
+            return None;
+        }
+        let keep = (self.rule.keep)(pair);
+        (apart <= keep + r + ROUNDING).then_some(Listed { a, b, keep, apart })
+    }
+
+    /// Vertex `v` (radius `rv`) against triangle `f` (radius `rf`), their boxes overlapping.
+    #[inline]
+    fn vertex_face(&self, v: u32, rv: f64, f: u32, rf: f64) -> Option<Listed> {
+        let t = self.el.triangles[f as usize];
+        if t.contains(&v) {
+            return None;
+        }
+        let at = |i: u32| self.anchors[i as usize];
+        let apart = point_triangle_distance(at(v), [at(t[0]), at(t[1]), at(t[2])]);
+        self.listed(Pair::VertexFace(v, f), (v, f), apart, rv + rf)
+    }
+
+    /// Edge `e` against a later edge `g` (radii summing to `r`), their boxes overlapping.
+    #[inline]
+    fn edge_edge(&self, e: u32, g: u32, r: f64) -> Option<Listed> {
+        let ([a0, a1], [b0, b1]) = (self.el.edges[e as usize], self.el.edges[g as usize]);
+        if a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1 {
+            return None;
+        }
+        let at = |i: u32| self.anchors[i as usize];
+        let apart = segment_distance(at(a0), at(a1), at(b0), at(b1));
+        self.listed(Pair::EdgeEdge(e, g), (e, g), apart, r)
+    }
 }
 
 impl Candidates {
+    /// Makes the list hold for the paths `prev → x` under `rule`: kept if every member stays
+    /// within its box and ball, refreshed if a few left, built from scratch otherwise.
+    pub(crate) fn check<K: Fn(Pair) -> f64 + Sync>(
+        &mut self,
+        el: &Elements,
+        prev: &[DVec3],
+        x: &[DVec3],
+        rule: &Rule<K>,
+    ) {
+        if !self.built {
+            return self.build(el, prev, x, rule);
+        }
+        let (out, escaped) = self.escaped(el, prev, x, MARGIN * rule.skin);
+        if out == 0 {
+            return;
+        }
+        if out * REBUILD_ESCAPED > el.vertices.len() || !self.refresh(el, prev, x, &escaped, rule) {
+            self.build(el, prev, x, rule);
+        }
+    }
+
     /// Whether the list holds for the paths `prev → x` (see the module's invariant); records
     /// each member's displacement δᵢ = max(|x_prevᵢ − aᵢ|, |xᵢ − aᵢ|).
+    #[cfg(test)]
     pub(crate) fn holds(&mut self, el: &Elements, prev: &[DVec3], x: &[DVec3]) -> bool {
-        if !self.built {
-            return false;
-        }
+        self.built && self.escaped(el, prev, x, 0.0).0 == 0
+    }
+
+    /// How many members left their box or ball on the paths `prev → x`, and, if any did,
+    /// those and the ones within `margin` of leaving (ascending: placed afresh together, so
+    /// that the list is refreshed for many at once rather than for each as it leaves);
+    /// records each member's displacement δᵢ = max(|x_prevᵢ − aᵢ|, |xᵢ − aᵢ|).
+    fn escaped(
+        &mut self,
+        el: &Elements,
+        prev: &[DVec3],
+        x: &[DVec3],
+        margin: f64,
+    ) -> (usize, Vec<u32>) {
         self.measure(prev, x);
         let (moved, radius, boxes) = (&self.moved, &self.radius, &self.boxes);
-        el.vertices.iter().all(|&v| {
-            let i = v as usize;
-            let (lo, hi) = boxes[i];
+        let out = |v: &u32, m: f64| {
+            let i = *v as usize;
+            let (lo, hi) = (boxes[i].0 + m, boxes[i].1 - m);
             let inside = |p: DVec3| p.cmpge(lo).all() && p.cmple(hi).all();
-            moved[i] <= radius[i] && inside(prev[i]) && inside(x[i])
-        })
+            !(moved[i] <= radius[i] - m && inside(prev[i]) && inside(x[i]))
+        };
+        let count = el.vertices.par_iter().filter(|v| out(v, 0.0)).count();
+        if count == 0 {
+            return (0, Vec::new());
+        }
+        let near = (el.vertices.par_iter().copied())
+            .filter(|v| out(v, margin))
+            .collect();
+        (count, near)
     }
 
     /// Records each member's displacement δᵢ = max(|x_prevᵢ − aᵢ|, |xᵢ − aᵢ|) from its
@@ -140,18 +252,38 @@ impl Candidates {
         pair.apart - first - second - ROUNDING
     }
 
-    /// Lists every pair that can come within the distance it keeps (`keep(pair)`, at most
-    /// `reach`) while each particle stays inside its path's (`prev → x`) box grown by `skin` /
-    /// 2 and within half its path plus `skin` / 2 of the path's midpoint (see the module's
-    /// invariant).
-    pub(crate) fn build(
+    /// Particle `i`'s anchor, radius, box and displacement for its path `prev → x`.
+    fn place(&mut self, i: usize, prev: DVec3, x: DVec3, skin: f64) {
+        let (a, r) = ball(prev, x, skin);
+        self.anchors[i] = a;
+        self.moved[i] = prev.distance(a).max(x.distance(a));
+        self.radius[i] = r;
+        self.boxes[i] = path_box(prev, x, skin);
+    }
+
+    /// The box of the particles `ids` together, grown by `half` the reach, and their largest
+    /// radius.
+    fn grown(&self, ids: &[u32], half: f64) -> (Aabb, f64) {
+        let (mut lo, mut hi, mut r) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0f64);
+        for &i in ids {
+            let b = self.boxes[i as usize];
+            (lo, hi) = (lo.min(b.0), hi.max(b.1));
+            r = r.max(self.radius[i as usize]);
+        }
+        let h = DVec3::splat(half);
+        ((lo - h, hi + h), r)
+    }
+
+    /// Lists every pair that can come within the distance it keeps (`rule.keep(pair)`, at
+    /// most `rule.reach`) while each particle stays inside its path's (`prev → x`) box grown
+    /// by half the skin and within half its path plus half the skin of the path's midpoint
+    /// (see the module's invariant).
+    pub(crate) fn build<K: Fn(Pair) -> f64 + Sync>(
         &mut self,
         el: &Elements,
         prev: &[DVec3],
         x: &[DVec3],
-        reach: f64,
-        skin: f64,
-        keep: impl Fn(Pair) -> f64 + Sync,
+        rule: &Rule<K>,
     ) {
         self.builds += 1;
         let n = prev.len();
@@ -159,94 +291,174 @@ impl Candidates {
         self.radius.resize(n, 0.0);
         self.moved.resize(n, 0.0);
         self.boxes.resize(n, (DVec3::ZERO, DVec3::ZERO));
+        if self.incidence.len() != n {
+            self.incidence = Incidence::new(el, n);
+        }
         for &v in &el.vertices {
             let i = v as usize;
-            let (a, r) = ball(prev[i], x[i], skin);
-            self.anchors[i] = a;
-            self.moved[i] = prev[i].distance(a).max(x[i].distance(a));
-            self.radius[i] = r;
-            self.boxes[i] = path_box(prev[i], x[i], skin);
+            self.place(i, prev[i], x[i], rule.skin);
         }
-        let (anchors, radius, boxes) = (&self.anchors, &self.radius, &self.boxes);
-        let at = |i: u32| anchors[i as usize];
-        let half = DVec3::splat(0.5 * reach);
-        // An element's box (its corners' boxes) grown by half the reach, and its radius.
-        let grown = |ids: &[u32]| {
-            let (mut lo, mut hi, mut r) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0f64);
-            for &i in ids {
-                let b = boxes[i as usize];
-                (lo, hi) = (lo.min(b.0), hi.max(b.1));
-                r = r.max(radius[i as usize]);
-            }
-            ((lo - half, hi + half), r)
+        let half = 0.5 * rule.reach;
+        let this = &*self;
+        let (tris, (edges, verts)) = rayon::join(
+            || {
+                el.triangles
+                    .par_iter()
+                    .map(|t| this.grown(t, half))
+                    .collect::<Vec<_>>()
+            },
+            || {
+                rayon::join(
+                    || {
+                        el.edges
+                            .par_iter()
+                            .map(|e| this.grown(e, half))
+                            .collect::<Vec<_>>()
+                    },
+                    || {
+                        (el.vertices.iter())
+                            .map(|&v| this.grown(&[v], half))
+                            .collect::<Vec<_>>()
+                    },
+                )
+            },
+        );
+        // Cells about as large as a triangle's box, for all three kinds.
+        let cell = Grid::mean_extent(tris.iter().map(|b| b.0));
+        let (t, (e, v)) = (&mut self.triangles, (&mut self.edges, &mut self.vertices));
+        rayon::join(|| t.bin(tris, cell), || e.bin(edges, cell));
+        // The vertices' grid serves refreshes alone: binned at the first one.
+        v.boxes = verts;
+        v.grid = Grid::default();
+        let search = Search {
+            el,
+            anchors: &self.anchors,
+            rule,
         };
-        let tris: Vec<(Aabb, f64)> = el.triangles.par_iter().map(|t| grown(t)).collect();
-        let edges: Vec<(Aabb, f64)> = el.edges.par_iter().map(|e| grown(e)).collect();
-        let (tri_grid, edge_grid) = rayon::join(|| Grid::new(&tris), || Grid::new(&edges));
-        let (tris, edges, keep) = (&tris, &edges, &keep);
-        // A pair of elements `ids` at distance `apart` at the anchors, with radii summing to
-        // `r`: listed if within the distance it keeps (the reach first, which needs no
-        // `keep`; not a number lists nothing either).
-        let listed = |pair: Pair, (a, b): (u32, u32), apart: f64, r: f64| {
-            let within = apart <= reach + r;
-            if !within {
-                return None;
-            }
-            let keep = keep(pair);
-            (apart <= keep + r + ROUNDING).then_some(Listed { a, b, keep, apart })
-        };
-        // Vertex v against triangle f, found in cell `home` (`None`: its only cell, or outside
-        // the grid).
-        let vertex_face = |v: u32, vbox: &Aabb, rv: f64, f: u32, home: Option<I64Vec3>| {
-            let (fbox, rf) = &tris[f as usize];
-            let t = el.triangles[f as usize];
-            if t.contains(&v) || !overlap(vbox, fbox) || !tri_grid.is_home(home, vbox, fbox) {
-                return None;
-            }
-            let apart = point_triangle_distance(at(v), [at(t[0]), at(t[1]), at(t[2])]);
-            listed(Pair::VertexFace(v, f), (v, f), apart, rv + rf)
-        };
-        self.vf = el
-            .vertices
-            .par_iter()
-            .flat_map_iter(|&v| {
-                let rv = radius[v as usize];
-                let b = boxes[v as usize];
-                let vbox = (b.0 - half, b.1 + half);
+        let (tris, edges) = (&self.triangles, &self.edges);
+        self.vf = (0..el.vertices.len() as u32)
+            .into_par_iter()
+            .flat_map_iter(|k| {
+                let v = el.vertices[k as usize];
+                let (vbox, rv) = self.vertices.boxes[k as usize];
                 let mut found = Vec::new();
-                tri_grid.query(&vbox, tris.len() as u32, |f, home| {
-                    found.extend(vertex_face(v, &vbox, rv, f, home));
+                tris.query(&vbox, 0, |f| {
+                    found.extend(search.vertex_face(v, rv, f, tris.boxes[f as usize].1));
                 });
                 found
             })
             .collect();
-        // Edge e against a later edge g.
-        let edge_edge = |e: u32, g: u32, home: Option<I64Vec3>| {
-            let ((ebox, re), (gbox, rg)) = (&edges[e as usize], &edges[g as usize]);
-            let ([a0, a1], [b0, b1]) = (el.edges[e as usize], el.edges[g as usize]);
-            if a0 == b0
-                || a0 == b1
-                || a1 == b0
-                || a1 == b1
-                || !overlap(ebox, gbox)
-                || !edge_grid.is_home(home, ebox, gbox)
-            {
-                return None;
-            }
-            let apart = segment_distance(at(a0), at(a1), at(b0), at(b1));
-            listed(Pair::EdgeEdge(e, g), (e, g), apart, re + rg)
-        };
         self.ee = (0..el.edges.len() as u32)
             .into_par_iter()
             .flat_map_iter(|e| {
+                let (ebox, re) = edges.boxes[e as usize];
                 let mut found = Vec::new();
-                edge_grid.query_after(e, &edges[e as usize].0, edges.len() as u32, |g, home| {
-                    found.extend(edge_edge(e, g, home));
+                edges.query(&ebox, e + 1, |g| {
+                    found.extend(search.edge_edge(e, g, re + edges.boxes[g as usize].1));
                 });
                 found
             })
             .collect();
         self.built = true;
+    }
+
+    /// Places the `escaped` members (ascending) afresh and searches again the pairs of every
+    /// element holding one; false (and the list unusable until a build) when too many
+    /// elements would have changed since the last build.
+    fn refresh<K: Fn(Pair) -> f64 + Sync>(
+        &mut self,
+        el: &Elements,
+        prev: &[DVec3],
+        x: &[DVec3],
+        escaped: &[u32],
+        rule: &Rule<K>,
+    ) -> bool {
+        let n = prev.len();
+        if self.vertices.grid.cell == 0.0 {
+            let cell = self.triangles.grid.cell;
+            let boxes = std::mem::take(&mut self.vertices.boxes);
+            self.vertices.bin(boxes, cell);
+        }
+        for &v in escaped {
+            let i = v as usize;
+            self.place(i, prev[i], x[i], rule.skin);
+        }
+        let (dirty_t, dirty_e) = self.incidence.around(escaped);
+        let slots: Vec<u32> = (escaped.iter())
+            .map(|v| el.vertices.partition_point(|u| u < v) as u32)
+            .collect();
+        let half = 0.5 * rule.reach;
+        let this = &*self;
+        let tb = (dirty_t.iter())
+            .map(|&f| this.grown(&el.triangles[f as usize], half))
+            .collect();
+        let eb = (dirty_e.iter())
+            .map(|&e| this.grown(&el.edges[e as usize], half))
+            .collect();
+        let vb = (slots.iter())
+            .map(|&k| this.grown(&[el.vertices[k as usize]], half))
+            .collect();
+        if !(self.triangles.rebox(&dirty_t, tb)
+            && self.edges.rebox(&dirty_e, eb)
+            && self.vertices.rebox(&slots, vb))
+        {
+            return false;
+        }
+        self.refreshes += 1;
+        let mut dirty = vec![false; n];
+        escaped.iter().for_each(|&v| dirty[v as usize] = true);
+        let mut tri_dirty = vec![false; el.triangles.len()];
+        dirty_t.iter().for_each(|&f| tri_dirty[f as usize] = true);
+        let mut edge_dirty = vec![false; el.edges.len()];
+        dirty_e.iter().for_each(|&e| edge_dirty[e as usize] = true);
+        (self.vf).retain(|l| !dirty[l.a as usize] && !tri_dirty[l.b as usize]);
+        (self.ee).retain(|l| !edge_dirty[l.a as usize] && !edge_dirty[l.b as usize]);
+        let search = Search {
+            el,
+            anchors: &self.anchors,
+            rule,
+        };
+        let (tris, edges, verts) = (&self.triangles, &self.edges, &self.vertices);
+        // Each moved vertex against every triangle, then each moved triangle against the
+        // vertices that did not move; each moved edge against every edge that did not move and
+        // the later moved ones.
+        let mut found: Vec<Listed> = (slots.par_iter().zip(escaped))
+            .flat_map_iter(|(&k, &v)| {
+                let (vbox, rv) = verts.boxes[k as usize];
+                let mut found = Vec::new();
+                tris.query(&vbox, 0, |f| {
+                    found.extend(search.vertex_face(v, rv, f, tris.boxes[f as usize].1));
+                });
+                found
+            })
+            .collect();
+        found.par_extend(dirty_t.par_iter().flat_map_iter(|&f| {
+            let (fbox, rf) = tris.boxes[f as usize];
+            let mut found = Vec::new();
+            verts.query(&fbox, 0, |k| {
+                let v = el.vertices[k as usize];
+                if !dirty[v as usize] {
+                    found.extend(search.vertex_face(v, verts.boxes[k as usize].1, f, rf));
+                }
+            });
+            found
+        }));
+        self.vf.append(&mut found);
+        let mut found: Vec<Listed> = (dirty_e.par_iter())
+            .flat_map_iter(|&e| {
+                let (ebox, re) = edges.boxes[e as usize];
+                let mut found = Vec::new();
+                edges.query(&ebox, 0, |g| {
+                    if g != e && (!edge_dirty[g as usize] || e < g) {
+                        let (a, b) = (e.min(g), e.max(g));
+                        found.extend(search.edge_edge(a, b, re + edges.boxes[g as usize].1));
+                    }
+                });
+                found
+            })
+            .collect();
+        self.ee.append(&mut found);
+        true
     }
 }
 
@@ -272,165 +484,6 @@ pub(crate) enum Pair {
     VertexFace(u32, u32),
     /// Two edge indices.
     EdgeEdge(u32, u32),
-}
-
-/// Whether two boxes overlap (touching counts).
-#[inline]
-fn overlap(a: &Aabb, b: &Aabb) -> bool {
-    a.0.cmple(b.1).all() && b.0.cmple(a.1).all()
-}
-
-/// Element boxes binned by the cells they touch, in a hash table of `(cell key, element)`
-/// entries (counting-sorted by bucket, each bucket in element order), with the boxes that
-/// span too many cells apart.
-struct Grid {
-    cell: f64,
-    /// Bits of the bucket index.
-    bits: u32,
-    /// Where each bucket's entries start (one more for the end).
-    starts: Vec<u32>,
-    entries: Vec<(u64, u32)>,
-    /// Elements tried against every query, ascending.
-    big: Vec<u32>,
-}
-
-impl Grid {
-    /// Bins the boxes of `elements` in cells about as large as the mean box.
-    fn new(elements: &[(Aabb, f64)]) -> Self {
-        let mean = (elements.iter())
-            .map(|((lo, hi), _)| (*hi - *lo).max_element())
-            .filter(|s| s.is_finite())
-            .sum::<f64>()
-            / elements.len().max(1) as f64;
-        let mut grid = Self {
-            cell: mean.max(1e-6),
-            bits: 0,
-            starts: Vec::new(),
-            entries: Vec::new(),
-            big: Vec::new(),
-        };
-        let mut raw = Vec::with_capacity(elements.len() * 8);
-        for (k, (b, _)) in elements.iter().enumerate() {
-            match grid.span(b, BIN_LIMIT) {
-                Span::Cells(lo, hi) => raw.extend(cells(lo, hi).map(|c| (key(c), k as u32))),
-                Span::Many => grid.big.push(k as u32),
-                Span::None => {}
-            }
-        }
-        grid.bits = raw.len().max(16).next_power_of_two().trailing_zeros();
-        let mut starts = vec![0u32; (1 << grid.bits) + 1];
-        for &(k, _) in &raw {
-            starts[grid.bucket(k) + 1] += 1;
-        }
-        for b in 1..starts.len() {
-            starts[b] += starts[b - 1];
-        }
-        let mut fill = starts.clone();
-        grid.entries = vec![(0, 0); raw.len()];
-        for &(k, e) in &raw {
-            let b = grid.bucket(k);
-            grid.entries[fill[b] as usize] = (k, e);
-            fill[b] += 1;
-        }
-        grid.starts = starts;
-        grid
-    }
-
-    /// The bucket of cell key `k`.
-    #[inline]
-    fn bucket(&self, k: u64) -> usize {
-        (k.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize
-    }
-
-    /// The cells box `b` touches, if at most `limit`.
-    fn span(&self, b: &Aabb, limit: f64) -> Span {
-        let (lo, hi) = ((b.0 / self.cell).floor(), (b.1 / self.cell).floor());
-        if !(lo.is_finite() && hi.is_finite()) {
-            return Span::None;
-        }
-        let count = (hi - lo + DVec3::ONE).element_product();
-        if count > limit {
-            Span::Many
-        } else {
-            Span::Cells(lo.as_i64vec3(), hi.as_i64vec3())
-        }
-    }
-
-    /// The elements binned in cell `c` from `from` on, ascending.
-    #[inline]
-    fn bin(&self, c: I64Vec3, from: u32) -> impl Iterator<Item = u32> + '_ {
-        let k = key(c);
-        let b = self.bucket(k);
-        let bucket = &self.entries[self.starts[b] as usize..self.starts[b + 1] as usize];
-        (bucket.iter())
-            .filter(move |&&(e, g)| e == k && g >= from)
-            .map(|&(_, g)| g)
-    }
-
-    /// Calls `f(element, cell)` with every element whose box may overlap `b`: those binned in
-    /// the cells `b` touches (with the cell, if more than one), then the unbinned ones
-    /// (`None`); or every one of `count` elements (`None`) if `b` spans too many cells.
-    fn query(&self, b: &Aabb, count: u32, f: impl FnMut(u32, Option<I64Vec3>)) {
-        self.query_from(0, b, count, f);
-    }
-
-    /// As [`Self::query`] for the elements after `e`, whose own box is `b`.
-    fn query_after(&self, e: u32, b: &Aabb, count: u32, f: impl FnMut(u32, Option<I64Vec3>)) {
-        self.query_from(e + 1, b, count, f);
-    }
-
-    /// As [`Self::query`] for the elements from `from` on.
-    fn query_from(&self, from: u32, b: &Aabb, count: u32, mut f: impl FnMut(u32, Option<I64Vec3>)) {
-        match self.span(b, QUERY_LIMIT) {
-            Span::Cells(lo, hi) => {
-                // In a single cell every overlapping pair has it as its home.
-                let one = lo == hi;
-                for c in cells(lo, hi) {
-                    let home = (!one).then_some(c);
-                    for g in self.bin(c, from) {
-                        f(g, home);
-                    }
-                }
-                let start = self.big.partition_point(|&g| g < from);
-                for &g in &self.big[start..] {
-                    f(g, None);
-                }
-            }
-            Span::Many => (from..count).for_each(|g| f(g, None)),
-            Span::None => {}
-        }
-    }
-
-    /// Whether cell `home` is the one a pair of overlapping boxes `a`, `b` is taken in: the
-    /// cell of their overlap's low corner (`None`: the only one the pair is found in).
-    #[inline]
-    fn is_home(&self, home: Option<I64Vec3>, a: &Aabb, b: &Aabb) -> bool {
-        home.is_none_or(|c| (a.0.max(b.0) / self.cell).floor().as_i64vec3() == c)
-    }
-}
-
-/// How many cells a box touches.
-enum Span {
-    /// Those from the first to the last (inclusive on every axis).
-    Cells(I64Vec3, I64Vec3),
-    /// Too many.
-    Many,
-    /// None: the box is not a number.
-    None,
-}
-
-/// The cells from `a` to `b` (inclusive on every axis).
-fn cells(a: I64Vec3, b: I64Vec3) -> impl Iterator<Item = I64Vec3> {
-    (a.x..=b.x).flat_map(move |x| {
-        (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| I64Vec3::new(x, y, z)))
-    })
-}
-
-/// A cell's key: 21 bits of each coordinate (cells that share a key share a bin, which costs
-/// a box test, never a pair).
-fn key(c: I64Vec3) -> u64 {
-    let m = (1u64 << 21) - 1;
-    ((c.x as u64) & m) | (((c.y as u64) & m) << 21) | (((c.z as u64) & m) << 42)
 }
 
 #[cfg(test)]
@@ -485,29 +538,25 @@ mod tests {
         (el, prev, x)
     }
 
-    /// Pairs keep the reach or less, as the distance kept at rest does.
-    fn keep(reach: f64) -> impl Fn(Pair) -> f64 + Sync {
-        move |p: Pair| match p {
-            Pair::VertexFace(v, f) => reach * (0.5 + 0.5 * ((v + f) % 2) as f64),
-            Pair::EdgeEdge(e, g) => reach * (0.5 + 0.5 * ((e + g) % 2) as f64),
+    /// The rule of the tests: pairs keep the reach or less, as the distance kept at rest does.
+    fn rule() -> Rule<impl Fn(Pair) -> f64 + Sync> {
+        let reach = 0.012;
+        Rule {
+            reach,
+            skin: 0.006,
+            keep: move |p: Pair| match p {
+                Pair::VertexFace(v, f) => reach * (0.5 + 0.5 * ((v + f) % 2) as f64),
+                Pair::EdgeEdge(e, g) => reach * (0.5 + 0.5 * ((e + g) % 2) as f64),
+            },
         }
     }
 
-    /// Builds the list for `prev → x` and checks it against an O(n²) search by the module's
-    /// rule (pairs within a hair of the bound aside, for rounding): every pair is listed,
-    /// once, and nothing beyond the bound. Returns the list.
-    fn build_and_compare(el: &Elements, prev: &[DVec3], x: &[DVec3], tag: &str) -> Candidates {
-        let (reach, skin) = (0.012, 0.006);
-        let keep = keep(reach);
-        let mut list = Candidates::default();
-        list.build(el, prev, x, reach, skin, &keep);
-        let (a, r): (Vec<DVec3>, Vec<f64>) = (prev.iter().zip(x))
-            .map(|(p, q)| ball(*p, *q, skin))
-            .unzip();
+    /// Checks `list` against an O(n²) search by the module's rule over the boxes, anchors and
+    /// radii it holds (pairs within a hair of the bound aside, for rounding): every pair is
+    /// listed, once, and nothing beyond the bound.
+    fn compare<K: Fn(Pair) -> f64>(el: &Elements, list: &Candidates, rule: &Rule<K>, tag: &str) {
+        let (a, r, bx) = (&list.anchors, &list.radius, &list.boxes);
         let rmax = |ids: &[u32]| ids.iter().map(|&i| r[i as usize]).fold(0.0, f64::max);
-        let bx: Vec<Aabb> = (prev.iter().zip(x))
-            .map(|(p, q)| path_box(*p, *q, skin))
-            .collect();
         let unite = |ids: &[u32]| {
             (ids.iter()).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
                 (lo.min(bx[i as usize].0), hi.max(bx[i as usize].1))
@@ -515,7 +564,7 @@ mod tests {
         };
         // The boxes within the reach on every axis.
         let near = |a: Aabb, b: Aabb| {
-            let g = DVec3::splat(reach);
+            let g = DVec3::splat(rule.reach);
             (a.0 - g).cmple(b.1).all() && (b.0 - g).cmple(a.1).all()
         };
         let q = |i: u32| a[i as usize];
@@ -524,7 +573,7 @@ mod tests {
         for &v in &el.vertices {
             for (f, t) in (0u32..).zip(&el.triangles) {
                 let d = point_triangle_distance(q(v), [q(t[0]), q(t[1]), q(t[2])]);
-                let bound = keep(Pair::VertexFace(v, f)) + rmax(&[v]) + rmax(t);
+                let bound = (rule.keep)(Pair::VertexFace(v, f)) + rmax(&[v]) + rmax(t);
                 if !t.contains(&v) && near(unite(&[v]), unite(t)) {
                     vf.push(((v, f), d <= bound * (1.0 - 1e-9), d <= bound * (1.0 + 1e-9)));
                 }
@@ -535,7 +584,7 @@ mod tests {
             for (g, &[b0, b1]) in (0u32..).zip(&el.edges).skip(e as usize + 1) {
                 let shared = a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1;
                 let d = segment_distance(q(a0), q(a1), q(b0), q(b1));
-                let bound = keep(Pair::EdgeEdge(e, g)) + rmax(&[a0, a1]) + rmax(&[b0, b1]);
+                let bound = (rule.keep)(Pair::EdgeEdge(e, g)) + rmax(&[a0, a1]) + rmax(&[b0, b1]);
                 if !shared && near(unite(&[a0, a1]), unite(&[b0, b1])) {
                     ee.push(((e, g), d <= bound * (1.0 - 1e-9), d <= bound * (1.0 + 1e-9)));
                 }
@@ -560,6 +609,14 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Builds the list for `prev → x` and checks it against the brute-force search.
+    fn build_and_compare(el: &Elements, prev: &[DVec3], x: &[DVec3], tag: &str) -> Candidates {
+        let rule = rule();
+        let mut list = Candidates::default();
+        list.build(el, prev, x, &rule);
+        compare(el, &list, &rule, tag);
         list
     }
 
@@ -572,7 +629,7 @@ mod tests {
             // ball.
             assert!(list.holds(&el, &prev, &x));
             let mut far = x.clone();
-            let (a, r) = ball(prev[5], x[5], 0.006);
+            let (a, r) = ball(prev[5], x[5], rule().skin);
             far[5] = a + DVec3::X * (r * 1.001);
             assert!(!list.holds(&el, &prev, &far));
         }
@@ -588,6 +645,36 @@ mod tests {
             prev[47] += DVec3::new(0.0, 0.3, 0.0);
             prev[60] += DVec3::new(0.1, 0.1, -0.1);
             build_and_compare(&el, &prev, &x, &format!("far, seed {seed}"));
+        }
+    }
+
+    #[test]
+    fn a_refreshed_list_holds_every_pair_brute_force_finds() {
+        // A few particles at a time leave their boxes, frame after frame: each time only their
+        // pairs are searched again, and the list is what a search of every pair finds.
+        let rule = rule();
+        for seed in 1..4 {
+            let (el, prev, mut x) = crumpled(16, seed);
+            let mut list = Candidates::default();
+            list.check(&el, &prev, &x, &rule);
+            let mut r = rng(seed + 100);
+            for round in 0..6 {
+                for _ in 0..2 {
+                    let i = (r() * x.len() as f64) as usize;
+                    x[i] += (DVec3::new(r(), r(), r()) - 0.5) * 0.03;
+                }
+                list.check(&el, &prev, &x, &rule);
+                assert_eq!((list.builds, list.refreshes), (1, round + 1), "seed {seed}");
+                compare(&el, &list, &rule, &format!("seed {seed}, refresh {round}"));
+                assert!(list.holds(&el, &prev, &x));
+            }
+            // Most of the particles moving: a build from scratch.
+            for p in x.iter_mut() {
+                *p += DVec3::Y * 0.05;
+            }
+            list.check(&el, &prev, &x, &rule);
+            assert_eq!(list.builds, 2, "seed {seed}");
+            compare(&el, &list, &rule, &format!("seed {seed}, rebuilt"));
         }
     }
 }

@@ -29,6 +29,7 @@
 mod broad;
 mod failsafe;
 mod geometry;
+mod grid;
 mod proximity;
 mod topology;
 
@@ -36,7 +37,7 @@ use weft_solver::{Particles, Solver};
 
 use crate::error::CollideError;
 use crate::friction::Friction;
-use broad::{Candidates, Pair};
+use broad::{Candidates, Pair, Rule};
 pub use failsafe::FailSafeStats;
 use proximity::Sweep;
 use topology::Elements;
@@ -109,8 +110,11 @@ pub struct ClothContactStats {
     pub depth: f64,
     /// Pairs listed (vertex–triangle and edge–edge).
     pub listed: usize,
-    /// Lists built so far.
+    /// Lists built from scratch so far.
     pub builds: u64,
+    /// Lists refreshed so far (only the pairs of the few particles that left their boxes
+    /// searched again).
+    pub refreshes: u64,
     /// The continuous check's findings.
     pub fail_safe: FailSafeStats,
     /// Forced pairs ([`FailSafeStats::forced`]) summed over every substep so far.
@@ -174,9 +178,6 @@ impl ClothContact {
 
     /// Makes sure the list holds every pair that can touch on the paths `prev → x`.
     fn check(&mut self, p: &Particles) {
-        if self.list.holds(&self.el, &p.prev_positions, &p.positions) {
-            return;
-        }
         let (el, thickness) = (&self.el, &self.thickness);
         let target = |pair: Pair| {
             let (a, b, rest) = match pair {
@@ -203,16 +204,14 @@ impl ClothContact {
                 t
             }
         };
-        let skin = self.params.skin * self.reach.max(1e-6);
-        (self.list).build(
-            el,
-            &p.prev_positions,
-            &p.positions,
-            self.reach,
-            skin,
-            target,
-        );
+        let rule = Rule {
+            reach: self.reach,
+            skin: self.params.skin * self.reach.max(1e-6),
+            keep: target,
+        };
+        (self.list).check(el, &p.prev_positions, &p.positions, &rule);
         self.stats.builds = self.list.builds;
+        self.stats.refreshes = self.list.refreshes;
         self.stats.listed = self.list.vf.len() + self.list.ee.len();
     }
 

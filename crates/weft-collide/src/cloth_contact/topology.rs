@@ -57,6 +57,82 @@ impl Elements {
     }
 }
 
+/// Each particle's triangles and edges (indices into [`Elements`]' lists), for finding the
+/// elements a moved particle belongs to.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Incidence {
+    triangles: Csr,
+    edges: Csr,
+}
+
+impl Incidence {
+    /// The incidence of `el`'s elements over `n` particles.
+    pub(crate) fn new(el: &Elements, n: usize) -> Self {
+        Self {
+            triangles: Csr::new(n, &el.triangles),
+            edges: Csr::new(n, &el.edges),
+        }
+    }
+
+    /// Particles covered.
+    pub(crate) fn len(&self) -> usize {
+        self.triangles.starts.len().saturating_sub(1)
+    }
+
+    /// The triangles and the edges holding any of `particles`, each ascending and once.
+    pub(crate) fn around(&self, particles: &[u32]) -> (Vec<u32>, Vec<u32>) {
+        (
+            self.triangles.around(particles),
+            self.edges.around(particles),
+        )
+    }
+}
+
+/// Per particle, the elements holding it (compressed rows).
+#[derive(Clone, Debug, Default)]
+struct Csr {
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Csr {
+    /// The rows of `elements` (each a list of particle indices below `n`).
+    fn new<const K: usize>(n: usize, elements: &[[u32; K]]) -> Self {
+        let mut starts = vec![0u32; n + 1];
+        for e in elements {
+            for &i in e {
+                starts[i as usize + 1] += 1;
+            }
+        }
+        for i in 1..=n {
+            starts[i] += starts[i - 1];
+        }
+        let mut fill = starts.clone();
+        let mut items = vec![0u32; starts[n] as usize];
+        for (k, e) in (0u32..).zip(elements) {
+            for &i in e {
+                items[fill[i as usize] as usize] = k;
+                fill[i as usize] += 1;
+            }
+        }
+        Self { starts, items }
+    }
+
+    /// The elements holding any of `particles`, ascending and once.
+    fn around(&self, particles: &[u32]) -> Vec<u32> {
+        let mut out: Vec<u32> = (particles.iter())
+            .flat_map(|&i| {
+                let i = i as usize;
+                &self.items[self.starts[i] as usize..self.starts[i + 1] as usize]
+            })
+            .copied()
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
+
 /// The edges of `triangles`, each as its two vertices lower first, sorted, once.
 pub(crate) fn edges_of(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     let mut edges: Vec<[u32; 2]> = (triangles.iter())
