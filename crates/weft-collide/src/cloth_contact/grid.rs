@@ -3,7 +3,7 @@
 //! the boxes that span too many cells kept apart and tried against every query.
 //!
 //! A query finds each overlapping pair once: a pair is taken in one cell alone, the one
-//! holding the low corner of the two boxes' overlap ([`Grid::is_home`]).
+//! holding the low corner of the two boxes' overlap.
 
 use glam::{DVec3, I64Vec3};
 
@@ -16,13 +16,13 @@ const BIN_LIMIT: f64 = 64.0;
 /// A query spanning more cells than this tries every element instead.
 const QUERY_LIMIT: f64 = 128.0;
 
-/// A kind's elements are binned afresh when the loose ones (boxes changed since the last
-/// [`Binned::bin`]) would reach 1 / this of them.
-const REBUILD_LOOSE: usize = 4;
+/// A kind's boxes are not changed apart (the caller builds afresh) once the loose ones (boxes
+/// changed since the last [`Binned::bin`]) would reach 1 / this of them.
+const MOST_LOOSE: usize = 2;
 
 /// One kind of cloth contact's elements (vertices, triangles or edges): each one's box (grown
-/// by half the reach) and radius, the grid of the boxes as they were at the last build, and
-/// the elements whose box changed since (loose), in a small grid of their own.
+/// by half the reach) and radius, the grid of the boxes as they were when last binned, and the
+/// elements whose box changed since (loose), in a small grid of their own.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Binned {
     /// Per element, its box and radius.
@@ -38,21 +38,22 @@ pub(crate) struct Binned {
 }
 
 impl Binned {
-    /// Bins `boxes` afresh in cells of edge `cell` (none loose).
-    pub(crate) fn bin(&mut self, boxes: Vec<(Aabb, f64)>, cell: f64) {
-        self.grid = Grid::new(boxes.iter().map(|b| b.0), cell);
+    /// Bins every box afresh in cells of edge `cell` (none loose).
+    pub(crate) fn bin(&mut self, cell: f64) {
+        self.grid = Grid::new(self.boxes.iter().map(|b| b.0), cell);
         self.loose.clear();
-        self.loose.resize(boxes.len(), false);
+        self.loose.resize(self.boxes.len(), false);
         self.loose_ids.clear();
         self.loose_grid = Grid::default();
-        self.boxes = boxes;
     }
 
-    /// Gives the elements `changed` (ascending) the boxes `grown`; false when the loose
-    /// elements would reach 1 / [`REBUILD_LOOSE`] of the kind (nothing changed then).
+    /// Gives the elements `changed` (ascending) the boxes `grown`, binned apart in the loose
+    /// grid; false (nothing changed) when the loose ones would reach 1 / [`MOST_LOOSE`] of the
+    /// kind: the loose grid is made again at each change, and a build from scratch also gives
+    /// every particle a fresh box.
     pub(crate) fn rebox(&mut self, changed: &[u32], grown: Vec<(Aabb, f64)>) -> bool {
         let fresh = changed.iter().filter(|&&e| !self.loose[e as usize]).count();
-        if (self.loose_ids.len() + fresh) * REBUILD_LOOSE >= self.boxes.len().max(1) {
+        if (self.loose_ids.len() + fresh) * MOST_LOOSE >= self.boxes.len().max(1) {
             return false;
         }
         for (&e, b) in changed.iter().zip(grown) {
@@ -72,7 +73,8 @@ impl Binned {
     }
 
     /// Calls `f(element)` once with every element from `from` on whose box overlaps `b`:
-    /// unchanged ones through the build's grid, loose ones through their own.
+    /// unchanged ones through the main grid, loose ones through their own.
+    #[inline]
     pub(crate) fn query(&self, b: &Aabb, from: u32, mut f: impl FnMut(u32)) {
         let (boxes, loose) = (&self.boxes, &self.loose);
         let at = |g: u32| boxes[g as usize].0;
@@ -101,6 +103,8 @@ pub(crate) struct Grid {
     entries: Vec<(u64, u32)>,
     /// Elements tried against every query, ascending.
     big: Vec<u32>,
+    /// Per element, the cell of its box's low corner (binned elements only).
+    low: Vec<I64Vec3>,
 }
 
 impl Grid {
@@ -112,9 +116,13 @@ impl Grid {
             ..Self::default()
         };
         let mut raw = Vec::with_capacity(boxes.len() * 8);
+        grid.low = vec![I64Vec3::ZERO; boxes.len()];
         for (k, b) in boxes.enumerate() {
             match grid.span(&b, BIN_LIMIT) {
-                Span::Cells(lo, hi) => raw.extend(cells(lo, hi).map(|c| (key(c), k as u32))),
+                Span::Cells(lo, hi) => {
+                    grid.low[k] = lo;
+                    raw.extend(cells(lo, hi).map(|c| (key(c), k as u32)));
+                }
                 Span::Many => grid.big.push(k as u32),
                 Span::None => {}
             }
@@ -198,12 +206,14 @@ impl Grid {
         }
         match self.span(b, QUERY_LIMIT) {
             Span::Cells(lo, hi) => {
-                // In a single cell every overlapping pair has it as its home.
+                // A pair's home: the cell of its boxes' overlap's low corner, the larger of
+                // their low corners' cells on each axis (the floor is monotonic). In a single
+                // cell every overlapping pair has it as its home.
                 let one = lo == hi;
                 for c in cells(lo, hi) {
                     for g in self.bin(c, from) {
-                        let gb = boxes(g);
-                        if overlap(b, &gb) && (one || self.is_home(c, b, &gb)) {
+                        let home = one || lo.max(self.low[g as usize]) == c;
+                        if home && overlap(b, &boxes(g)) {
                             f(g);
                         }
                     }
@@ -220,13 +230,6 @@ impl Grid {
                 .for_each(f),
             Span::None => {}
         }
-    }
-
-    /// Whether cell `home` is the one a pair of overlapping boxes `a`, `b` is taken in: the
-    /// cell of their overlap's low corner.
-    #[inline]
-    fn is_home(&self, home: I64Vec3, a: &Aabb, b: &Aabb) -> bool {
-        (a.0.max(b.0) / self.cell).floor().as_i64vec3() == home
     }
 }
 
