@@ -2,14 +2,14 @@
 //! triangle they share no vertex with, and how close non-adjacent elements come.
 //!
 //! It measures contact and shares nothing with it: its own broad phase (triangles binned in a
-//! sorted list of grid cells) and exact-predicate style tests in f64 (signed volumes for the
+//! hash table of grid cells) and exact-predicate style tests in f64 (signed volumes for the
 //! crossings, Ericson's closest points for the distances, "Real-Time Collision Detection"
 //! §5.1.5 and §5.1.9). A crossing is an edge whose two end points lie strictly on opposite
 //! sides of a triangle's plane and whose line passes strictly inside the triangle; touching
 //! and coplanar configurations are not crossings. Integer counts and a minimum: the answer does
 //! not depend on the thread count.
 
-use glam::DVec3;
+use glam::{DVec3, I64Vec3};
 use rayon::prelude::*;
 
 /// What [`measure`] found.
@@ -121,57 +121,79 @@ fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     edges
 }
 
-/// Triangles binned by the grid cells their boxes touch: `(cell key, triangle)` sorted.
+/// Triangles binned by the grid cells their boxes touch: `(cell key, triangle)` entries in a
+/// hash table, counting-sorted by bucket (each bucket in triangle order).
 struct Bins {
     cell: f64,
+    /// Bits of the bucket index.
+    bits: u32,
+    /// Where each bucket's entries start (one more for the end).
+    starts: Vec<u32>,
     entries: Vec<(u64, u32)>,
+    /// Per triangle, its box.
+    boxes: Vec<(DVec3, DVec3)>,
+    /// Per triangle, the cell of its box's low corner.
+    low: Vec<I64Vec3>,
 }
 
 impl Bins {
     fn new(positions: &[DVec3], triangles: &[[u32; 3]], cell: f64) -> Self {
-        let mut entries = Vec::with_capacity(triangles.len() * 2);
-        for (t, tri) in triangles.iter().enumerate() {
-            let (lo, hi) = bounds(tri.iter().map(|&i| positions[i as usize]));
-            let b = Bins {
-                cell,
-                entries: Vec::new(),
-            };
-            b.for_cells(lo, hi, |key| entries.push((key, t as u32)));
-        }
-        entries.par_sort_unstable();
-        Bins { cell, entries }
-    }
-
-    /// Calls `f` with the key of every cell the box `lo..hi` touches.
-    fn for_cells(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(u64)) {
-        let (a, b) = ((lo / self.cell).floor(), (hi / self.cell).floor());
-        if !(a.is_finite() && b.is_finite()) {
-            return;
-        }
-        let (a, b) = (a.as_i64vec3(), b.as_i64vec3());
-        for x in a.x..=b.x {
-            for y in a.y..=b.y {
-                for z in a.z..=b.z {
-                    f(key(x, y, z));
-                }
+        let boxes: Vec<(DVec3, DVec3)> = (triangles.par_iter())
+            .map(|tri| bounds(tri.iter().map(|&i| positions[i as usize])))
+            .collect();
+        let mut low = vec![I64Vec3::ZERO; triangles.len()];
+        let mut raw = Vec::with_capacity(triangles.len() * 2);
+        for (t, &(lo, hi)) in boxes.iter().enumerate() {
+            if let Some((a, b)) = cells(lo, hi, cell) {
+                low[t] = a;
+                for_cells(a, b, |c| raw.push((key(c), t as u32)));
             }
         }
+        let bits = raw.len().max(16).next_power_of_two().trailing_zeros();
+        let mut starts = vec![0u32; (1 << bits) + 1];
+        for &(k, _) in &raw {
+            starts[bucket(k, bits) + 1] += 1;
+        }
+        for b in 1..starts.len() {
+            starts[b] += starts[b - 1];
+        }
+        let mut fill = starts.clone();
+        let mut entries = vec![(0, 0); raw.len()];
+        for &(k, t) in &raw {
+            let b = bucket(k, bits);
+            entries[fill[b] as usize] = (k, t);
+            fill[b] += 1;
+        }
+        Bins {
+            cell,
+            bits,
+            starts,
+            entries,
+            boxes,
+            low,
+        }
     }
 
-    /// The triangles binned in the cells the box touches, each once, into `found`.
+    /// The triangles whose boxes overlap the box `lo..hi`, each once, into `found`: a triangle
+    /// is taken only in its home cell, the larger of the two boxes' low-corner cells on each
+    /// axis (the cell of the boxes' overlap's low corner, which both touch).
     fn near(&self, lo: DVec3, hi: DVec3, found: &mut Vec<u32>) {
         found.clear();
-        self.for_cells(lo, hi, |k| {
-            let start = self.entries.partition_point(|&(c, _)| c < k);
-            found.extend(
-                self.entries[start..]
-                    .iter()
-                    .take_while(|&&(c, _)| c == k)
-                    .map(|&(_, t)| t),
-            );
+        let Some((a, b)) = cells(lo, hi, self.cell) else {
+            return;
+        };
+        for_cells(a, b, |c| {
+            let (k, i) = (key(c), bucket(key(c), self.bits));
+            let bucket = &self.entries[self.starts[i] as usize..self.starts[i + 1] as usize];
+            for &(e, t) in bucket {
+                if e == k && a.max(self.low[t as usize]) == c {
+                    let (tlo, thi) = self.boxes[t as usize];
+                    if tlo.cmple(hi).all() && lo.cmple(thi).all() {
+                        found.push(t);
+                    }
+                }
+            }
         });
-        found.sort_unstable();
-        found.dedup();
     }
 
     fn crossings_of(
@@ -202,10 +224,9 @@ impl Bins {
             if tri.contains(&v) {
                 continue;
             }
-            let corners = tri.map(|i| x[i as usize]);
-            let (lo, hi) = bounds(corners.into_iter());
+            let (lo, hi) = self.boxes[t as usize];
             if box_gap(p, p, lo, hi) < best.min(r) {
-                best = best.min(point_triangle_distance(p, corners));
+                best = best.min(point_triangle_distance(p, tri.map(|i| x[i as usize])));
             }
         }
         best
@@ -242,10 +263,32 @@ impl Bins {
 }
 
 /// A cell's key: the three coordinates' low 21 bits interleaved into one word (distinct cells
-/// may share a key far apart; they only add candidates).
-fn key(x: i64, y: i64, z: i64) -> u64 {
+/// may share a key far apart; they only add candidates, which the home cell turns away).
+fn key(c: I64Vec3) -> u64 {
     let m = |v: i64| (v as u64) & 0x1f_ffff;
-    (m(x) << 42) | (m(y) << 21) | m(z)
+    (m(c.x) << 42) | (m(c.y) << 21) | m(c.z)
+}
+
+/// The hash bucket of key `k` in a table of 2^`bits` buckets.
+fn bucket(k: u64, bits: u32) -> usize {
+    (k.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - bits)) as usize
+}
+
+/// The first and last cells (of edge `cell`) the box `lo..hi` touches, if it is finite.
+fn cells(lo: DVec3, hi: DVec3, cell: f64) -> Option<(I64Vec3, I64Vec3)> {
+    let (a, b) = ((lo / cell).floor(), (hi / cell).floor());
+    (a.is_finite() && b.is_finite()).then(|| (a.as_i64vec3(), b.as_i64vec3()))
+}
+
+/// Calls `f` with every cell from `a` to `b` (inclusive on every axis).
+fn for_cells(a: I64Vec3, b: I64Vec3, mut f: impl FnMut(I64Vec3)) {
+    for x in a.x..=b.x {
+        for y in a.y..=b.y {
+            for z in a.z..=b.z {
+                f(I64Vec3::new(x, y, z));
+            }
+        }
+    }
 }
 
 fn bounds(points: impl Iterator<Item = DVec3>) -> (DVec3, DVec3) {
