@@ -301,29 +301,10 @@ impl Candidates {
         }
         let half = 0.5 * rule.reach;
         let this = &*self;
-        let (tris, (edges, verts)) = rayon::join(
-            || {
-                el.triangles
-                    .par_iter()
-                    .map(|t| this.grown(t, half))
-                    .collect::<Vec<_>>()
-            },
-            || {
-                rayon::join(
-                    || {
-                        el.edges
-                            .par_iter()
-                            .map(|e| this.grown(e, half))
-                            .collect::<Vec<_>>()
-                    },
-                    || {
-                        (el.vertices.iter())
-                            .map(|&v| this.grown(&[v], half))
-                            .collect::<Vec<_>>()
-                    },
-                )
-            },
-        );
+        let grown = |ids: &[u32]| this.grown(ids, half);
+        let tris: Vec<_> = el.triangles.par_iter().map(|t| grown(t)).collect();
+        let edges: Vec<_> = el.edges.par_iter().map(|e| grown(e)).collect();
+        let verts: Vec<_> = (el.vertices.iter()).map(|&v| grown(&[v])).collect();
         // Cells about as large as a triangle's box, for all three kinds.
         let cell = Grid::mean_extent(tris.iter().map(|b| b.0));
         (self.triangles.boxes, self.edges.boxes) = (tris, edges);
