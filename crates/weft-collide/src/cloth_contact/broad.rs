@@ -139,7 +139,7 @@ impl<K: Fn(Pair) -> f64> Search<'_, K> {
     #[inline]
     fn vertex_face(&self, v: u32, rv: f64, f: u32, rf: f64) -> Option<Listed> {
         let t = self.el.triangles[f as usize];
-        if t.contains(&v) {
+        if self.el.adjacent(&[v], &t) {
             return None;
         }
         let at = |i: u32| self.anchors[i as usize];
@@ -151,7 +151,7 @@ impl<K: Fn(Pair) -> f64> Search<'_, K> {
     #[inline]
     fn edge_edge(&self, e: u32, g: u32, r: f64) -> Option<Listed> {
         let ([a0, a1], [b0, b1]) = (self.el.edges[e as usize], self.el.edges[g as usize]);
-        if a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1 {
+        if self.el.adjacent(&[a0, a1], &[b0, b1]) {
             return None;
         }
         let at = |i: u32| self.anchors[i as usize];
@@ -534,6 +534,7 @@ mod tests {
             edges,
             cloth: vec![0; n * n],
             rest: x.clone(),
+            sewn: (0..(n * n) as u32).collect(),
         };
         (el, prev, x)
     }
@@ -574,7 +575,7 @@ mod tests {
             for (f, t) in (0u32..).zip(&el.triangles) {
                 let d = point_triangle_distance(q(v), [q(t[0]), q(t[1]), q(t[2])]);
                 let bound = (rule.keep)(Pair::VertexFace(v, f)) + rmax(&[v]) + rmax(t);
-                if !t.contains(&v) && near(unite(&[v]), unite(t)) {
+                if !el.adjacent(&[v], t) && near(unite(&[v]), unite(t)) {
                     vf.push(((v, f), d <= bound * (1.0 - 1e-9), d <= bound * (1.0 + 1e-9)));
                 }
             }
@@ -582,7 +583,7 @@ mod tests {
         let mut ee = Vec::new();
         for (e, &[a0, a1]) in (0u32..).zip(&el.edges) {
             for (g, &[b0, b1]) in (0u32..).zip(&el.edges).skip(e as usize + 1) {
-                let shared = a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1;
+                let shared = el.adjacent(&[a0, a1], &[b0, b1]);
                 let d = segment_distance(q(a0), q(a1), q(b0), q(b1));
                 let bound = (rule.keep)(Pair::EdgeEdge(e, g)) + rmax(&[a0, a1]) + rmax(&[b0, b1]);
                 if !shared && near(unite(&[a0, a1]), unite(&[b0, b1])) {
@@ -676,5 +677,28 @@ mod tests {
             assert_eq!(list.builds, 2, "seed {seed}");
             compare(&el, &list, &rule, &format!("seed {seed}, rebuilt"));
         }
+    }
+
+    #[test]
+    fn elements_joined_by_a_seam_are_adjacent_and_never_listed() {
+        // Vertex 57 sewn onto vertex 12: on it, path and all, as a closed seam holds them.
+        let (mut el, mut prev, mut x) = crumpled(10, 3);
+        (prev[57], x[57]) = (prev[12], x[12]);
+        let seam_pairs = |list: &Candidates, el: &Elements| {
+            let vf = (list.vf.iter())
+                .filter(|l| el.adjacent(&[l.a], &el.triangles[l.b as usize]))
+                .count();
+            let ee = (list.ee.iter())
+                .filter(|l| el.adjacent(&el.edges[l.a as usize], &el.edges[l.b as usize]))
+                .count();
+            vf + ee
+        };
+        let open = build_and_compare(&el, &prev, &x, "open");
+        el.sewn = super::super::topology::sewn(100, &[[57, 12]]);
+        assert_eq!(el.sewn[57], 12);
+        // Unsewn, the two sides' elements touch and are listed.
+        assert!(seam_pairs(&open, &el) > 5);
+        let sewn = build_and_compare(&el, &prev, &x, "sewn");
+        assert_eq!(seam_pairs(&sewn, &el), 0);
     }
 }

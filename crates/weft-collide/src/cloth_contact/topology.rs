@@ -20,6 +20,36 @@ pub(crate) struct Elements {
     pub cloth: Vec<u32>,
     /// Positions when contact was turned on (the rest state).
     pub rest: Vec<DVec3>,
+    /// Per particle, the vertex it is once sewn: the smallest particle its seams join it to
+    /// (itself without seams). Elements that share a vertex so are adjacent, as in one panel.
+    pub sewn: Vec<u32>,
+}
+
+impl Elements {
+    /// Whether the elements with corners `a` and `b` share a vertex, seams joined.
+    #[inline]
+    pub(crate) fn adjacent(&self, a: &[u32], b: &[u32]) -> bool {
+        let s = |i: &u32| self.sewn[*i as usize];
+        a.iter().any(|i| b.iter().any(|j| s(i) == s(j)))
+    }
+}
+
+/// Per particle of `n`, the smallest particle the `seams` join it to.
+pub(crate) fn sewn(n: usize, seams: &[[u32; 2]]) -> Vec<u32> {
+    let mut rep: Vec<u32> = (0..n as u32).collect();
+    fn find(rep: &mut [u32], mut v: u32) -> u32 {
+        while rep[v as usize] != v {
+            rep[v as usize] = rep[rep[v as usize] as usize];
+            v = rep[v as usize];
+        }
+        v
+    }
+    for &[a, b] in seams {
+        let (ra, rb) = (find(&mut rep, a), find(&mut rep, b));
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        rep[hi as usize] = lo;
+    }
+    (0..n as u32).map(|v| find(&mut rep, v)).collect()
 }
 
 impl Elements {
@@ -53,6 +83,7 @@ impl Elements {
             edges,
             cloth,
             rest: solver.particles().positions.clone(),
+            sewn: sewn(n, solver.seam_pairs()),
         })
     }
 }

@@ -188,6 +188,12 @@ impl Solver {
         &self.cloths
     }
 
+    /// The particle pairs each seam joins (global indices): once sewn, the two sides of a
+    /// seam are one vertex of the cloth.
+    pub fn seam_pairs(&self) -> &[[u32; 2]] {
+        &self.constraints.seams.particles
+    }
+
     /// The index of the cloth called `name`.
     pub fn cloth_index(&self, name: &str) -> Option<usize> {
         self.cloths.iter().position(|c| c.name == name)
