@@ -158,6 +158,38 @@ impl<K: Fn(Pair) -> f64> Search<'_, K> {
         let apart = segment_distance(at(a0), at(a1), at(b0), at(b1));
         self.listed(Pair::EdgeEdge(e, g), (e, g), apart, r)
     }
+
+    /// The listed pairs of member vertex `k` (`el.vertices[k]`, box and radius
+    /// `verts.boxes[k]`) with the triangles of `tris` its box overlaps.
+    fn faces_near(&self, verts: &Binned, tris: &Binned, k: u32) -> Vec<Listed> {
+        let v = self.el.vertices[k as usize];
+        let (vbox, rv) = verts.boxes[k as usize];
+        let mut found = Vec::new();
+        tris.query(&vbox, 0, |f| {
+            found.extend(self.vertex_face(v, rv, f, tris.boxes[f as usize].1));
+        });
+        found
+    }
+
+    /// The listed pairs of edge `e` with the edges of `edges` from `from` on that its box
+    /// overlaps and `take` accepts (each pair lower edge first).
+    fn edges_near(
+        &self,
+        edges: &Binned,
+        e: u32,
+        from: u32,
+        take: impl Fn(u32) -> bool,
+    ) -> Vec<Listed> {
+        let (ebox, re) = edges.boxes[e as usize];
+        let mut found = Vec::new();
+        edges.query(&ebox, from, |g| {
+            if take(g) {
+                let r = re + edges.boxes[g as usize].1;
+                found.extend(self.edge_edge(e.min(g), e.max(g), r));
+            }
+        });
+        found
+    }
 }
 
 impl Candidates {
@@ -318,29 +350,14 @@ impl Candidates {
             anchors: &self.anchors,
             rule,
         };
-        let (tris, edges) = (&self.triangles, &self.edges);
+        let (tris, edges, verts) = (&self.triangles, &self.edges, &self.vertices);
         self.vf = (0..el.vertices.len() as u32)
             .into_par_iter()
-            .flat_map_iter(|k| {
-                let v = el.vertices[k as usize];
-                let (vbox, rv) = self.vertices.boxes[k as usize];
-                let mut found = Vec::new();
-                tris.query(&vbox, 0, |f| {
-                    found.extend(search.vertex_face(v, rv, f, tris.boxes[f as usize].1));
-                });
-                found
-            })
+            .flat_map_iter(|k| search.faces_near(verts, tris, k))
             .collect();
         self.ee = (0..el.edges.len() as u32)
             .into_par_iter()
-            .flat_map_iter(|e| {
-                let (ebox, re) = edges.boxes[e as usize];
-                let mut found = Vec::new();
-                edges.query(&ebox, e + 1, |g| {
-                    found.extend(search.edge_edge(e, g, re + edges.boxes[g as usize].1));
-                });
-                found
-            })
+            .flat_map_iter(|e| search.edges_near(edges, e, e + 1, |_| true))
             .collect();
         self.built = true;
     }
@@ -404,15 +421,8 @@ impl Candidates {
         // Each moved vertex against every triangle, then each moved triangle against the
         // vertices that did not move; each moved edge against every edge that did not move and
         // the later moved ones.
-        let mut found: Vec<Listed> = (slots.par_iter().zip(escaped))
-            .flat_map_iter(|(&k, &v)| {
-                let (vbox, rv) = verts.boxes[k as usize];
-                let mut found = Vec::new();
-                tris.query(&vbox, 0, |f| {
-                    found.extend(search.vertex_face(v, rv, f, tris.boxes[f as usize].1));
-                });
-                found
-            })
+        let mut found: Vec<Listed> = (slots.par_iter())
+            .flat_map_iter(|&k| search.faces_near(verts, tris, k))
             .collect();
         found.par_extend(dirty_t.par_iter().flat_map_iter(|&f| {
             let (fbox, rf) = tris.boxes[f as usize];
@@ -428,15 +438,9 @@ impl Candidates {
         merge(&mut self.vf, found);
         let found: Vec<Listed> = (dirty_e.par_iter())
             .flat_map_iter(|&e| {
-                let (ebox, re) = edges.boxes[e as usize];
-                let mut found = Vec::new();
-                edges.query(&ebox, 0, |g| {
-                    if g != e && (!edge_dirty[g as usize] || e < g) {
-                        let (a, b) = (e.min(g), e.max(g));
-                        found.extend(search.edge_edge(a, b, re + edges.boxes[g as usize].1));
-                    }
-                });
-                found
+                search.edges_near(edges, e, 0, |g| {
+                    g != e && (!edge_dirty[g as usize] || e < g)
+                })
             })
             .collect();
         merge(&mut self.ee, found);
@@ -446,8 +450,8 @@ impl Candidates {
 
 /// Merges the pairs `found` into `list` (ordered by first element, as a build lists them) so
 /// that it stays so ordered: the sweeps read the list in order, and pairs of one element
-/// together touch the same particles (measured: appended, the resting layers' frame was a
-/// quarter slower).
+/// together touch the same particles (measured while every kind was binned at each refresh:
+/// appended, the resting layers' frame was 20 ms against 17.6 ms merged).
 fn merge(list: &mut Vec<Listed>, mut found: Vec<Listed>) {
     found.sort_unstable_by_key(|l| (l.a, l.b));
     let old = std::mem::take(list);
