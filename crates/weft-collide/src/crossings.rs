@@ -183,7 +183,8 @@ impl Bins {
             return;
         };
         for_cells(a, b, |c| {
-            let (k, i) = (key(c), bucket(key(c), self.bits));
+            let k = key(c);
+            let i = bucket(k, self.bits);
             let bucket = &self.entries[self.starts[i] as usize..self.starts[i + 1] as usize];
             for &(e, t) in bucket {
                 if e == k && a.max(self.low[t as usize]) == c {
