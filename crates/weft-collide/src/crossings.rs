@@ -26,10 +26,35 @@ pub struct Crossings {
 /// Counts the crossings of `triangles` (indices into `positions`) and the closest approach
 /// below `reach` (at most the longest edge) between elements that share no vertex.
 pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Crossings {
+    let own: Vec<u32> = (0..positions.len() as u32).collect();
+    measure_joined(positions, triangles, &own, reach)
+}
+
+/// [`measure`] where particles are joined into vertices (`vertex[i]`, e.g. the two sides of
+/// a closed seam): elements are adjacent when they share a vertex so joined, while every
+/// particle keeps its own position. Edges and triangles a join collapses are left out.
+/// Measured at the particles' own positions, a seam that opens a little neither makes nor
+/// hides a crossing, as moving the joined particles onto one would.
+pub fn measure_joined(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    vertex: &[u32],
+    reach: f64,
+) -> Crossings {
+    let j = |i: u32| vertex[i as usize];
+    let kept: Vec<[u32; 3]> = (triangles.iter().copied())
+        .filter(|t| j(t[0]) != j(t[1]) && j(t[1]) != j(t[2]) && j(t[2]) != j(t[0]))
+        .collect();
+    let triangles = &kept[..];
     let edges = unique_edges(triangles);
     if edges.is_empty() {
         return Crossings::default();
     }
+    let mesh = Joined {
+        x: positions,
+        triangles,
+        vertex,
+    };
     let longest = edges
         .iter()
         .map(|&[a, b]| positions[a as usize].distance(positions[b as usize]))
@@ -44,9 +69,7 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
     let bins = Bins::new(positions, triangles, longest.max(reach).max(1e-9));
     let crossings = edges
         .par_iter()
-        .map_init(Vec::new, |found, &e| {
-            bins.crossings_of(positions, triangles, e, found)
-        })
+        .map_init(Vec::new, |found, &e| bins.crossings_of(&mesh, e, found))
         .sum();
     let closest = if reach > 0.0 {
         // Each task searches only as far as the closest pair it has found so far (`Near`):
@@ -56,7 +79,7 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
             .map_init(
                 || Near::new(reach),
                 |near, v| {
-                    let d = bins.vertex_closest(positions, triangles, v, near);
+                    let d = bins.vertex_closest(&mesh, v, near);
                     near.keep(d)
                 },
             )
@@ -67,7 +90,7 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
             .map_init(
                 || Near::new(vertex_face.min(reach)),
                 |near, &e| {
-                    let d = bins.edge_closest(positions, triangles, e, near);
+                    let d = bins.edge_closest(&mesh, e, near);
                     near.keep(d)
                 },
             )
@@ -78,6 +101,28 @@ pub fn measure(positions: &[DVec3], triangles: &[[u32; 3]], reach: f64) -> Cross
         None
     };
     Crossings { crossings, closest }
+}
+
+/// The measured mesh: positions per particle, triangles, and each particle's vertex.
+struct Joined<'a> {
+    x: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+    vertex: &'a [u32],
+}
+
+impl Joined<'_> {
+    /// Whether triangle `t` holds a vertex of particle `a`.
+    #[inline]
+    fn holds(&self, t: &[u32; 3], a: u32) -> bool {
+        let v = self.vertex[a as usize];
+        t.iter().any(|&i| self.vertex[i as usize] == v)
+    }
+
+    /// Whether particles `a` and `b` are one vertex.
+    #[inline]
+    fn same(&self, a: u32, b: u32) -> bool {
+        self.vertex[a as usize] == self.vertex[b as usize]
+    }
 }
 
 /// One task's search for the closest approach: its candidate buffer and the distance it
@@ -197,32 +242,28 @@ impl Bins {
         });
     }
 
-    fn crossings_of(
-        &self,
-        x: &[DVec3],
-        triangles: &[[u32; 3]],
-        [a, b]: [u32; 2],
-        found: &mut Vec<u32>,
-    ) -> usize {
+    fn crossings_of(&self, m: &Joined, [a, b]: [u32; 2], found: &mut Vec<u32>) -> usize {
+        let x = m.x;
         let (p, q) = (x[a as usize], x[b as usize]);
         self.near(p.min(q), p.max(q), found);
         found
             .iter()
-            .map(|&t| triangles[t as usize])
-            .filter(|tri| !tri.contains(&a) && !tri.contains(&b))
+            .map(|&t| m.triangles[t as usize])
+            .filter(|tri| !m.holds(tri, a) && !m.holds(tri, b))
             .filter(|tri| segment_crosses(p, q, tri.map(|i| x[i as usize])))
             .count()
     }
 
     /// The closest triangle to vertex `v` that does not hold it, if closer than
     /// `near.within` (else at least that, or infinity).
-    fn vertex_closest(&self, x: &[DVec3], triangles: &[[u32; 3]], v: u32, near: &mut Near) -> f64 {
+    fn vertex_closest(&self, m: &Joined, v: u32, near: &mut Near) -> f64 {
+        let x = m.x;
         let (p, r) = (x[v as usize], near.within);
         self.near(p - r, p + r, &mut near.found);
         let mut best = f64::INFINITY;
         for &t in &near.found {
-            let tri = triangles[t as usize];
-            if tri.contains(&v) {
+            let tri = m.triangles[t as usize];
+            if m.holds(&tri, v) {
                 continue;
             }
             let (lo, hi) = self.boxes[t as usize];
@@ -235,22 +276,17 @@ impl Bins {
 
     /// The closest edge to edge `a b` that shares no vertex with it, if closer than
     /// `near.within` (else at least that, or infinity).
-    fn edge_closest(
-        &self,
-        x: &[DVec3],
-        triangles: &[[u32; 3]],
-        [a, b]: [u32; 2],
-        near: &mut Near,
-    ) -> f64 {
+    fn edge_closest(&self, m: &Joined, [a, b]: [u32; 2], near: &mut Near) -> f64 {
+        let x = m.x;
         let (p, q, r) = (x[a as usize], x[b as usize], near.within);
         let (lo, hi) = (p.min(q), p.max(q));
         self.near(lo - r, hi + r, &mut near.found);
         let mut best = f64::INFINITY;
         for &t in &near.found {
-            let tri = triangles[t as usize];
+            let tri = m.triangles[t as usize];
             for k in 0..3 {
                 let (c, d) = (tri[k], tri[(k + 1) % 3]);
-                if c == a || c == b || d == a || d == b {
+                if m.same(c, a) || m.same(c, b) || m.same(d, a) || m.same(d, b) {
                     continue;
                 }
                 let (pc, pd) = (x[c as usize], x[d as usize]);

@@ -4,13 +4,14 @@
 //!
 //! Cloths of one solver share its particle store and meet only each other, so each solver's
 //! cloths are measured together (crossings between them count) and the solvers' counts are
-//! summed. A garment's seams join vertices that are distinct particles: once the seams have
-//! closed, each seam's particles are measured as one vertex (the sewn mesh), so the two sides of
-//! a seam are neither "crossings" nor a "closest approach" of zero.
+//! summed. A garment's seams join vertices that are distinct particles: from the start, each
+//! seam's particles are one vertex for adjacency (the sewn mesh), each measured where it is, so
+//! the two sides of a seam, which pass each other's neighbours as the seam closes, are neither
+//! "crossings" nor a "closest approach" of zero.
 
 use std::fmt;
 
-use weft_collide::crossings::measure;
+use weft_collide::crossings::{measure, measure_joined};
 use weft_scene::{Scene, SolverGroup};
 use weft_solver::glam::DVec3;
 
@@ -31,63 +32,41 @@ pub struct CrossingStats {
     pub reach: f64,
 }
 
-/// One solver's mesh as it is measured: triangles over a compact vertex list, before and after
-/// its garments' seams have closed.
+/// One solver's mesh as it is measured: its triangles, each seam's particles one vertex.
 #[derive(Clone, Debug)]
 pub(crate) struct SolverMesh {
-    open: Compact,
-    /// The sewn mesh and the solver time from which it is measured (its latest seam's closing
-    /// time); `None` without seams.
-    sewn: Option<(Compact, f64)>,
+    mesh: Measured,
 }
 
-/// Triangles over the particles listed in `gather` (compact index → particle index; `None`
-/// when every particle is listed in order).
+/// Triangles over the solver's particles, with each particle's vertex where seams join
+/// particles (`None`: every particle its own vertex).
 #[derive(Clone, Debug)]
-struct Compact {
-    gather: Option<Vec<u32>>,
+struct Measured {
+    vertex: Option<Vec<u32>>,
     triangles: Vec<[u32; 3]>,
 }
 
-impl Compact {
+impl Measured {
     fn measure(&self, x: &[DVec3], reach: f64) -> weft_collide::crossings::Crossings {
-        match &self.gather {
+        match &self.vertex {
             None => measure(x, &self.triangles, reach),
-            Some(g) => {
-                let positions: Vec<DVec3> = g.iter().map(|&i| x[i as usize]).collect();
-                measure(&positions, &self.triangles, reach)
-            }
+            Some(v) => measure_joined(x, &self.triangles, v, reach),
         }
     }
 }
 
-impl Compact {
+impl Measured {
     /// The mesh of `triangles` over `n` particles with each seam's particles as one vertex
-    /// (each class of joined particles becomes its smallest particle; the others leave the
-    /// vertex list, where they would sit on their class's triangles); triangles a seam
-    /// collapses are dropped.
+    /// (each class of joined particles named by its smallest particle), each particle measured
+    /// where it is: a seam that has opened a little neither makes nor hides a crossing.
     fn sewn(n: usize, triangles: &[[u32; 3]], seams: &[[u32; 2]]) -> Self {
         let mut rep: Vec<u32> = (0..n as u32).collect();
         for &[a, b] in seams {
             union(&mut rep, a, b);
         }
-        let root: Vec<u32> = (0..n as u32).map(|v| find(&rep, v)).collect();
-        let mut compact = vec![u32::MAX; n];
-        let mut gather = Vec::new();
-        for v in 0..n {
-            if root[v] == v as u32 {
-                compact[v] = gather.len() as u32;
-                gather.push(v as u32);
-            }
-        }
-        let triangles = triangles
-            .iter()
-            .map(|t| t.map(|v| compact[root[v as usize] as usize]))
-            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
-            .collect();
         Self {
-            gather: Some(gather),
-            triangles,
+            vertex: Some((0..n as u32).map(|v| find(&rep, v)).collect()),
+            triangles: triangles.to_vec(),
         }
     }
 }
@@ -102,28 +81,20 @@ impl SolverMesh {
             .collect();
         let n = group.solver.particles().len();
         let mut seams = Vec::new();
-        let mut sewn_at: Option<f64> = None;
         for (j, &i) in group.cloths.iter().enumerate() {
-            let spec = &scene.cloths[i];
             let start = cloths[j].particles.start as u32;
+            let spec = &scene.cloths[i];
             seams.extend(spec.seams.iter().map(|&[a, b]| [start + a, start + b]));
-            if !spec.seams.is_empty() {
-                sewn_at = Some(sewn_at.unwrap_or(0.0).max(spec.seam_time));
-            }
         }
-        let sewn = sewn_at.map(|at| (Compact::sewn(n, &triangles, &seams), at));
-        let open = Compact {
-            gather: None,
-            triangles,
+        let mesh = if seams.is_empty() {
+            Measured {
+                vertex: None,
+                triangles,
+            }
+        } else {
+            Measured::sewn(n, &triangles, &seams)
         };
-        Self { open, sewn }
-    }
-
-    /// Whether the mesh measured at the solver's present time is the sewn one.
-    pub(crate) fn sewn(&self, group: &SolverGroup) -> bool {
-        self.sewn
-            .as_ref()
-            .is_some_and(|(_, at)| group.solver.time() >= at - 1e-9)
+        Self { mesh }
     }
 
     /// Measures `group`'s cloths at their present positions.
@@ -135,11 +106,9 @@ impl SolverMesh {
             .map(|c| c.thickness)
             .fold(0.0, f64::max);
         let reach = REACH_THICKNESSES * thickest;
-        let mesh = match &self.sewn {
-            Some((m, _)) if self.sewn(group) => m,
-            _ => &self.open,
-        };
-        let m = mesh.measure(&group.solver.particles().positions, reach);
+        let m = self
+            .mesh
+            .measure(&group.solver.particles().positions, reach);
         CrossingStats {
             crossings: m.crossings,
             closest: m.closest,
@@ -349,6 +318,31 @@ mod tests {
     }
 
     #[test]
+    fn each_particle_is_measured_where_it_is() {
+        // A flat triangle, a far triangle, and a small one whose corner 6 lies under the
+        // first and is sewn to the far corner 3 (the seam still open): the small triangle's
+        // two edges from 6 cross the first. Moving 6 onto its seam partner, as measuring the
+        // joined vertex at one place would, hides both.
+        let x = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(3.0, 0.0, 0.0),
+            DVec3::new(4.0, 0.0, 0.0),
+            DVec3::new(3.0, 1.0, 0.0),
+            DVec3::new(0.2, 0.2, -0.02),
+            DVec3::new(0.25, 0.2, 0.02),
+            DVec3::new(0.3, 0.25, 0.02),
+        ];
+        let triangles = vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]];
+        let sewn = Measured::sewn(9, &triangles, &[[3, 6]]);
+        assert_eq!(sewn.measure(&x, 0.0).crossings, 2);
+        let mut moved = x.clone();
+        moved[6] = moved[3];
+        assert_eq!(sewn.measure(&moved, 0.0).crossings, 0);
+    }
+
+    #[test]
     fn the_two_sides_of_a_closed_seam_are_one_vertex() {
         // Two triangles sharing no particle, glued along an edge by a seam of two pairs, and
         // a stray particle 7 on nothing: open, the seam's sides coincide (closest approach 0);
@@ -365,18 +359,35 @@ mod tests {
         let triangles = vec![[0, 1, 2], [3, 5, 4]];
         let open = measure(&x, &triangles, 0.5);
         assert_eq!(open.closest, Some(0.0), "the seam's sides coincide");
-        let sewn = Compact::sewn(6, &triangles, &[[3, 1], [2, 4]]);
-        assert_eq!(sewn.gather.as_deref(), Some(&[0, 1, 2, 5][..]));
-        assert_eq!(sewn.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+        let sewn = Measured::sewn(6, &triangles, &[[3, 1], [2, 4]]);
+        assert_eq!(sewn.vertex.as_deref(), Some(&[0, 1, 2, 1, 2, 5][..]));
         assert_eq!(sewn.measure(&x, 0.5).closest, None);
+        assert_eq!(
+            Measured::sewn(6, &triangles, &[[0, 5]])
+                .measure(&x, 0.5)
+                .closest,
+            Some(0.0)
+        );
+        // A seam that collapses a triangle drops it: an upright triangle whose edge 3–4
+        // pierces a small flat one, and which the flat one's edge 1–2 pierces, crosses it
+        // twice until 3 and 4 are sewn.
+        let pierce = [
+            DVec3::new(0.45, 0.45, 0.0),
+            DVec3::new(0.56, 0.45, 0.0),
+            DVec3::new(0.45, 0.56, 0.0),
+            DVec3::new(0.5, 0.5, -0.1),
+            DVec3::new(0.5, 0.5, 0.1),
+            DVec3::new(5.0, 5.0, 5.0),
+        ];
+        let both = [[0, 1, 2], [3, 4, 5]];
+        assert_eq!(measure(&pierce, &both, 0.0).crossings, 2);
+        let collapsed = Measured::sewn(6, &both, &[[3, 4]]);
+        assert_eq!(collapsed.measure(&pierce, 0.0).crossings, 0);
         // Folded shut along the seam's diagonal, the sewn quad's far corner comes back 1 cm
         // over the first triangle's corner: within reach again (a hair under 1 cm, to the
         // slanted second triangle).
         x[5] = DVec3::new(0.0, 0.0, 0.01);
         let d = sewn.measure(&x, 0.5).closest.expect("folded");
         assert!(d > 0.0099 && d <= 0.01, "{d}");
-        // A seam that collapses a triangle drops it.
-        let collapsed = Compact::sewn(6, &triangles, &[[0, 1]]);
-        assert_eq!(collapsed.triangles.len(), 1);
     }
 }
