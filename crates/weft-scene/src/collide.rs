@@ -75,9 +75,13 @@ impl Scene {
     /// among these cloths.
     ///
     /// When one of the self-colliding cloths is a garment whose seams are still closing,
-    /// self-collision is not turned on here: it is returned, to be turned on once the seams
-    /// have closed (see [`crate::SolverGroup::step`]), with the sewn garment as its rest state,
-    /// so that the two sides of a seam are not held a thickness apart.
+    /// particle self-collision is not turned on here: it is returned, to be turned on once the
+    /// seams have closed (see [`crate::SolverGroup::step`]), with the sewn garment as its rest
+    /// state, so that the two sides of a seam are not held a thickness apart. Mesh contact is
+    /// turned on at once: elements that share a seam's vertex are adjacent to it, so the seams
+    /// close freely while the rest of the cloth is kept apart from the first substep (turned
+    /// on after the sewing, it would find the crossings the sewing made and could not undo
+    /// them).
     pub fn collision_world(
         &self,
         solver: &Solver,
@@ -131,7 +135,8 @@ impl Scene {
                 .map(|c| c.seam_time)
                 .fold(None, |a: Option<f64>, t| Some(a.map_or(t, |a| a.max(t))));
             match sewn_at {
-                Some(at) if at > 0.0 => {
+                // Mesh contact holds the seams' two sides as one vertex from the start.
+                Some(at) if at > 0.0 && matches!(contact, SelfContact::Particles(_)) => {
                     delayed = Some(DelayedSelfCollision {
                         at,
                         cloths: self_cloths,
