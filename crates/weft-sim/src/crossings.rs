@@ -38,21 +38,12 @@ pub(crate) struct SolverMesh {
     mesh: Measured,
 }
 
-/// Triangles over the solver's particles, with each particle's vertex where seams join
-/// particles (`None`: every particle its own vertex).
+/// Triangles over the solver's particles, with each particle's vertex (the smallest particle
+/// its seams join it to; itself without seams).
 #[derive(Clone, Debug)]
 struct Measured {
-    vertex: Option<Vec<u32>>,
+    vertex: Vec<u32>,
     triangles: Vec<[u32; 3]>,
-}
-
-impl Measured {
-    fn measure(&self, x: &[DVec3], reach: f64) -> weft_collide::crossings::Crossings {
-        match &self.vertex {
-            None => measure(x, &self.triangles, reach),
-            Some(v) => measure_joined(x, &self.triangles, v, reach),
-        }
-    }
 }
 
 impl Measured {
@@ -65,9 +56,13 @@ impl Measured {
             union(&mut rep, a, b);
         }
         Self {
-            vertex: Some((0..n as u32).map(|v| find(&rep, v)).collect()),
+            vertex: (0..n as u32).map(|v| find(&rep, v)).collect(),
             triangles: triangles.to_vec(),
         }
+    }
+
+    fn measure(&self, x: &[DVec3], reach: f64) -> weft_collide::crossings::Crossings {
+        measure_joined(x, &self.triangles, &self.vertex, reach)
     }
 }
 
@@ -82,18 +77,11 @@ impl SolverMesh {
         let n = group.solver.particles().len();
         let mut seams = Vec::new();
         for (j, &i) in group.cloths.iter().enumerate() {
-            let start = cloths[j].particles.start as u32;
             let spec = &scene.cloths[i];
+            let start = cloths[j].particles.start as u32;
             seams.extend(spec.seams.iter().map(|&[a, b]| [start + a, start + b]));
         }
-        let mesh = if seams.is_empty() {
-            Measured {
-                vertex: None,
-                triangles,
-            }
-        } else {
-            Measured::sewn(n, &triangles, &seams)
-        };
+        let mesh = Measured::sewn(n, &triangles, &seams);
         Self { mesh }
     }
 
@@ -360,7 +348,7 @@ mod tests {
         let open = measure(&x, &triangles, 0.5);
         assert_eq!(open.closest, Some(0.0), "the seam's sides coincide");
         let sewn = Measured::sewn(6, &triangles, &[[3, 1], [2, 4]]);
-        assert_eq!(sewn.vertex.as_deref(), Some(&[0, 1, 2, 1, 2, 5][..]));
+        assert_eq!(sewn.vertex, [0, 1, 2, 1, 2, 5]);
         assert_eq!(sewn.measure(&x, 0.5).closest, None);
         assert_eq!(
             Measured::sewn(6, &triangles, &[[0, 5]])
