@@ -11,13 +11,14 @@
 //!
 //! The old positional form `-- N FRAMES` still works. `--threads 0` uses rayon's default pool.
 //! `--simd avx512|avx2|neon|scalar` (or `WEFT_SIMD=…`) forces the kernel path; the output names
-//! the path that ran.
+//! the path that ran. `--method` picks the method (default xpbd); springs get k = m / (16 h²)
+//! for a particle's mass m, as in the method benches.
 
 use std::process::ExitCode;
 use std::time::Instant;
 
 use weft_solver::{
-    ClothParams, Edge, Family, Forces, GridDesc, Pin, Settings, SimdPath, SolverBuilder,
+    ClothParams, Edge, Family, Forces, GridDesc, Method, Pin, Settings, SimdPath, SolverBuilder,
 };
 
 /// Command-line options.
@@ -28,9 +29,10 @@ struct Options {
     threads: usize,
     domain_size: usize,
     simd: Option<SimdPath>,
+    method: Method,
 }
 
-const USAGE: &str = "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] [--domain-size D] [--simd avx512|avx2|neon|scalar] | [N [FRAMES]]";
+const USAGE: &str = "usage: reference_workload [--n N] [--frames F] [--warmup W] [--threads T] [--domain-size D] [--simd avx512|avx2|neon|scalar] [--method NAME] | [N [FRAMES]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut o = Options {
@@ -40,6 +42,7 @@ fn parse_args() -> Result<Options, String> {
         threads: 1,
         domain_size: Settings::default().domain_size,
         simd: SimdPath::from_env().map_err(|e| format!("WEFT_SIMD: {e}"))?,
+        method: Method::Xpbd,
     };
     let mut positional = 0;
     let mut args = std::env::args().skip(1);
@@ -62,6 +65,12 @@ fn parse_args() -> Result<Options, String> {
                     .next()
                     .ok_or(format!("--simd needs a value\n{USAGE}"))?;
                 o.simd = Some(v.parse().map_err(|e| format!("--simd: {e}\n{USAGE}"))?);
+            }
+            "--method" => {
+                let v = args
+                    .next()
+                    .ok_or(format!("--method needs a value\n{USAGE}"))?;
+                o.method = v.parse().map_err(|e| format!("--method: {e}\n{USAGE}"))?;
             }
             "-h" | "--help" => return Err(USAGE.to_owned()),
             _ if !a.starts_with('-') && positional < 2 => {
@@ -107,10 +116,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     for f in Family::ALL {
         params.get_mut(f).enabled = matches!(f, Family::Stretch | Family::Shear);
         params.get_mut(f).compliance = 0.0;
+        // As the method benches: k = m / (16 h²) for the lightest particle, so ω h ≤ 1.
+        let h = Settings::default().h();
+        params.get_mut(f).spring_stiffness = 1.0 / (n * n) as f64 / (16.0 * h * h);
     }
     let settings = Settings {
         domain_size: o.domain_size,
         simd: o.simd,
+        method: o.method,
         ..Settings::default()
     };
     let mut b = SolverBuilder::new(settings, Forces::default())?;
@@ -141,13 +154,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .build()?;
     let threads = pool.current_num_threads();
     let mut times = Vec::with_capacity(o.frames);
+    let mut cg = 0u64;
     pool.install(|| -> Result<(), weft_solver::SolverError> {
         for _ in 0..o.warmup {
             s.step()?;
         }
         for _ in 0..o.frames {
             let t = Instant::now();
-            s.step()?;
+            cg += u64::from(s.step()?.cg_iterations);
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }
         Ok(())
@@ -162,7 +176,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let r = s.residual();
     println!(
         "{:<14} simd={:<6} threads={threads} N={n:<4} particles={:<6} constraints={constraints:<6} substeps={substeps:<3} iters={iterations} frames={} seconds={:.3} ms/frame={mean:.3} (median {median:.3}) ns/proj={:.2} proj/s={:.4e}",
-        "weft-xpbd",
+        format!("weft-{}", o.method.name()),
         s.simd_path().name(),
         s.particles().len(),
         o.frames,
@@ -170,6 +184,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         1e6 * median / projections,
         projections / median * 1e3,
     );
+    if cg > 0 {
+        println!("  {:.1} CG iterations a frame", cg as f64 / o.frames as f64);
+    }
     println!(
         "  min {:.3} ms/frame, max {:.3} ms/frame; residual after {} frames: max |C| {:.3e} m, RMS {:.3e} m",
         times[0],

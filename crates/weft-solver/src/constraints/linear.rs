@@ -23,20 +23,19 @@
 //!
 //! (σ n nᵀ + κ (I − n nᵀ) written as (σ − κ) n nᵀ + κ I, σ = h² k + h c; σ ≥ κ as the rest
 //! length is not negative), so a spring is one [`Ray`] of four numbers and its product one
-//! 3-vector, g (g·u) + κ u, that each of its particles reads with its weight aₖ. The dihedral
-//! keeps one [`Outer`] term per particle, gₖ = √σ ∇ₖC. Every pass runs in parallel over fixed
-//! chunks of springs, each writing its own terms, and each particle sums its terms in a fixed
-//! order ([`crate::sparse::Terms`]).
+//! 3-vector, g (g·u) + κ u, that each of its particles adds with its weight aₖ. The dihedral
+//! keeps one [`Outer`] term per particle, gₖ = √σ ∇ₖC. Each pass adds every spring's terms
+//! straight into its particles' rows: the springs of each particle range ([`PassOrder`]) in
+//! one task, the ranges in parallel, then the few springs that straddle ranges, so each
+//! particle sums its terms in a fixed order whatever the thread count. Nothing per spring is
+//! stored but the ray.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{Block, ConstraintSet, Distance, Isometric, Seam, Shape, Tether};
 use crate::params::FamilyParams;
-use crate::sparse::{Entry, Sym3, Terms};
-
-/// Springs per parallel task.
-const SPRINGS: usize = 512;
+use crate::sparse::Sym3;
 
 /// A shape whose gradient is one direction weighted per particle, ∇ₖC = aₖ n, and whose
 /// Hessian is ∂²C/∂pₖ∂pₘ = aₖ aₘ (I − n nᵀ)/ℓ, with u = Σ aₖ pₖ, ℓ = |u| and n = u/ℓ.
@@ -119,21 +118,30 @@ impl Ray {
 /// A spring without a Hessian: its share of A − M is g gᵀ, g = √σ ∇C, one term per particle.
 pub(crate) type Outer<const N: usize> = [DVec3; N];
 
-/// A term's share of the right-hand side, of A x₀ and of A's diagonal block, each read by a
-/// particle with its weight (the diagonal with the weight squared).
+/// A particle's row of A − M and of the right-hand side, summed over its springs: what the
+/// linearisation adds to each particle (the caller starts each row with M's share).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct TermRhs {
-    /// h f − h² K v.
+pub(crate) struct RowSums {
+    /// b = h f − h² K v (Baraff & Witkin eq. 6).
     pub b: DVec3,
-    /// (A − M) x₀ for the warm start x₀.
+    /// A x₀ for the warm start x₀.
     pub ax: DVec3,
-    /// The diagonal block of A − M.
+    /// A's diagonal block.
     pub d: Sym3,
 }
 
-/// Every spring of a constraint set, linearised at one state, aligned with the constraint
-/// blocks (a disabled or degenerate spring is all zeros); terms in block order: distance,
-/// dihedral, isometric, tethers, seams.
+impl RowSums {
+    /// Adds a term read with weight `a`: b and A x₀ scaled by a, the diagonal block by a².
+    #[inline(always)]
+    fn add(&mut self, a: f64, b: DVec3, ax: DVec3, d: Sym3) {
+        self.b += b * a;
+        self.ax += ax * a;
+        self.d = self.d.add(d.scale(a * a));
+    }
+}
+
+/// Every spring of a constraint set, linearised at one state, each block's in its
+/// [`PassOrder`] (a disabled or degenerate spring is all zeros), with those orders.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Springs {
     distance: Vec<Ray>,
@@ -141,6 +149,53 @@ pub(crate) struct Springs {
     isometric: Vec<Ray>,
     tethers: Vec<Ray>,
     seams: Vec<Ray>,
+    orders: Option<(usize, [PassOrder; 5])>,
+}
+
+/// Springs per particle part of the implicit passes, at least.
+const PER_PART: usize = 4096;
+
+/// Particle parts of the implicit passes at most: more leave more springs straddling parts,
+/// which run alone.
+const MAX_PARTS: usize = 8;
+
+/// The order in which the implicit passes visit a block's springs: the particles cut into
+/// ranges (their number a function of the spring count alone, never of the thread count), the
+/// springs of each range in insertion order, then those that straddle ranges.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PassOrder {
+    /// Particle range p is `bounds[p] .. bounds[p + 1]`.
+    bounds: Vec<usize>,
+    /// The springs in pass order.
+    springs: Vec<u32>,
+    /// Range p's springs are `springs[starts[p] .. starts[p + 1]]`; the straddlers, the last.
+    starts: Vec<usize>,
+}
+
+impl PassOrder {
+    /// The pass order of `block`'s springs over `n` particles.
+    fn new<const N: usize, S>(block: &Block<N, S>, n: usize) -> Self {
+        let len = block.particles.len();
+        let parts = (len / PER_PART).clamp(1, MAX_PARTS).min(n.max(1));
+        let bounds: Vec<usize> = (0..=parts).map(|p| n * p / parts).collect();
+        let mut by_insertion: Vec<u32> = (0..len as u32).collect();
+        if block.order.len() == len {
+            by_insertion.sort_by_key(|&s| block.order[s as usize]);
+        }
+        let mut buckets = vec![Vec::new(); parts + 1];
+        for s in by_insertion {
+            buckets[super::parts::part_of(&block.particles[s as usize], &bounds)].push(s);
+        }
+        let mut starts = vec![0];
+        for b in &buckets {
+            starts.push(starts.last().copied().unwrap_or(0) + b.len());
+        }
+        Self {
+            bounds,
+            springs: buckets.concat(),
+            starts,
+        }
+    }
 }
 
 /// What the linearisation needs besides the springs: the state, the substep and the warm start.
@@ -156,211 +211,207 @@ pub(crate) struct State<'a> {
     pub x0: Option<&'a [DVec3]>,
 }
 
-/// Linearises a rank-one block: one ray and one [`TermRhs`] per spring.
+/// Runs `f(start, springs, per, rows, base)` over `order`'s runs of springs (from position
+/// `start` of the pass order, `per` their slice of the per-spring data), where `rows` holds the particles from `base` on: each
+/// particle range's springs on that range's own rows, the ranges in parallel, then the
+/// springs that straddle ranges on all the rows. Each range's springs run in one task, so
+/// every particle receives its springs' shares in a fixed order whatever the thread count.
+fn by_parts<A, R, F>(order: &PassOrder, rows: &mut [A], per: &mut [R], f: F)
+where
+    A: Send,
+    R: Send,
+    F: Fn(usize, &[u32], &mut [R], &mut [A], usize) + Sync,
+{
+    let PassOrder {
+        bounds,
+        springs,
+        starts,
+    } = order;
+    let parts = bounds.len() - 1;
+    if parts < 2 {
+        f(0, springs, per, rows, 0);
+        return;
+    }
+    let (own, straddlers) = per.split_at_mut(starts[parts]);
+    let mut tasks = Vec::with_capacity(parts);
+    let (mut left, mut rest) = (&mut rows[..], own);
+    for p in 0..parts {
+        let (head, tail) = std::mem::take(&mut left).split_at_mut(bounds[p + 1] - bounds[p]);
+        let (mine, others) = std::mem::take(&mut rest).split_at_mut(starts[p + 1] - starts[p]);
+        tasks.push((
+            starts[p],
+            &springs[starts[p]..starts[p + 1]],
+            mine,
+            head,
+            bounds[p],
+        ));
+        (left, rest) = (tail, others);
+    }
+    tasks
+        .into_par_iter()
+        .for_each(|(start, springs, per, rows, base)| f(start, springs, per, rows, base));
+    f(
+        starts[parts],
+        &springs[starts[parts]..],
+        straddlers,
+        rows,
+        0,
+    );
+}
+
+/// Linearises a rank-one block: one ray per spring, its share added to its particles' rows.
 fn linearize_rays<const N: usize, S: RankOne<N>>(
-    block: &Block<N, S>,
+    (block, order): (&Block<N, S>, &PassOrder),
     params: &[FamilyParams],
     st: State<'_>,
     out: &mut Vec<Ray>,
-    rhs: &mut [TermRhs],
+    rows: &mut [RowSums],
 ) {
     let h = st.h;
     out.clear();
     out.resize(block.particles.len(), Ray::default());
-    out.par_chunks_mut(SPRINGS)
-        .zip(rhs.par_chunks_mut(SPRINGS))
-        .enumerate()
-        .for_each(|(c, (out, rhs))| {
-            let base = c * SPRINGS;
-            for (j, (ray, term)) in out.iter_mut().zip(rhs.iter_mut()).enumerate() {
-                let s = base + j;
-                let idx = block.particles[s];
-                let p = &params[block.group[s] as usize];
-                let shape = &block.shapes[s];
-                let a = shape.coefficients();
-                let u = weighted(&a, &idx, st.x);
+    by_parts(order, rows, out, |_, springs, run, rows, base| {
+        // u, ℓ and 1/ℓ first, in a loop of their own: there the square roots and divisions of
+        // many springs overlap, where in the loop below each waited for the last.
+        let geometry: Vec<(DVec3, f64, f64)> = (springs.iter())
+            .map(|&s| {
+                let s = s as usize;
+                let u = weighted(&block.shapes[s].coefficients(), &block.particles[s], st.x);
                 let len = u.length();
-                let (k, damping) = (p.spring_stiffness, p.spring_damping);
-                let hhk = h * h * k;
-                let (c, n, kappa) = match p.enabled.then(|| shape.value(len)).flatten() {
-                    Some(c) => {
-                        let kappa = if c > 0.0 && k > 0.0 {
-                            hhk * c / len
-                        } else {
-                            0.0
-                        };
-                        (c, u / len, kappa)
-                    }
-                    // ℓ = 0 where C = ℓ (a flat isometric hinge): no direction, so no force and
-                    // no damping, and κ = h² k, the limit of h² k C/ℓ.
-                    None if p.enabled && S::QUADRATIC => (0.0, DVec3::ZERO, hhk),
-                    None => {
-                        (*ray, *term) = (Ray::default(), TermRhs::default());
-                        continue;
-                    }
-                };
-                let sigma = hhk + h * damping;
-                *ray = Ray {
-                    g: n * (sigma - kappa).max(0.0).sqrt(),
-                    kappa,
-                };
-                // Ċ = Σ ∇ₖC·vₖ = n·Σ aₖ vₖ.
-                let uv = weighted(&a, &idx, st.v);
-                let force = -(k * c + damping * n.dot(uv));
-                // h² K v = a ⊗ ((h² k − κ) n n·u_v + κ u_v); b = h f − h² K v (Baraff &
-                // Witkin eq. 6, spring part).
-                let kv = n * ((hhk - kappa) * n.dot(uv)) + uv * kappa;
-                *term = TermRhs {
-                    b: n * (h * force) - kv,
-                    ax: st
-                        .x0
-                        .map_or(DVec3::ZERO, |x0| ray.apply(weighted(&a, &idx, x0))),
-                    d: Sym3::outer(ray.g, 1.0).add(Sym3::scaled_identity(kappa)),
-                };
+                (u, len, 1.0 / len)
+            })
+            .collect();
+        for ((ray, &(u, len, inv)), &s) in run.iter_mut().zip(&geometry).zip(springs) {
+            let s = s as usize;
+            let idx = block.particles[s];
+            let p = &params[block.group[s] as usize];
+            let shape = &block.shapes[s];
+            let a = shape.coefficients();
+            let (k, damping) = (p.spring_stiffness, p.spring_damping);
+            let hhk = h * h * k;
+            let (c, n, kappa) = match p.enabled.then(|| shape.value(len)).flatten() {
+                Some(c) => {
+                    let kappa = if c > 0.0 && k > 0.0 {
+                        hhk * c * inv
+                    } else {
+                        0.0
+                    };
+                    (c, u * inv, kappa)
+                }
+                // ℓ = 0 where C = ℓ (a flat isometric hinge): no direction, so no force and no
+                // damping, and κ = h² k, the limit of h² k C/ℓ.
+                None if p.enabled && S::QUADRATIC => (0.0, DVec3::ZERO, hhk),
+                None => continue,
+            };
+            let sigma = hhk + h * damping;
+            *ray = Ray {
+                g: n * (sigma - kappa).max(0.0).sqrt(),
+                kappa,
+            };
+            // Ċ = Σ ∇ₖC·vₖ = n·Σ aₖ vₖ.
+            let uv = weighted(&a, &idx, st.v);
+            let force = -(k * c + damping * n.dot(uv));
+            // h² K v = a ⊗ ((h² k − κ) n n·u_v + κ u_v); b = h f − h² K v (Baraff & Witkin eq. 6,
+            // spring part).
+            let kv = n * ((hhk - kappa) * n.dot(uv)) + uv * kappa;
+            let b = n * (h * force) - kv;
+            let ax = st
+                .x0
+                .map_or(DVec3::ZERO, |x0| ray.apply(weighted(&a, &idx, x0)));
+            let d = Sym3::outer(ray.g, 1.0).add(Sym3::scaled_identity(kappa));
+            for m in 0..N {
+                rows[idx[m] as usize - base].add(a[m], b, ax, d);
             }
-        });
+        }
+    });
 }
 
-/// Linearises a block with ∇C ∇Cᵀ alone: `N` terms and `N` [`TermRhs`] per spring.
+/// Linearises a block with ∇C ∇Cᵀ alone: `N` terms per spring, each added to its particle's
+/// row.
 fn linearize_outers<const N: usize, S: Shape<N>>(
-    block: &Block<N, S>,
+    (block, order): (&Block<N, S>, &PassOrder),
     params: &[FamilyParams],
     st: State<'_>,
     out: &mut Vec<Outer<N>>,
-    rhs: &mut [TermRhs],
+    rows: &mut [RowSums],
 ) {
     let h = st.h;
     out.clear();
     out.resize(block.particles.len(), [DVec3::ZERO; N]);
-    out.par_chunks_mut(SPRINGS)
-        .zip(rhs.par_chunks_mut(SPRINGS * N))
-        .enumerate()
-        .for_each(|(c, (out, rhs))| {
-            let base = c * SPRINGS;
-            for (j, (g, terms)) in out.iter_mut().zip(rhs.chunks_exact_mut(N)).enumerate() {
-                let s = base + j;
-                let idx = block.particles[s];
-                let p = &params[block.group[s] as usize];
-                let pos = idx.map(|i| st.x[i as usize]);
-                let evaluated = p.enabled.then(|| block.shapes[s].evaluate(&pos)).flatten();
-                let Some((c, grad)) = evaluated else {
-                    *g = [DVec3::ZERO; N];
-                    terms.fill(TermRhs::default());
-                    continue;
-                };
-                let (k, damping) = (p.spring_stiffness, p.spring_damping);
-                let root = (h * h * k + h * damping).sqrt();
-                *g = grad.map(|d| d * root);
-                let c_dot: f64 = (0..N).map(|m| grad[m].dot(st.v[idx[m] as usize])).sum();
-                let force = -(k * c + damping * c_dot);
-                let g_x0: f64 = st.x0.map_or(0.0, |x0| {
-                    (0..N).map(|m| g[m].dot(x0[idx[m] as usize])).sum()
-                });
-                for m in 0..N {
-                    terms[m] = TermRhs {
-                        b: grad[m] * (h * force - h * h * k * c_dot),
-                        ax: g[m] * g_x0,
-                        d: Sym3::outer(g[m], 1.0),
-                    };
-                }
+    by_parts(order, rows, out, |_, springs, run, rows, base| {
+        for (g, &s) in run.iter_mut().zip(springs) {
+            let s = s as usize;
+            let idx = block.particles[s];
+            let p = &params[block.group[s] as usize];
+            let pos = idx.map(|i| st.x[i as usize]);
+            let evaluated = p.enabled.then(|| block.shapes[s].evaluate(&pos)).flatten();
+            let Some((c, grad)) = evaluated else {
+                continue;
+            };
+            let (k, damping) = (p.spring_stiffness, p.spring_damping);
+            let root = (h * h * k + h * damping).sqrt();
+            *g = grad.map(|d| d * root);
+            let c_dot: f64 = (0..N).map(|m| grad[m].dot(st.v[idx[m] as usize])).sum();
+            let force = -(k * c + damping * c_dot);
+            let g_x0: f64 = st.x0.map_or(0.0, |x0| {
+                (0..N).map(|m| g[m].dot(x0[idx[m] as usize])).sum()
+            });
+            for m in 0..N {
+                rows[idx[m] as usize - base].add(
+                    1.0,
+                    grad[m] * (h * force - h * h * k * c_dot),
+                    g[m] * g_x0,
+                    Sym3::outer(g[m], 1.0),
+                );
             }
-        });
+        }
+    });
 }
 
-/// One term per spring: g (g·u) + κ u, u = Σ aₖ pₖ.
+/// Adds each spring's product g (g·u) + κ u, u = Σ aₖ pₖ, to its particles, weighted by aₖ.
 fn product_rays<const N: usize, S: RankOne<N>>(
-    block: &Block<N, S>,
+    (block, order): (&Block<N, S>, &PassOrder),
     rays: &[Ray],
     p: &[DVec3],
-    t: &mut [DVec3],
+    q: &mut [DVec3],
 ) {
-    rays.par_chunks(SPRINGS)
-        .zip(t.par_chunks_mut(SPRINGS))
-        .enumerate()
-        .for_each(|(c, (rays, t))| {
-            let base = c * SPRINGS;
-            for (j, (ray, t)) in rays.iter().zip(t).enumerate() {
-                let s = base + j;
-                let u = weighted(&block.shapes[s].coefficients(), &block.particles[s], p);
-                *t = ray.apply(u);
+    let mut none = vec![(); rays.len()];
+    by_parts(order, q, &mut none, |start, springs, _, q, base| {
+        for (ray, &s) in rays[start..].iter().zip(springs) {
+            let (a, idx) = (
+                block.shapes[s as usize].coefficients(),
+                &block.particles[s as usize],
+            );
+            let t = ray.apply(weighted(&a, idx, p));
+            for m in 0..N {
+                q[idx[m] as usize - base] += t * a[m];
             }
-        });
+        }
+    });
 }
 
-/// `N` terms per spring: gₖ (Σₘ gₘ·pₘ).
+/// Adds each spring's gₖ (Σₘ gₘ·pₘ) to its particle k.
 fn product_outers<const N: usize, S: Sync>(
-    block: &Block<N, S>,
+    (block, order): (&Block<N, S>, &PassOrder),
     outers: &[Outer<N>],
     p: &[DVec3],
-    t: &mut [DVec3],
+    q: &mut [DVec3],
 ) {
-    outers
-        .par_chunks(SPRINGS)
-        .zip(t.par_chunks_mut(SPRINGS * N))
-        .enumerate()
-        .for_each(|(c, (outers, t))| {
-            let base = c * SPRINGS;
-            for (j, (g, t)) in outers.iter().zip(t.chunks_exact_mut(N)).enumerate() {
-                let idx = &block.particles[base + j];
-                let s: f64 = (0..N).map(|m| g[m].dot(p[idx[m] as usize])).sum();
-                for m in 0..N {
-                    t[m] = g[m] * s;
-                }
+    let mut none = vec![(); outers.len()];
+    by_parts(order, q, &mut none, |start, springs, _, q, base| {
+        for (g, &s) in outers[start..].iter().zip(springs) {
+            let idx = &block.particles[s as usize];
+            let t: f64 = (0..N).map(|m| g[m].dot(p[idx[m] as usize])).sum();
+            for m in 0..N {
+                q[idx[m] as usize - base] += g[m] * t;
             }
-        });
-}
-
-/// A rank-one block's entries: spring s's term, `first + s`, read by each particle with its
-/// weight.
-fn ray_entries<const N: usize, S: RankOne<N>>(
-    block: &Block<N, S>,
-    first: usize,
-    out: &mut Vec<Entry>,
-) {
-    for (s, (idx, shape)) in block.particles.iter().zip(&block.shapes).enumerate() {
-        let a = shape.coefficients();
-        for m in 0..N {
-            out.push(Entry {
-                particle: idx[m],
-                term: (first + s) as u32,
-                coef: a[m],
-            });
         }
-    }
-}
-
-/// An outer block's entries: particle m of spring s reads term `first + N s + m`.
-fn outer_entries<const N: usize, S>(block: &Block<N, S>, first: usize, out: &mut Vec<Entry>) {
-    for (s, idx) in block.particles.iter().enumerate() {
-        for (m, &particle) in idx.iter().enumerate() {
-            out.push(Entry {
-                particle,
-                term: (first + N * s + m) as u32,
-                coef: 1.0,
-            });
-        }
-    }
+    });
 }
 
 impl ConstraintSet {
-    /// The terms of the spring operator over `n` particles (in [`Springs`]' order).
-    pub(crate) fn spring_terms(&self, n: usize) -> Terms {
-        let counts = self.spring_counts();
-        let mut first = [0; 5];
-        for k in 1..5 {
-            first[k] = first[k - 1] + counts[k - 1] * TERMS_PER_SPRING[k - 1];
-        }
-        let mut e = Vec::new();
-        ray_entries(&self.distance, first[0], &mut e);
-        outer_entries(&self.dihedral, first[1], &mut e);
-        ray_entries(&self.isometric, first[2], &mut e);
-        ray_entries(&self.tethers, first[3], &mut e);
-        ray_entries(&self.seams, first[4], &mut e);
-        Terms::new(n, &e)
-    }
-
-    /// Spring counts of each block, in slot order: what [`ConstraintSet::spring_rows`] and
-    /// [`ConstraintSet::spring_terms`] depend on.
+    /// Spring counts of each block, in slot order: what [`ConstraintSet::spring_rows`] and the
+    /// implicit solve's warm start depend on.
     pub(crate) fn spring_counts(&self) -> [usize; 5] {
         [
             self.distance.particles.len(),
@@ -371,41 +422,59 @@ impl ConstraintSet {
         ]
     }
 
-    /// Linearises every spring at `st` into `out`, and writes each term's share of the
-    /// right-hand side, of A x₀ and of A's diagonal into `rhs` (one per term).
+    /// Linearises every spring at `st` into `out`, and adds each spring's share of the
+    /// right-hand side, of (A − M) x₀ and of A − M's diagonal to its particles' `rows` (one per
+    /// particle).
     pub(crate) fn linearize(
         &self,
         params: &[FamilyParams],
         st: State<'_>,
         out: &mut Springs,
-        rhs: &mut Vec<TermRhs>,
+        rows: &mut [RowSums],
     ) {
-        let [r_d, r_b, r_i, r_t, r_s] = cut(self.spring_counts(), TERMS_PER_SPRING, rhs);
-        linearize_rays(&self.distance, params, st, &mut out.distance, r_d);
-        linearize_outers(&self.dihedral, params, st, &mut out.dihedral, r_b);
-        linearize_rays(&self.isometric, params, st, &mut out.isometric, r_i);
-        linearize_rays(&self.tethers, params, st, &mut out.tethers, r_t);
-        linearize_rays(&self.seams, &self.seam_params, st, &mut out.seams, r_s);
+        let n = rows.len();
+        let counts = self.spring_counts();
+        let fresh = |o: &[PassOrder; 5]| (0..5).all(|k| o[k].springs.len() == counts[k]);
+        if !matches!(&out.orders, Some((m, o)) if *m == n && fresh(o)) {
+            out.orders = Some((
+                n,
+                [
+                    PassOrder::new(&self.distance, n),
+                    PassOrder::new(&self.dihedral, n),
+                    PassOrder::new(&self.isometric, n),
+                    PassOrder::new(&self.tethers, n),
+                    PassOrder::new(&self.seams, n),
+                ],
+            ));
+        }
+        let Some((_, [o_d, o_b, o_i, o_t, o_s])) = &out.orders else {
+            return;
+        };
+        linearize_rays((&self.distance, o_d), params, st, &mut out.distance, rows);
+        linearize_outers((&self.dihedral, o_b), params, st, &mut out.dihedral, rows);
+        linearize_rays((&self.isometric, o_i), params, st, &mut out.isometric, rows);
+        linearize_rays((&self.tethers, o_t), params, st, &mut out.tethers, rows);
+        let seams = (&self.seams, o_s);
+        linearize_rays(seams, &self.seam_params, st, &mut out.seams, rows);
     }
 
-    /// Writes each term of (A − M) p = (h D + h² K) p into `t`, for `springs` linearised on
-    /// this set.
-    pub(crate) fn spring_product(&self, springs: &Springs, p: &[DVec3], t: &mut Vec<DVec3>) {
-        let [t_d, t_b, t_i, t_t, t_s] = cut(self.spring_counts(), TERMS_PER_SPRING, t);
-        product_rays(&self.distance, &springs.distance, p, t_d);
-        product_outers(&self.dihedral, &springs.dihedral, p, t_b);
-        product_rays(&self.isometric, &springs.isometric, p, t_i);
-        product_rays(&self.tethers, &springs.tethers, p, t_t);
-        product_rays(&self.seams, &springs.seams, p, t_s);
+    /// Adds (A − M) p = (h D + h² K) p to `q`, for `springs` linearised on this set over as many
+    /// particles as `p` holds.
+    pub(crate) fn spring_product(&self, springs: &Springs, p: &[DVec3], q: &mut [DVec3]) {
+        let Some((_, [o_d, o_b, o_i, o_t, o_s])) = &springs.orders else {
+            return;
+        };
+        product_rays((&self.distance, o_d), &springs.distance, p, q);
+        product_outers((&self.dihedral, o_b), &springs.dihedral, p, q);
+        product_rays((&self.isometric, o_i), &springs.isometric, p, q);
+        product_rays((&self.tethers, o_t), &springs.tethers, p, q);
+        product_rays((&self.seams, o_s), &springs.seams, p, q);
     }
 }
 
 /// Slots each spring of a block owns in the explicit force pass, block by block: distance,
 /// dihedral, isometric, tethers, seams (the order of [`ConstraintSet::spring_rows`]).
 const SLOTS_PER_SPRING: [usize; 5] = [2, 4, 4, 2, 2];
-
-/// Terms each spring of a block owns in the implicit system, in the same block order.
-const TERMS_PER_SPRING: [usize; 5] = [1, 4, 1, 1, 1];
 
 /// `v` resized to hold `per[k]` entries for each of `counts[k]` springs of block k, cut into
 /// the blocks' parts, in block order.

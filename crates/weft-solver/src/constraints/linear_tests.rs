@@ -1,5 +1,5 @@
 //! Tests of the linearised springs: the rank-one shapes' weights against their own gradients
-//! and Hessian products, and the terms summed by rows against a serial spring-by-spring
+//! and Hessian products, and the rows the passes add up against a serial spring-by-spring
 //! reference (the method's first, single-threaded form).
 
 use glam::DVec3;
@@ -17,16 +17,17 @@ use crate::{Forces, SolverBuilder};
 pub(crate) fn crumpled(
     bending: Family,
 ) -> (ConstraintSet, Vec<FamilyParams>, Vec<DVec3>, Vec<DVec3>) {
-    stretched(bending, 0.02)
+    stretched(bending, 0.02, 10)
 }
 
-/// [`crumpled`]'s grid stretched by 30 % and moved by up to `noise` (0: flat).
+/// An `n`² grid as [`crumpled`]'s, stretched by 30 % and moved by up to `noise` (0: flat).
 fn stretched(
     bending: Family,
     noise: f64,
+    n: usize,
 ) -> (ConstraintSet, Vec<FamilyParams>, Vec<DVec3>, Vec<DVec3>) {
     let mesh = GridDesc {
-        resolution: (10, 10),
+        resolution: (n, n),
         orientation: Orientation::Horizontal,
         ..GridDesc::default()
     }
@@ -176,53 +177,69 @@ fn rank_one_shapes_have_the_gradient_and_hessian_their_coefficients_give() {
     }
 }
 
+/// The springs linearised at (`x`, `v`) with warm start `x0`: the springs and each particle's
+/// row sums.
+fn linearized(
+    cs: &ConstraintSet,
+    params: &[FamilyParams],
+    (x, v, x0): (&[DVec3], &[DVec3], &[DVec3]),
+    h: f64,
+) -> (Springs, Vec<RowSums>) {
+    let mut springs = Springs::default();
+    let mut sums = vec![RowSums::default(); x.len()];
+    let st = State {
+        x,
+        v,
+        h,
+        x0: Some(x0),
+    };
+    cs.linearize(params, st, &mut springs, &mut sums);
+    (springs, sums)
+}
+
+/// (A − M) p through the product pass.
+fn product(cs: &ConstraintSet, springs: &Springs, p: &[DVec3]) -> Vec<DVec3> {
+    let mut q = vec![DVec3::ZERO; p.len()];
+    cs.spring_product(springs, p, &mut q);
+    q
+}
+
+/// Random vectors, one per particle.
+fn random_vectors(n: usize, seed: u64) -> Vec<DVec3> {
+    let mut rnd = rng(seed);
+    (0..n).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect()
+}
+
 #[test]
-fn terms_summed_by_rows_match_the_serial_springs() {
+fn rows_summed_by_the_passes_match_the_serial_springs() {
     for bending in [Family::BendDihedral, Family::BendIsometric] {
         let (cs, params, x, v) = crumpled(bending);
         let n = x.len();
         let h = 1e-3;
-        let mut rnd = rng(0x0bad_cafe_f00d_0001);
-        let x0: Vec<DVec3> = (0..n).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
-        let terms = cs.spring_terms(n);
-        let mut springs = Springs::default();
-        let mut rhs = Vec::new();
-        let st = State {
-            x: &x,
-            v: &v,
-            h,
-            x0: Some(&x0),
-        };
-        cs.linearize(&params, st, &mut springs, &mut rhs);
-        let read = |i: usize, f: &dyn Fn(&TermRhs) -> DVec3| {
-            (terms.row(i).iter()).fold(DVec3::ZERO, |s, e| s + f(&rhs[e.term as usize]) * e.coef)
-        };
+        let x0 = random_vectors(n, 0x0bad_cafe_f00d_0001);
+        let (springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h);
         // A − M applied to x₀, and to a fresh vector through the product pass.
         let (want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
         let (kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
-        let mut t = Vec::new();
-        cs.spring_product(&springs, &x0, &mut t);
-        assert_eq!(t.len(), rhs.len(), "one product term per term");
+        let q = product(&cs, &springs, &x0);
         let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
         let mut curved = 0;
         for i in 0..n {
-            let ax = read(i, &|r| r.ax);
+            let ax = sums[i].ax;
             assert!(
                 close(ax, want_ax[i], scale),
                 "{bending:?} row {i}: {ax} {}",
                 want_ax[i]
             );
-            assert!(close(terms.sum(i, &t), want_ax[i], scale));
-            let b = read(i, &|r| r.b);
+            assert!(close(q[i], want_ax[i], scale));
+            let b = sums[i].b;
             let want_b = f[i] * h - kv[i];
             assert!(
                 close(b, want_b, scale),
                 "{bending:?} row {i}: b {b} {want_b}"
             );
             // The diagonal block: A − M applied to a vector at particle i alone, read at i.
-            let d = (terms.row(i).iter()).fold(Sym3::default(), |s, e| {
-                s.add(rhs[e.term as usize].d.scale(e.coef * e.coef))
-            });
+            let d = sums[i].d;
             for e in [DVec3::X, DVec3::Y, DVec3::Z] {
                 let mut p = vec![DVec3::ZERO; n];
                 p[i] = e;
@@ -239,22 +256,57 @@ fn terms_summed_by_rows_match_the_serial_springs() {
 }
 
 #[test]
+fn parts_in_parallel_sum_as_the_serial_springs_on_any_thread_count() {
+    // 64² particles: the distance springs are cut into particle ranges, some straddling.
+    let (cs, params, x, v) = stretched(Family::BendIsometric, 0.02, 64);
+    let order = PassOrder::new(&cs.distance, x.len());
+    let parts = order.bounds.len() - 1;
+    assert!(parts >= 2, "{parts} ranges");
+    assert!(
+        order.springs.len() > order.starts[parts],
+        "some springs straddle"
+    );
+    let (n, h) = (x.len(), 1e-3);
+    let x0 = random_vectors(n, 0x0bad_cafe_f00d_0003);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            let (springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h);
+            let q = product(&cs, &springs, &x0);
+            let rows: Vec<[DVec3; 3]> = sums
+                .iter()
+                .map(|r| [r.b, r.ax, r.d.mul(DVec3::ONE)])
+                .collect();
+            (rows, q)
+        })
+    };
+    let (rows, q) = run(1);
+    assert_eq!(
+        (rows.clone(), q.clone()),
+        run(2),
+        "1 and 2 threads, same bits"
+    );
+    let (want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
+    let (kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
+    let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
+    for i in 0..n {
+        assert!(close(q[i], want_ax[i], scale), "product row {i}");
+        assert!(close(rows[i][1], want_ax[i], scale), "A x0 row {i}");
+        assert!(close(rows[i][0], f[i] * h - kv[i], scale), "b row {i}");
+    }
+}
+
+#[test]
 fn a_flat_isometric_hinge_keeps_its_stiffness_in_the_system() {
-    let (cs, params, x, v) = stretched(Family::BendIsometric, 0.0);
+    let (cs, params, x, v) = stretched(Family::BendIsometric, 0.0, 10);
     let n = x.len();
     let h = 1e-3;
-    let mut rnd = rng(0x0bad_cafe_f00d_0002);
-    let x0: Vec<DVec3> = (0..n).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
-    let terms = cs.spring_terms(n);
-    let (mut springs, mut rhs, mut t) = (Springs::default(), Vec::new(), Vec::new());
-    let st = State {
-        x: &x,
-        v: &v,
-        h,
-        x0: Some(&x0),
-    };
-    cs.linearize(&params, st, &mut springs, &mut rhs);
-    cs.spring_product(&springs, &x0, &mut t);
+    let x0 = random_vectors(n, 0x0bad_cafe_f00d_0002);
+    let (springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h);
+    let q = product(&cs, &springs, &x0);
     // The reference has no term for a hinge without a direction: add h² k a aᵀ ⊗ I by hand.
     let (mut want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
     let (mut kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
@@ -273,10 +325,18 @@ fn a_flat_isometric_hinge_keeps_its_stiffness_in_the_system() {
     assert!(!iso.particles.is_empty());
     let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
     for i in 0..n {
-        let ax = terms.sum(i, &t);
-        assert!(close(ax, want_ax[i], scale), "row {i}: {ax} {}", want_ax[i]);
-        let b = (terms.row(i).iter()).fold(DVec3::ZERO, |s, e| s + rhs[e.term as usize].b * e.coef);
+        assert!(
+            close(q[i], want_ax[i], scale),
+            "row {i}: {} {}",
+            q[i],
+            want_ax[i]
+        );
+        assert!(close(sums[i].ax, want_ax[i], scale), "row {i}: A x0");
         let want_b = f[i] * h - kv[i];
-        assert!(close(b, want_b, scale), "row {i}: b {b} {want_b}");
+        assert!(
+            close(sums[i].b, want_b, scale),
+            "row {i}: b {} {want_b}",
+            sums[i].b
+        );
     }
 }

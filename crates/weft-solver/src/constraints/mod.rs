@@ -45,7 +45,7 @@ pub(crate) use block::{Block, BlockBuilder, Rule};
 pub use dihedral::Dihedral;
 pub use distance::Distance;
 pub use isometric::Isometric;
-pub(crate) use linear::{Springs, State as LinearState, TermRhs};
+pub(crate) use linear::{RowSums, Springs, State as LinearState};
 pub use seam::Seam;
 pub(crate) use spring_stencil::{Mirror, Ring, SpringStencil, WIDEST};
 pub use tether::Tether;

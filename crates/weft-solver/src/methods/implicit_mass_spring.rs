@@ -15,9 +15,9 @@
 //! pinned, kinematic and grabbed particles (inverse mass 0). The shared loop then applies
 //! v ← v + Δv, x ← x + h v.
 //!
-//! A is never assembled: each product runs spring by spring into terms (one 3-vector per
-//! rank-one spring), in parallel, and each particle sums its terms, weighted, in a fixed order
-//! ([`crate::sparse::Terms`]); every sum across tasks is taken in a fixed order, so the result
+//! A is never assembled: each product starts from M p and adds every spring's term to its
+//! particles, part by part in parallel, each particle's terms in a fixed order (see
+//! `constraints/linear.rs`); every sum across tasks is taken in a fixed order, so the result
 //! does not depend on the thread count.
 
 use glam::DVec3;
@@ -25,10 +25,10 @@ use rayon::prelude::*;
 
 use super::{ForcePass, SpringWork, Strategy};
 use crate::chunk::CHUNK;
-use crate::constraints::{ConstraintSet, LinearState, Rule, Springs};
+use crate::constraints::{ConstraintSet, LinearState, RowSums, Rule, Springs};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
-use crate::sparse::{Operator, Sym3, Terms, solve};
+use crate::sparse::{Operator, Sym3, solve};
 
 /// Springs integrated with backward Euler: unconditionally stable, numerically damped.
 pub(crate) struct ImplicitMassSpring;
@@ -37,27 +37,36 @@ pub(crate) struct ImplicitMassSpring;
 struct System<'a> {
     constraints: &'a ConstraintSet,
     springs: &'a Springs,
-    terms: &'a Terms,
     w: &'a [f64],
-    t: &'a mut Vec<DVec3>,
 }
 
 impl Operator for System<'_> {
     fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64 {
-        self.constraints.spring_product(self.springs, p, self.t);
         let w = self.w;
-        self.terms.gather(
-            self.t,
-            q,
-            |i, s| {
-                if w[i] > 0.0 {
-                    p[i] / w[i] + s
-                } else {
-                    DVec3::ZERO
+        q.par_chunks_mut(CHUNK).enumerate().for_each(|(c, q)| {
+            for (j, q) in q.iter_mut().enumerate() {
+                let i = c * CHUNK + j;
+                *q = if w[i] > 0.0 { p[i] / w[i] } else { DVec3::ZERO };
+            }
+        });
+        self.constraints.spring_product(self.springs, p, q);
+        let partials: Vec<f64> = q
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, q)| {
+                let mut pq = 0.0;
+                for (j, q) in q.iter_mut().enumerate() {
+                    let i = c * CHUNK + j;
+                    if w[i] > 0.0 {
+                        pq += p[i].dot(*q);
+                    } else {
+                        *q = DVec3::ZERO;
+                    }
                 }
-            },
-            |i, q| p[i].dot(q),
-        )
+                pq
+            })
+            .collect();
+        partials.iter().sum()
     }
 }
 
@@ -78,35 +87,48 @@ impl Strategy for ImplicitMassSpring {
         let h = pass.h;
         let n = particles.len();
         let w = &particles.inv_masses;
-        work.ensure_terms(constraints, n);
+        work.check_warm_start(constraints, n);
         let warm = work.dv.len() == n;
         if !warm {
             work.dv.clear();
             work.dv.resize(n, DVec3::ZERO);
         }
-        let st = LinearState {
-            x: &particles.positions,
-            v: &particles.velocities,
-            h,
-            x0: warm.then_some(&work.dv[..]),
-        };
-        constraints.linearize(params, st, &mut work.springs, &mut work.rhs);
         let SpringWork {
-            terms,
             springs,
-            rhs,
-            y,
+            sums,
             pinv,
             r,
             dv,
             scratch,
             ..
         } = work;
+        // Each row starts with M's share: b = h M a_ext, M x₀ and M; the springs add theirs.
+        sums.resize(n, RowSums::default());
+        sums.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, sums)| {
+                for (j, row) in sums.iter_mut().enumerate() {
+                    let i = c * CHUNK + j;
+                    let m = if w[i] > 0.0 { 1.0 / w[i] } else { 0.0 };
+                    *row = RowSums {
+                        b: accel[i] * (m * h),
+                        ax: dv[i] * m,
+                        d: Sym3::scaled_identity(m),
+                    };
+                }
+            });
+        let st = LinearState {
+            x: &particles.positions,
+            v: &particles.velocities,
+            h,
+            x0: warm.then_some(&dv[..]),
+        };
+        constraints.linearize(params, st, springs, sums);
         pinv.resize(n, Sym3::default());
         r.resize(n, DVec3::ZERO);
-        // Per particle: b = h M a_ext + Σ terms' weighted b, r = b − A x₀, the block-Jacobi
-        // inverse; filtered particles get zeros (Baraff & Witkin's S).
-        let (terms_ref, rhs_ref, accel_ref) = (&*terms, &*rhs, &*accel);
+        // Per particle: r = b − A x₀ and the block-Jacobi inverse; filtered particles get zeros
+        // (Baraff & Witkin's S).
+        let sums_ref = &*sums;
         let partials: Vec<f64> = r
             .par_chunks_mut(CHUNK)
             .zip(pinv.par_chunks_mut(CHUNK))
@@ -120,18 +142,10 @@ impl Strategy for ImplicitMassSpring {
                         (r[j], pinv[j], dv[j]) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
                         continue;
                     }
-                    let m = 1.0 / w[i];
-                    let (mut b, mut ax) = (accel_ref[i] * (m * h), dv[j] * m);
-                    let mut d = Sym3::scaled_identity(m);
-                    for e in terms_ref.row(i) {
-                        let s = &rhs_ref[e.term as usize];
-                        b += s.b * e.coef;
-                        ax += s.ax * e.coef;
-                        d = d.add(s.d.scale(e.coef * e.coef));
-                    }
-                    r[j] = b - ax;
-                    pinv[j] = d.inverse();
-                    bb += b.dot(b);
+                    let row = &sums_ref[i];
+                    r[j] = row.b - row.ax;
+                    pinv[j] = row.d.inverse();
+                    bb += row.b.dot(row.b);
                 }
                 bb
             })
@@ -140,9 +154,7 @@ impl Strategy for ImplicitMassSpring {
         let mut system = System {
             constraints,
             springs,
-            terms,
             w,
-            t: y,
         };
         let outcome = solve(&mut system, pinv, b_norm2, dv, r, pass.cg, scratch, &|| {
             pass.stopping()

@@ -1,12 +1,12 @@
 //! `SpringWork`: what the spring methods keep between substeps — the rows of the explicit
-//! force pass and the terms of the implicit operator (each built once from the constraint
-//! graph), the last velocity change (the implicit solve's warm start), the scratch vectors,
-//! and the iterations the frame's solves took.
+//! force pass (built once from the constraint graph), the implicit system's row sums, the last
+//! velocity change (the implicit solve's warm start), the scratch vectors, and the iterations
+//! the frame's solves took.
 
 use glam::DVec3;
 
-use crate::constraints::{ConstraintSet, Springs, TermRhs};
-use crate::sparse::{Outcome, PcgScratch, Rows, Sym3, Terms};
+use crate::constraints::{ConstraintSet, RowSums, Springs};
+use crate::sparse::{Outcome, PcgScratch, Rows, Sym3};
 
 /// The spring methods' state and scratch, held by the solver (see the module documentation).
 #[derive(Clone, Debug, Default)]
@@ -14,14 +14,13 @@ pub(crate) struct SpringWork {
     /// The rows of the explicit force pass and the spring counts they were built for.
     pub rows: Rows,
     counts: Option<[usize; 5]>,
-    /// The terms of the implicit operator and the spring counts they were built for.
-    pub terms: Terms,
-    term_counts: Option<[usize; 5]>,
+    /// The spring counts and particle count the warm start was solved for.
+    warm_for: Option<([usize; 5], usize)>,
     /// The springs linearised at the current substep's state.
     pub springs: Springs,
-    /// Each term's share of the right-hand side, of A x₀ and of A's diagonal.
-    pub rhs: Vec<TermRhs>,
-    /// Each term of a product, or each slot of the spring forces (scratch).
+    /// Each particle's right-hand side, A x₀ and diagonal block of A (the implicit system).
+    pub sums: Vec<RowSums>,
+    /// Each slot of the spring forces (scratch).
     pub y: Vec<DVec3>,
     /// The inverse diagonal blocks of A (zero at filtered particles): the preconditioner.
     pub pinv: Vec<Sym3>,
@@ -50,14 +49,12 @@ impl SpringWork {
         }
     }
 
-    /// Builds the terms of the implicit operator for `constraints` over `n` particles unless
-    /// they are already built; a changed constraint set or particle count drops the warm start
-    /// too.
-    pub fn ensure_terms(&mut self, constraints: &ConstraintSet, n: usize) {
-        let counts = constraints.spring_counts();
-        if self.term_counts != Some(counts) || self.terms.len() != n {
-            self.terms = constraints.spring_terms(n);
-            self.term_counts = Some(counts);
+    /// Drops the implicit solve's warm start when the constraint set or the particle count
+    /// changed since it was solved.
+    pub fn check_warm_start(&mut self, constraints: &ConstraintSet, n: usize) {
+        let now = (constraints.spring_counts(), n);
+        if self.warm_for != Some(now) {
+            self.warm_for = Some(now);
             self.dv.clear();
         }
     }

@@ -1,6 +1,6 @@
-//! Sparse linear algebra for the spring methods: the rows of the explicit force pass and the
-//! weighted terms of the implicit operator, vectors summed deterministically in parallel, 3×3
-//! symmetric blocks, and preconditioned conjugate gradients.
+//! Sparse linear algebra for the spring methods: the rows of the explicit force pass, vectors
+//! summed deterministically in parallel, 3×3 symmetric blocks, and preconditioned conjugate
+//! gradients.
 //!
 //! Every parallel loop here is split into fixed chunks of particles or springs, and every sum
 //! across chunks is taken in chunk order on one thread: the bits never depend on the thread
@@ -9,10 +9,8 @@
 pub(crate) mod pcg;
 pub(crate) mod rows;
 pub(crate) mod sym3;
-pub(crate) mod terms;
 pub(crate) mod vector;
 
 pub(crate) use pcg::{CgLimits, Operator, Outcome, PcgScratch, solve};
 pub(crate) use rows::Rows;
 pub(crate) use sym3::Sym3;
-pub(crate) use terms::{Entry, Terms};
