@@ -152,16 +152,17 @@ pub(crate) struct Springs {
     orders: Option<(usize, [PassOrder; 5])>,
 }
 
-/// Springs per particle part of the implicit passes, at least.
-const PER_PART: usize = 4096;
+/// Springs per particle range of the implicit passes, at least.
+const PER_PART: usize = 1024;
 
-/// Particle parts of the implicit passes at most: more leave more springs straddling parts,
+/// Particle ranges of the implicit passes at most: more leave more springs straddling ranges,
 /// which run alone.
 const MAX_PARTS: usize = 8;
 
 /// The order in which the implicit passes visit a block's springs: the particles cut into
-/// ranges (their number a function of the spring count alone, never of the thread count), the
-/// springs of each range in insertion order, then those that straddle ranges.
+/// ranges (their number a power of two and a function of the spring count alone, never of the
+/// thread count), the springs of each range in insertion order, then those that straddle
+/// ranges.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct PassOrder {
     /// Particle range p is `bounds[p] .. bounds[p + 1]`.
@@ -176,7 +177,9 @@ impl PassOrder {
     /// The pass order of `block`'s springs over `n` particles.
     fn new<const N: usize, S>(block: &Block<N, S>, n: usize) -> Self {
         let len = block.particles.len();
+        // A power of two, so that the ranges share out evenly among 2, 4 or 8 threads.
         let parts = (len / PER_PART).clamp(1, MAX_PARTS).min(n.max(1));
+        let parts = 1 << parts.ilog2();
         let bounds: Vec<usize> = (0..=parts).map(|p| n * p / parts).collect();
         let mut by_insertion: Vec<u32> = (0..len as u32).collect();
         if block.order.len() == len {

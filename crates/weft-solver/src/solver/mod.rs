@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::DVec3;
 
+use crate::awake::awake;
 use crate::constraints::{ConstraintSet, Residual};
 use crate::domains::{DomainStats, Domains};
 use crate::driver::PinDriver;
@@ -487,6 +488,10 @@ impl Solver {
                 self.frame_fused(rule, hook)
             }
             None if springs => self.frame_springs(),
+            // The implicit solve's many short passes, each on workers kept awake.
+            None if s.method == crate::Method::ImplicitMassSpring => {
+                awake(|| self.frame_general(hook))
+            }
             _ => self.frame_general(hook),
         });
         let frame::Frame {
