@@ -141,7 +141,8 @@ impl RowSums {
 }
 
 /// Every spring of a constraint set, linearised at one state, each block's in its
-/// [`PassOrder`] (a disabled or degenerate spring is all zeros), with those orders.
+/// [`PassOrder`] (a disabled or degenerate spring is all zeros), with those orders (set by
+/// [`Springs::order`]).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Springs {
     distance: Vec<Ray>,
@@ -149,7 +150,20 @@ pub(crate) struct Springs {
     isometric: Vec<Ray>,
     tethers: Vec<Ray>,
     seams: Vec<Ray>,
-    orders: Option<(usize, [PassOrder; 5])>,
+    orders: Option<[PassOrder; 5]>,
+}
+
+impl Springs {
+    /// Orders the passes over `cs`'s springs for `n` particles (see [`PassOrder`]).
+    pub(crate) fn order(&mut self, cs: &ConstraintSet, n: usize) {
+        self.orders = Some([
+            PassOrder::new(&cs.distance, n),
+            PassOrder::new(&cs.dihedral, n),
+            PassOrder::new(&cs.isometric, n),
+            PassOrder::new(&cs.tethers, n),
+            PassOrder::new(&cs.seams, n),
+        ]);
+    }
 }
 
 /// Springs per particle range of the implicit passes, at least.
@@ -215,9 +229,9 @@ pub(crate) struct State<'a> {
 }
 
 /// Runs `f(start, springs, per, rows, base)` over `order`'s runs of springs (from position
-/// `start` of the pass order, `per` their slice of the per-spring data), where `rows` holds the particles from `base` on: each
-/// particle range's springs on that range's own rows, the ranges in parallel, then the
-/// springs that straddle ranges on all the rows. Each range's springs run in one task, so
+/// `start` of the pass order, `per` their slice of the per-spring data), where `rows` holds
+/// the particles from `base` on: each particle range's springs on that range's own rows, the
+/// ranges in parallel, then the springs that straddle ranges on all the rows. Each range's springs run in one task, so
 /// every particle receives its springs' shares in a fixed order whatever the thread count.
 fn by_parts<A, R, F>(order: &PassOrder, rows: &mut [A], per: &mut [R], f: F)
 where
@@ -270,63 +284,96 @@ fn linearize_rays<const N: usize, S: RankOne<N>>(
     out: &mut Vec<Ray>,
     rows: &mut [RowSums],
 ) {
-    let h = st.h;
     out.clear();
     out.resize(block.particles.len(), Ray::default());
     by_parts(order, rows, out, |_, springs, run, rows, base| {
-        // u, ℓ and 1/ℓ first, in a loop of their own: there the square roots and divisions of
-        // many springs overlap, where in the loop below each waited for the last.
-        let geometry: Vec<(DVec3, f64, f64)> = (springs.iter())
-            .map(|&s| {
+        for (springs, run) in springs
+            .chunks(GEOMETRY_RUN)
+            .zip(run.chunks_mut(GEOMETRY_RUN))
+        {
+            // u, ℓ and 1/ℓ first, in a loop of their own: there the square roots and
+            // divisions of many springs overlap, where in the loop below each waited for the
+            // last.
+            let mut geometry = [(DVec3::ZERO, 0.0, 0.0); GEOMETRY_RUN];
+            for (g, &s) in geometry.iter_mut().zip(springs) {
                 let s = s as usize;
                 let u = weighted(&block.shapes[s].coefficients(), &block.particles[s], st.x);
                 let len = u.length();
-                (u, len, 1.0 / len)
-            })
-            .collect();
-        for ((ray, &(u, len, inv)), &s) in run.iter_mut().zip(&geometry).zip(springs) {
-            let s = s as usize;
-            let idx = block.particles[s];
-            let p = &params[block.group[s] as usize];
-            let shape = &block.shapes[s];
-            let a = shape.coefficients();
-            let (k, damping) = (p.spring_stiffness, p.spring_damping);
-            let hhk = h * h * k;
-            let (c, n, kappa) = match p.enabled.then(|| shape.value(len)).flatten() {
-                Some(c) => {
-                    let kappa = if c > 0.0 && k > 0.0 {
-                        hhk * c * inv
-                    } else {
-                        0.0
-                    };
-                    (c, u * inv, kappa)
-                }
-                // ℓ = 0 where C = ℓ (a flat isometric hinge): no direction, so no force and no
-                // damping, and κ = h² k, the limit of h² k C/ℓ.
-                None if p.enabled && S::QUADRATIC => (0.0, DVec3::ZERO, hhk),
-                None => continue,
-            };
-            let sigma = hhk + h * damping;
-            *ray = Ray {
-                g: n * (sigma - kappa).max(0.0).sqrt(),
-                kappa,
-            };
-            // Ċ = Σ ∇ₖC·vₖ = n·Σ aₖ vₖ.
-            let uv = weighted(&a, &idx, st.v);
-            let force = -(k * c + damping * n.dot(uv));
-            // h² K v = a ⊗ ((h² k − κ) n n·u_v + κ u_v); b = h f − h² K v (Baraff & Witkin eq. 6,
-            // spring part).
-            let kv = n * ((hhk - kappa) * n.dot(uv)) + uv * kappa;
-            let b = n * (h * force) - kv;
-            let ax = st
-                .x0
-                .map_or(DVec3::ZERO, |x0| ray.apply(weighted(&a, &idx, x0)));
-            let d = Sym3::outer(ray.g, 1.0).add(Sym3::scaled_identity(kappa));
-            for m in 0..N {
-                rows[idx[m] as usize - base].add(a[m], b, ax, d);
+                *g = (u, len, 1.0 / len);
+            }
+            for ((ray, &(u, len, inv)), &s) in run.iter_mut().zip(&geometry).zip(springs) {
+                linearize_ray(
+                    block,
+                    params,
+                    st,
+                    s as usize,
+                    (u, len, inv),
+                    ray,
+                    rows,
+                    base,
+                );
             }
         }
     });
+}
+
+/// Springs whose geometry is computed ahead of the rest of their linearisation.
+const GEOMETRY_RUN: usize = 64;
+
+/// Linearises spring `s` of a rank-one block, its u, ℓ and 1/ℓ given: its ray, and its share
+/// added to the rows of its particles (`rows` holding those from `base` on).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn linearize_ray<const N: usize, S: RankOne<N>>(
+    block: &Block<N, S>,
+    params: &[FamilyParams],
+    st: State<'_>,
+    s: usize,
+    (u, len, inv): (DVec3, f64, f64),
+    ray: &mut Ray,
+    rows: &mut [RowSums],
+    base: usize,
+) {
+    let h = st.h;
+    let idx = block.particles[s];
+    let p = &params[block.group[s] as usize];
+    let shape = &block.shapes[s];
+    let a = shape.coefficients();
+    let (k, damping) = (p.spring_stiffness, p.spring_damping);
+    let hhk = h * h * k;
+    let (c, n, kappa) = match p.enabled.then(|| shape.value(len)).flatten() {
+        Some(c) => {
+            let kappa = if c > 0.0 && k > 0.0 {
+                hhk * c * inv
+            } else {
+                0.0
+            };
+            (c, u * inv, kappa)
+        }
+        // ℓ = 0 where C = ℓ (a flat isometric hinge): no direction, so no force and no
+        // damping, and κ = h² k, the limit of h² k C/ℓ.
+        None if p.enabled && S::QUADRATIC => (0.0, DVec3::ZERO, hhk),
+        None => return,
+    };
+    let sigma = hhk + h * damping;
+    *ray = Ray {
+        g: n * (sigma - kappa).max(0.0).sqrt(),
+        kappa,
+    };
+    // Ċ = Σ ∇ₖC·vₖ = n·Σ aₖ vₖ.
+    let uv = weighted(&a, &idx, st.v);
+    let force = -(k * c + damping * n.dot(uv));
+    // h² K v = a ⊗ ((h² k − κ) n n·u_v + κ u_v); b = h f − h² K v (Baraff & Witkin eq. 6,
+    // spring part).
+    let kv = n * ((hhk - kappa) * n.dot(uv)) + uv * kappa;
+    let b = n * (h * force) - kv;
+    let ax = st
+        .x0
+        .map_or(DVec3::ZERO, |x0| ray.apply(weighted(&a, &idx, x0)));
+    let d = Sym3::outer(ray.g, 1.0).add(Sym3::scaled_identity(kappa));
+    for m in 0..N {
+        rows[idx[m] as usize - base].add(a[m], b, ax, d);
+    }
 }
 
 /// Linearises a block with ∇C ∇Cᵀ alone: `N` terms per spring, each added to its particle's
@@ -427,7 +474,8 @@ impl ConstraintSet {
 
     /// Linearises every spring at `st` into `out`, and adds each spring's share of the
     /// right-hand side, of (A − M) x₀ and of A − M's diagonal to its particles' `rows` (one per
-    /// particle).
+    /// particle). `out`'s pass orders must be this set's over as many particles
+    /// ([`Springs::order`]); without them nothing is added.
     pub(crate) fn linearize(
         &self,
         params: &[FamilyParams],
@@ -435,22 +483,7 @@ impl ConstraintSet {
         out: &mut Springs,
         rows: &mut [RowSums],
     ) {
-        let n = rows.len();
-        let counts = self.spring_counts();
-        let fresh = |o: &[PassOrder; 5]| (0..5).all(|k| o[k].springs.len() == counts[k]);
-        if !matches!(&out.orders, Some((m, o)) if *m == n && fresh(o)) {
-            out.orders = Some((
-                n,
-                [
-                    PassOrder::new(&self.distance, n),
-                    PassOrder::new(&self.dihedral, n),
-                    PassOrder::new(&self.isometric, n),
-                    PassOrder::new(&self.tethers, n),
-                    PassOrder::new(&self.seams, n),
-                ],
-            ));
-        }
-        let Some((_, [o_d, o_b, o_i, o_t, o_s])) = &out.orders else {
+        let Some([o_d, o_b, o_i, o_t, o_s]) = &out.orders else {
             return;
         };
         linearize_rays((&self.distance, o_d), params, st, &mut out.distance, rows);
@@ -464,7 +497,7 @@ impl ConstraintSet {
     /// Adds (A − M) p = (h D + h² K) p to `q`, for `springs` linearised on this set over as many
     /// particles as `p` holds.
     pub(crate) fn spring_product(&self, springs: &Springs, p: &[DVec3], q: &mut [DVec3]) {
-        let Some((_, [o_d, o_b, o_i, o_t, o_s])) = &springs.orders else {
+        let Some([o_d, o_b, o_i, o_t, o_s]) = &springs.orders else {
             return;
         };
         product_rays((&self.distance, o_d), &springs.distance, p, q);

@@ -186,6 +186,7 @@ fn linearized(
     h: f64,
 ) -> (Springs, Vec<RowSums>) {
     let mut springs = Springs::default();
+    springs.order(cs, x.len());
     let mut sums = vec![RowSums::default(); x.len()];
     let st = State {
         x,

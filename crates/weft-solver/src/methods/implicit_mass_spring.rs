@@ -87,7 +87,7 @@ impl Strategy for ImplicitMassSpring {
         let h = pass.h;
         let n = particles.len();
         let w = &particles.inv_masses;
-        work.check_warm_start(constraints, n);
+        work.prepare_implicit(constraints, n);
         let warm = work.dv.len() == n;
         if !warm {
             work.dv.clear();

@@ -14,8 +14,8 @@ pub(crate) struct SpringWork {
     /// The rows of the explicit force pass and the spring counts they were built for.
     pub rows: Rows,
     counts: Option<[usize; 5]>,
-    /// The spring counts and particle count the warm start was solved for.
-    warm_for: Option<([usize; 5], usize)>,
+    /// The spring counts and particle count the pass orders and the warm start are for.
+    implicit_for: Option<([usize; 5], usize)>,
     /// The springs linearised at the current substep's state.
     pub springs: Springs,
     /// Each particle's right-hand side, A x₀ and diagonal block of A (the implicit system).
@@ -49,12 +49,13 @@ impl SpringWork {
         }
     }
 
-    /// Drops the implicit solve's warm start when the constraint set or the particle count
-    /// changed since it was solved.
-    pub fn check_warm_start(&mut self, constraints: &ConstraintSet, n: usize) {
+    /// Readies the implicit solve for `constraints` over `n` particles: when either changed
+    /// since the last solve, the springs' pass orders are made anew and the warm start dropped.
+    pub fn prepare_implicit(&mut self, constraints: &ConstraintSet, n: usize) {
         let now = (constraints.spring_counts(), n);
-        if self.warm_for != Some(now) {
-            self.warm_for = Some(now);
+        if self.implicit_for != Some(now) {
+            self.implicit_for = Some(now);
+            self.springs.order(constraints, n);
             self.dv.clear();
         }
     }
