@@ -10,6 +10,7 @@ Reads every `<criterion>/**/new/benchmark.json` + `estimates.json` (criterion 0.
 - the reference workload at N = 64/128/256 on 1 and 2 threads;
 - substeps × iterations at equal cost with the constraint error reached after 1 s;
 - collisions (sphere, triangle mesh, self) with and without, and their exponents;
+- each method on the walker in its T-shirt, and mesh-level cloth contact against none;
 - self-collision vs constraint solve at N = 128; triangle-mesh contact (static and
   deforming meshes); a character's body; MCAP logging overhead;
 - the Python package stepped frame by frame against `weft run`, from
@@ -135,14 +136,23 @@ def fmt_p(p):
 
 SIZES = [32, 64, 128, 256]
 
+METHODS = ["xpbd", "pbd", "mass-spring", "implicit-mass-spring"]
+
+
+def ratio(a, b):
+    """a / b as "12.3×", or "–" when either is missing."""
+    return "–" if a is None or not b else f"{fmt(a / b)}×"
+
 
 def methods(r):
     print("## Step time per frame (reference cloth, 10 substeps × 1 iteration)\n")
     head = " | ".join(f"{n}² ms/frame" for n in SIZES)
-    print(f"| method | {head} | Mproj/s at 128² | exponent p (cost ∝ particles^p) |")
-    print("|---" * (len(SIZES) + 3) + "|")
+    print(f"| method | {head} | × XPBD at 128² | Mproj/s at 128² "
+          "| exponent p (cost ∝ particles^p) |")
+    print("|---" * (len(SIZES) + 4) + "|")
     any_row = False
-    for m in ["xpbd", "pbd", "mass-spring", "implicit-mass-spring"]:
+    xpbd = ms(r, f"step/xpbd/{128 * 128}")
+    for m in METHODS:
         t = [ms(r, f"step/{m}/{n * n}") for n in SIZES]
         if all(x is None for x in t):
             continue
@@ -150,7 +160,8 @@ def methods(r):
         v = r.get(f"step/{m}/{128 * 128}")
         rate = f"{v[1] / v[0] * 1e3:.0f}" if v and v[1] else "–"
         p = exponent([n * n for n, x in zip(SIZES, t) if x], [x for x in t if x])
-        print(f"| {m} | " + " | ".join(fmt(x) for x in t) + f" | {rate} | {fmt_p(p)} |")
+        print(f"| {m} | " + " | ".join(fmt(x) for x in t)
+              + f" | {ratio(t[2], xpbd)} | {rate} | {fmt_p(p)} |")
     if not any_row:
         print("(no results: run `cargo bench -p weft-scene --bench methods`)")
     print()
@@ -301,6 +312,43 @@ def dressed(r):
                        for what, label in (("solve + skinned body", "solve + skinned-body contact"),
                                            ("solve only", "solve only (no contact)"))]]:
         print(f"| {label} | {fmt(ms(r, f'dressed walker frame/{f}'))} |")
+    print()
+    print("| the walker in its T-shirt by method: the whole frame (solve, body contact, "
+          "self-collision), 10 substeps, from the same state | ms/frame | × XPBD |")
+    print("|---|---|---|")
+    xpbd = ms(r, "walker by method/xpbd")
+    for m in METHODS:
+        t = ms(r, f"walker by method/{m}")
+        shown = fmt(t) if t is not None else "does not run the walker (left out by the bench)"
+        print(f"| {m} | {shown} | {ratio(t, xpbd)} |")
+    print()
+
+
+def cloth_contact(r):
+    print("## Cloth contact (`crates/weft-collide/benches/cloth_contact.rs`, "
+          "`crates/weft-scene/benches/dressed.rs`, XPBD, 10 substeps × 1 iteration)\n")
+    print("One frame from the same state with mesh-level cloth contact off and on, side by side "
+          "in one run.\n")
+    print("| scene | contact off ms/frame | contact on ms/frame | ratio |")
+    print("|---|---|---|---|")
+    for group, label in [("layers landing", "two 2 mm sheets (48², 1 m) landing on a ball "
+                                            "(frame 12)"),
+                         ("layers at rest", "the same sheets at rest (frame 180)"),
+                         ("twist", "a 50² sheet, 4 mm, twisted a full turn (frame 120)")]:
+        off = ms(r, f"cloth contact: {group}/contact off")
+        on = ms(r, f"cloth contact: {group}/contact on")
+        print(f"| {label} | {fmt(off)} | {fmt(on)} | {ratio(on, off)} |")
+    print()
+    print("| the walker in two thin garments (`assets/scenes/layered_outfit.toml`: the T-shirt "
+          "under the cape, 1.5 mm each, 12,577 particles, body contact), one warm frame at "
+          "0.5 s | ms/frame | ratio to none |")
+    print("|---|---|---|")
+    none = ms(r, "walker in two garments/no cloth contact")
+    for name, label in [("no cloth contact", "no contact between or within the cloths"),
+                        ("particle contact", "particle contact (thin layers slip through)"),
+                        ("mesh contact", "mesh contact (the scene's: no crossing)")]:
+        t = ms(r, f"walker in two garments/{name}")
+        print(f"| {label} | {fmt(t)} | {ratio(t, none)} |")
     print()
 
 
@@ -492,6 +540,7 @@ def write_page(r, root, note):
     mesh_contact(r)
     character(r)
     dressed(r)
+    cloth_contact(r)
     logging(r, root)
     python_frames(root)
     not_benches()
