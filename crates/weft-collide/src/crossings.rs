@@ -2,12 +2,15 @@
 //! triangle they share no vertex with, and how close non-adjacent elements come.
 //!
 //! It measures contact and shares nothing with it: its own broad phase (triangles binned in a
-//! hash table of grid cells) and exact-predicate style tests in f64 (signed volumes for the
+//! hash table of grid cells, one search a triangle for the edges and vertices it owns, each
+//! search narrowed to the closest pair found so far) and exact-predicate style tests in f64 (signed volumes for the
 //! crossings, Ericson's closest points for the distances, "Real-Time Collision Detection"
 //! §5.1.5 and §5.1.9). A crossing is an edge whose two end points lie strictly on opposite
 //! sides of a triangle's plane and whose line passes strictly inside the triangle; touching
 //! and coplanar configurations are not crossings. Integer counts and a minimum: the answer does
 //! not depend on the thread count.
+
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, I64Vec3};
 use rayon::prelude::*;
@@ -46,8 +49,8 @@ pub fn measure_joined(
         .filter(|t| j(t[0]) != j(t[1]) && j(t[1]) != j(t[2]) && j(t[2]) != j(t[0]))
         .collect();
     let triangles = &kept[..];
-    let edges = unique_edges(triangles);
-    if edges.is_empty() {
+    let owned = Owned::new(positions.len(), triangles);
+    if !owned.any_edge {
         return Crossings::default();
     }
     let mesh = Joined {
@@ -55,9 +58,10 @@ pub fn measure_joined(
         triangles,
         vertex,
     };
-    let longest = edges
+    let longest = triangles
         .iter()
-        .map(|&[a, b]| positions[a as usize].distance(positions[b as usize]))
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| positions[a as usize].distance(positions[b as usize]))
         .fold(0.0_f64, f64::max);
     // The reach is capped at the longest edge: beyond it every vertex would be near a whole
     // neighbourhood of its own cloth, and the search would grow with the square of the mesh.
@@ -67,40 +71,83 @@ pub fn measure_joined(
         0.0
     };
     let bins = Bins::new(positions, triangles, longest.max(reach).max(1e-9));
-    let crossings = edges
-        .par_iter()
-        .map_init(Vec::new, |found, &e| bins.crossings_of(&mesh, e, found))
-        .sum();
+    // One search a triangle for the edges and vertices it owns: the crossings of its edges,
+    // and, within the reach, the closest triangle to its vertices and edge to its edges. Each
+    // search goes only as far as the closest pair any task has found so far (`Closest`): a
+    // pair no closer cannot lower the minimum, so the answer is the same at any split and in
+    // any order.
+    let shared = Closest::new(reach);
+    let (crossings, near) = (0..triangles.len())
+        .into_par_iter()
+        .map_init(Vec::new, |found, t| {
+            bins.owned_by(&mesh, t, owned.mask[t], (found, &shared))
+        })
+        .reduce(|| (0, f64::INFINITY), |a, b| (a.0 + b.0, a.1.min(b.1)));
     let closest = if reach > 0.0 {
-        // Each task searches only as far as the closest pair it has found so far (`Near`):
-        // a pair no closer cannot lower the minimum, so the answer is the same at any split.
-        let vertex_face = (0..positions.len() as u32)
-            .into_par_iter()
+        // Particles in no triangle (a triangle collapsed by a join): their own searches.
+        let orphans = (owned.orphans.par_iter())
             .map_init(
-                || Near::new(reach),
-                |near, v| {
-                    let d = bins.vertex_closest(&mesh, v, near);
-                    near.keep(d)
+                || Near::new(near.min(reach)),
+                |n, &v| {
+                    let d = bins.vertex_closest(&mesh, v, n);
+                    n.keep(d)
                 },
             )
             .min_by(f64::total_cmp)
             .unwrap_or(f64::INFINITY);
-        let edge_edge = edges
-            .par_iter()
-            .map_init(
-                || Near::new(vertex_face.min(reach)),
-                |near, &e| {
-                    let d = bins.edge_closest(&mesh, e, near);
-                    near.keep(d)
-                },
-            )
-            .min_by(f64::total_cmp)
-            .unwrap_or(f64::INFINITY);
-        Some(vertex_face.min(edge_edge)).filter(|&d| d < reach)
+        Some(near.min(orphans)).filter(|&d| d < reach)
     } else {
         None
     };
     Crossings { crossings, closest }
+}
+
+/// Which of its edges and vertices each triangle searches for: every edge and every particle
+/// is owned by the first triangle that holds it.
+struct Owned {
+    /// Per triangle: bit k for its edge from corner k to corner k + 1, bit 3 + k for its
+    /// corner k.
+    mask: Vec<u8>,
+    /// Particles no triangle holds.
+    orphans: Vec<u32>,
+    /// Whether any triangle owns an edge.
+    any_edge: bool,
+}
+
+impl Owned {
+    fn new(n: usize, triangles: &[[u32; 3]]) -> Self {
+        let mut mask = vec![0u8; triangles.len()];
+        let mut sides: Vec<(u32, u32, u32, u8)> = (triangles.iter().enumerate())
+            .flat_map(|(t, tri)| {
+                (0..3).map(move |k| {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    (a.min(b), a.max(b), t as u32, k as u8)
+                })
+            })
+            .filter(|&(a, b, _, _)| a != b)
+            .collect();
+        sides.sort_unstable();
+        let any_edge = !sides.is_empty();
+        for (i, &(a, b, t, k)) in sides.iter().enumerate() {
+            if i == 0 || (sides[i - 1].0, sides[i - 1].1) != (a, b) {
+                mask[t as usize] |= 1 << k;
+            }
+        }
+        let mut held = vec![false; n];
+        for (t, tri) in triangles.iter().enumerate() {
+            for (k, &v) in tri.iter().enumerate() {
+                if !std::mem::replace(&mut held[v as usize], true) {
+                    mask[t] |= 8 << k;
+                }
+            }
+        }
+        let orphans = (0..n as u32).filter(|&v| !held[v as usize]).collect();
+        Self {
+            mask,
+            orphans,
+            any_edge,
+        }
+    }
 }
 
 /// The measured mesh: positions per particle, triangles, and each particle's vertex.
@@ -147,6 +194,27 @@ impl Near {
     }
 }
 
+/// The closest approach any task has found so far, shared between tasks: a distance (not
+/// negative, so its bits order as its value) narrowed with an atomic minimum.
+struct Closest(AtomicU64);
+
+impl Closest {
+    fn new(reach: f64) -> Self {
+        Self(AtomicU64::new(reach.max(0.0).to_bits()))
+    }
+
+    fn get(&self) -> f64 {
+        f64::from_bits(self.0.load(Ordering::Relaxed))
+    }
+
+    /// Narrows it to a pair found `d` apart.
+    fn keep(&self, d: f64) {
+        if d >= 0.0 && d.is_finite() {
+            self.0.fetch_min(d.to_bits(), Ordering::Relaxed);
+        }
+    }
+}
+
 /// The distance between the boxes `lo1..hi1` and `lo2..hi2` (0 where they overlap): no point
 /// of one is closer to a point of the other.
 fn box_gap(lo1: DVec3, hi1: DVec3, lo2: DVec3, hi2: DVec3) -> f64 {
@@ -154,18 +222,6 @@ fn box_gap(lo1: DVec3, hi1: DVec3, lo2: DVec3, hi2: DVec3) -> f64 {
 }
 
 /// Every edge of the triangles once, as `[low, high]`, sorted.
-fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut edges: Vec<[u32; 2]> = triangles
-        .iter()
-        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-        .map(|[a, b]| [a.min(b), a.max(b)])
-        .filter(|[a, b]| a != b)
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges
-}
-
 /// Triangles binned by the grid cells their boxes touch: `(cell key, triangle)` entries in a
 /// hash table, counting-sorted by bucket (each bucket in triangle order).
 struct Bins {
@@ -242,18 +298,6 @@ impl Bins {
         });
     }
 
-    fn crossings_of(&self, m: &Joined, [a, b]: [u32; 2], found: &mut Vec<u32>) -> usize {
-        let x = m.x;
-        let (p, q) = (x[a as usize], x[b as usize]);
-        self.near(p.min(q), p.max(q), found);
-        found
-            .iter()
-            .map(|&t| m.triangles[t as usize])
-            .filter(|tri| !m.holds(tri, a) && !m.holds(tri, b))
-            .filter(|tri| segment_crosses(p, q, tri.map(|i| x[i as usize])))
-            .count()
-    }
-
     /// The closest triangle to vertex `v` that does not hold it, if closer than
     /// `near.within` (else at least that, or infinity).
     fn vertex_closest(&self, m: &Joined, v: u32, near: &mut Near) -> f64 {
@@ -274,28 +318,69 @@ impl Bins {
         best
     }
 
-    /// The closest edge to edge `a b` that shares no vertex with it, if closer than
-    /// `near.within` (else at least that, or infinity).
-    fn edge_closest(&self, m: &Joined, [a, b]: [u32; 2], near: &mut Near) -> f64 {
-        let x = m.x;
-        let (p, q, r) = (x[a as usize], x[b as usize], near.within);
-        let (lo, hi) = (p.min(q), p.max(q));
-        self.near(lo - r, hi + r, &mut near.found);
-        let mut best = f64::INFINITY;
-        for &t in &near.found {
-            let tri = m.triangles[t as usize];
-            for k in 0..3 {
-                let (c, d) = (tri[k], tri[(k + 1) % 3]);
-                if m.same(c, a) || m.same(c, b) || m.same(d, a) || m.same(d, b) {
+    /// Triangle `t`'s search for what it owns (`mask`, see [`Owned`]): the crossings of its
+    /// edges through triangles that share no vertex with them, and the closest triangle to its
+    /// vertices and edge to its edges that share none, if closer than the closest pair found
+    /// so far (else at least that, or infinity), to which `shared` is narrowed.
+    fn owned_by(
+        &self,
+        m: &Joined,
+        t: usize,
+        mask: u8,
+        (found, shared): (&mut Vec<u32>, &Closest),
+    ) -> (usize, f64) {
+        if mask == 0 {
+            return (0, f64::INFINITY);
+        }
+        let (x, tri, r) = (m.x, m.triangles[t], shared.get());
+        let (lo, hi) = self.boxes[t];
+        self.near(lo - r, hi + r, found);
+        let (mut count, mut best) = (0, f64::INFINITY);
+        for k in (0..3).filter(|k| mask & (1 << k) != 0) {
+            // The edge from its lower particle, as every search of it has read it.
+            let (a, b) = (tri[k].min(tri[(k + 1) % 3]), tri[k].max(tri[(k + 1) % 3]));
+            let (p, q) = (x[a as usize], x[b as usize]);
+            let (elo, ehi) = (p.min(q), p.max(q));
+            for &c in found.iter() {
+                let other = m.triangles[c as usize];
+                let (clo, chi) = self.boxes[c as usize];
+                if clo.cmple(ehi).all()
+                    && elo.cmple(chi).all()
+                    && !m.holds(&other, a)
+                    && !m.holds(&other, b)
+                    && segment_crosses(p, q, other.map(|i| x[i as usize]))
+                {
+                    count += 1;
+                }
+                if r <= 0.0 || box_gap(elo, ehi, clo, chi) >= best.min(r) {
                     continue;
                 }
-                let (pc, pd) = (x[c as usize], x[d as usize]);
-                if box_gap(lo, hi, pc.min(pd), pc.max(pd)) < best.min(r) {
-                    best = best.min(segment_distance(p, q, pc, pd));
+                for j in 0..3 {
+                    let (c, d) = (other[j], other[(j + 1) % 3]);
+                    if m.same(c, a) || m.same(c, b) || m.same(d, a) || m.same(d, b) {
+                        continue;
+                    }
+                    let (pc, pd) = (x[c as usize], x[d as usize]);
+                    if box_gap(elo, ehi, pc.min(pd), pc.max(pd)) < best.min(r) {
+                        best = best.min(segment_distance(p, q, pc, pd));
+                    }
                 }
             }
         }
-        best
+        if r > 0.0 {
+            for k in (0..3).filter(|k| mask & (8 << k) != 0) {
+                let (v, p) = (tri[k], x[tri[k] as usize]);
+                for &c in found.iter() {
+                    let (clo, chi) = self.boxes[c as usize];
+                    let other = m.triangles[c as usize];
+                    if box_gap(p, p, clo, chi) < best.min(r) && !m.holds(&other, v) {
+                        best = best.min(point_triangle_distance(p, other.map(|i| x[i as usize])));
+                    }
+                }
+            }
+        }
+        shared.keep(best);
+        (count, best)
     }
 }
 
@@ -454,6 +539,16 @@ mod tests {
     }
 
     #[test]
+    fn a_particle_in_no_triangle_is_measured_too() {
+        let (mut x, t) = sheet(4, 0.1, 0.0, 0);
+        // A lone particle 1 mm above the sheet's middle: nearer than any of the sheet's own.
+        x.push(DVec3::new(0.2, 0.2, 0.001));
+        let m = measure(&x, &t, 0.05);
+        assert_eq!(m.closest, Some(0.001));
+        assert_eq!(m.crossings, 0);
+    }
+
+    #[test]
     fn two_parallel_sheets_report_their_gap() {
         let (mut x, mut t) = sheet(4, 0.1, 0.0, 0);
         let (x2, t2) = sheet(4, 0.1, 0.002, x.len() as u32);
@@ -514,6 +609,19 @@ mod tests {
         (x, t)
     }
 
+    /// Every edge of `triangles` once, its ends in order.
+    fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+        let mut edges: Vec<[u32; 2]> = triangles
+            .iter()
+            .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+            .map(|[a, b]| [a.min(b), a.max(b)])
+            .filter(|[a, b]| a != b)
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
     #[test]
     fn crossings_match_a_brute_force_count_on_a_crumpled_pair() {
         // Opposite bumps in two sheets in one plane, so they interpenetrate in patches.
@@ -532,6 +640,8 @@ mod tests {
             .sum::<usize>();
         assert!(brute > 20, "the pair must interpenetrate: {brute}");
         assert_eq!(measure(&x, &t, 0.0).crossings, brute);
+        // With the closest approach searched too, each triangle's search reaches further.
+        assert_eq!(measure(&x, &t, 0.05).crossings, brute);
     }
 
     #[test]
