@@ -350,6 +350,16 @@ def cloth_contact(r):
         t = ms(r, f"walker in two garments/{name}")
         print(f"| {label} | {fmt(t)} | {ratio(t, none)} |")
     print()
+    print("| the independent crossing count (`crates/weft-sim/benches/crossings.rs`: "
+          "`Simulation::step` with the count off and on, and the count alone) | frame, count "
+          "off | frame, count on | the count alone |")
+    print("|---|---|---|---|")
+    for scene, label in [("layers", "`layers.toml` (4,608 particles) from frame 20"),
+                         ("twist", "`twist.toml` (2,500 particles) from frame 60"),
+                         ("character", "`character.toml` (10,203 particles) from frame 12")]:
+        row = [ms(r, f"crossings/{scene}/{k}") for k in ("frame_off", "frame_on", "measure_alone")]
+        print(f"| {label} | " + " | ".join(fmt(x) for x in row) + " |")
+    print()
 
 
 def not_benches():
