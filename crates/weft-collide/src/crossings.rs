@@ -3,12 +3,12 @@
 //!
 //! It measures contact and shares nothing with it: its own broad phase (triangles binned in a
 //! hash table of grid cells, one search a triangle for the edges and vertices it owns, each
-//! search narrowed to the closest pair found so far) and exact-predicate style tests in f64 (signed volumes for the
-//! crossings, Ericson's closest points for the distances, "Real-Time Collision Detection"
-//! §5.1.5 and §5.1.9). A crossing is an edge whose two end points lie strictly on opposite
-//! sides of a triangle's plane and whose line passes strictly inside the triangle; touching
-//! and coplanar configurations are not crossings. Integer counts and a minimum: the answer does
-//! not depend on the thread count.
+//! search narrowed to the closest pair found so far) and exact-predicate style tests in f64
+//! (signed volumes for the crossings, Ericson's closest points for the distances, "Real-Time
+//! Collision Detection" §5.1.5 and §5.1.9). A crossing is an edge whose two end points lie
+//! strictly on opposite sides of a triangle's plane and whose line passes strictly inside the
+//! triangle; touching and coplanar configurations are not crossings. Integer counts and a
+//! minimum: the answer does not depend on the thread count.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -221,7 +221,6 @@ fn box_gap(lo1: DVec3, hi1: DVec3, lo2: DVec3, hi2: DVec3) -> f64 {
     (lo2 - hi1).max(lo1 - hi2).max(DVec3::ZERO).length()
 }
 
-/// Every edge of the triangles once, as `[low, high]`, sorted.
 /// Triangles binned by the grid cells their boxes touch: `(cell key, triangle)` entries in a
 /// hash table, counting-sorted by bucket (each bucket in triangle order).
 struct Bins {

@@ -231,8 +231,9 @@ pub(crate) struct State<'a> {
 /// Runs `f(start, springs, per, rows, base)` over `order`'s runs of springs (from position
 /// `start` of the pass order, `per` their slice of the per-spring data), where `rows` holds
 /// the particles from `base` on: each particle range's springs on that range's own rows, the
-/// ranges in parallel, then the springs that straddle ranges on all the rows. Each range's springs run in one task, so
-/// every particle receives its springs' shares in a fixed order whatever the thread count.
+/// ranges in parallel, then the springs that straddle ranges on all the rows. Each range's
+/// springs run in one task, so every particle receives its springs' shares in a fixed order
+/// whatever the thread count.
 fn by_parts<A, R, F>(order: &PassOrder, rows: &mut [A], per: &mut [R], f: F)
 where
     A: Send,
