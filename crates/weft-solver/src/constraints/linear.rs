@@ -513,26 +513,20 @@ impl ConstraintSet {
 /// dihedral, isometric, tethers, seams (the order of [`ConstraintSet::spring_rows`]).
 const SLOTS_PER_SPRING: [usize; 5] = [2, 4, 4, 2, 2];
 
-/// `v` resized to hold `per[k]` entries for each of `counts[k]` springs of block k, cut into
-/// the blocks' parts, in block order.
-fn cut<T: Clone + Default>(counts: [usize; 5], per: [usize; 5], v: &mut Vec<T>) -> [&mut [T]; 5] {
-    let lens = std::array::from_fn::<_, 5, _>(|k| counts[k] * per[k]);
-    v.resize(lens.iter().sum(), T::default());
-    let mut rest = &mut v[..];
-    lens.map(|len| {
-        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
-        rest = tail;
-        head
-    })
-}
-
 /// `slots` resized to hold every slot of `counts` springs per block, cut into the blocks'
 /// slots, in slot order.
 pub(super) fn slot_blocks<T: Clone + Default>(
     counts: [usize; 5],
     slots: &mut Vec<T>,
 ) -> [&mut [T]; 5] {
-    cut(counts, SLOTS_PER_SPRING, slots)
+    let lens = std::array::from_fn::<_, 5, _>(|k| counts[k] * SLOTS_PER_SPRING[k]);
+    slots.resize(lens.iter().sum(), T::default());
+    let mut rest = &mut slots[..];
+    lens.map(|len| {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        rest = tail;
+        head
+    })
 }
 
 #[cfg(test)]

@@ -479,7 +479,8 @@ impl Solver {
     /// off to and woken once per frame, not once per loop (tens of µs each on a virtual core).
     pub fn step_with(&mut self, hook: &mut dyn SubstepHook) -> Result<StepStats, SolverError> {
         let s = self.settings;
-        let rule = s.method.strategy().rule(s.h());
+        let strategy = s.method.strategy();
+        let rule = strategy.rule(s.h());
         let springs = s.method.is_explicit() && !hook.is_active() && self.stencil_ready();
         let done = rayon::scope(|_| match rule {
             Some(rule)
@@ -488,10 +489,7 @@ impl Solver {
                 self.frame_fused(rule, hook)
             }
             None if springs => self.frame_springs(),
-            // The implicit solve's many short passes, each on workers kept awake.
-            None if s.method == crate::Method::ImplicitMassSpring => {
-                awake(|| self.frame_general(hook))
-            }
+            None if strategy.keeps_workers_awake() => awake(|| self.frame_general(hook)),
             _ => self.frame_general(hook),
         });
         let frame::Frame {
