@@ -16,8 +16,10 @@
 use std::collections::BTreeSet;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::{Block, Distance};
+use crate::chunk::CHUNK;
 use crate::params::FamilyParams;
 
 /// Slots a stencil holds at most: a grid's stretch and shear springs take 8 (warp, weft and
@@ -192,10 +194,22 @@ impl SpringStencil {
             mirror.x[a].resize(len, 0.0);
             mirror.v[a].resize(len, 0.0);
         }
-        mirror.origin = x.first().copied().unwrap_or(DVec3::ZERO);
-        for (i, (&x, &v)) in x.iter().zip(v).enumerate() {
-            mirror.set(self.margin, i, x, v);
-        }
+        let origin = x.first().copied().unwrap_or(DVec3::ZERO);
+        mirror.origin = origin;
+        let n = x.len().min(v.len());
+        let (m, c) = (self.margin, CHUNK);
+        let [x0, x1, x2] = mirror.x.each_mut().map(|s| s[m..m + n].par_chunks_mut(c));
+        let [v0, v1, v2] = mirror.v.each_mut().map(|s| s[m..m + n].par_chunks_mut(c));
+        let (x, v) = (x[..n].par_chunks(c), v[..n].par_chunks(c));
+        (x0, x1, x2, v0, v1, v2, x, v).into_par_iter().for_each(
+            |(x0, x1, x2, v0, v1, v2, x, v)| {
+                for (i, (&x, &v)) in x.iter().zip(v).enumerate() {
+                    let x = x - origin;
+                    (x0[i], x1[i], x2[i]) = (x.x as f32, x.y as f32, x.z as f32);
+                    (v0[i], v1[i], v2[i]) = (v.x as f32, v.y as f32, v.z as f32);
+                }
+            },
+        );
     }
 
     /// The stride of the per-slot arrays: the particle count rounded up to [`WIDEST`]; state

@@ -6,7 +6,9 @@
 
 use glam::DVec3;
 use multiversion::multiversion;
+use rayon::prelude::*;
 
+use crate::chunk::CHUNK;
 use crate::constraints::{Mirror, Ring, SpringStencil, WIDEST};
 use weft_simd::SimdPath;
 
@@ -26,7 +28,7 @@ pub(crate) struct LaneState {
 
 impl LaneState {
     /// Loads the particles' positions, velocities and inverse masses, padded to `stride`
-    /// (one pass over the particles).
+    /// (one parallel pass over the particles).
     pub fn load(&mut self, stride: usize, x: &[DVec3], v: &[DVec3], w: &[f64]) {
         let n = x.len().min(v.len());
         for a in 0..3 {
@@ -35,12 +37,17 @@ impl LaneState {
                 s[n..].fill(0.0);
             }
         }
-        let [x0, x1, x2] = self.x.each_mut().map(|s| &mut s[..n]);
-        let [v0, v1, v2] = self.v.each_mut().map(|s| &mut s[..n]);
-        for (i, (x, v)) in x.iter().zip(v).enumerate() {
-            (x0[i], x1[i], x2[i]) = (x.x, x.y, x.z);
-            (v0[i], v1[i], v2[i]) = (v.x, v.y, v.z);
-        }
+        let [x0, x1, x2] = self.x.each_mut().map(|s| s[..n].par_chunks_mut(CHUNK));
+        let [v0, v1, v2] = self.v.each_mut().map(|s| s[..n].par_chunks_mut(CHUNK));
+        let (x, v) = (x[..n].par_chunks(CHUNK), v[..n].par_chunks(CHUNK));
+        (x0, x1, x2, v0, v1, v2, x, v).into_par_iter().for_each(
+            |(x0, x1, x2, v0, v1, v2, x, v)| {
+                for (i, (x, v)) in x.iter().zip(v).enumerate() {
+                    (x0[i], x1[i], x2[i]) = (x.x, x.y, x.z);
+                    (v0[i], v1[i], v2[i]) = (v.x, v.y, v.z);
+                }
+            },
+        );
         self.w.clear();
         self.w.extend_from_slice(w);
         self.w.resize(stride, 0.0);

@@ -4,7 +4,8 @@
 //! force in f32 lanes from the last substep's [`Mirror`] and integrates in f64, writing its
 //! next mirror entry. The general loop does the same f64 integration from f64 forces: the two
 //! agree to the f32 rounding of the forces, and either gives the same bits on every thread
-//! count and kernel path.
+//! count and kernel path. The frame runs with the pool's workers kept awake (`crate::awake`);
+//! its loads, and its write-back with the divergence check, are parallel passes too.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -14,6 +15,7 @@ use super::{Solver, StepStats};
 use crate::chunk::CHUNK;
 use crate::constraints::{Mirror, SpringStencil};
 use crate::methods::{LaneState, Part, Scratch, Step, step_part};
+use crate::settings::within_bound;
 
 /// The stencil, the particles' state in lanes, the two mirrors (a substep reads one and
 /// writes the other) and each task's working memory.
@@ -155,20 +157,27 @@ impl Solver {
                 break;
             }
         }
+        // The write-back checks the positions against the divergence bound as it goes.
+        let mut within = false;
         if ran {
             let p = &mut self.particles;
-            let state = &*state;
-            (p.positions.par_chunks_mut(CHUNK))
+            let (state, bound) = (&*state, s.divergence_bound);
+            within = (p.positions.par_chunks_mut(CHUNK))
                 .zip(p.velocities.par_chunks_mut(CHUNK))
                 .zip(p.prev_positions.par_chunks_mut(CHUNK))
                 .enumerate()
-                .for_each(|(c, ((x, v), prev))| state.store(c * CHUNK, x, v, prev));
+                .map(|(c, ((x, v), prev))| {
+                    state.store(c * CHUNK, x, v, prev);
+                    // No branch: the chunk just written is still in the nearest cache.
+                    x.iter().fold(true, |ok, &x| ok & within_bound(x, bound))
+                })
+                .reduce(|| true, |a, b| a & b);
         }
         self.stencil = Stencil::Built(st);
         Frame {
             stats: StepStats::default(),
             whole,
-            within: false,
+            within,
         }
     }
 }

@@ -488,7 +488,7 @@ impl Solver {
             {
                 self.frame_fused(rule, hook)
             }
-            None if springs => self.frame_springs(),
+            None if springs => awake(|| self.frame_springs()),
             None if strategy.keeps_workers_awake() => awake(|| self.frame_general(hook)),
             _ => self.frame_general(hook),
         });

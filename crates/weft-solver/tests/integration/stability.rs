@@ -195,3 +195,34 @@ fn a_fused_frame_reports_a_particle_beyond_the_bound() {
         other => panic!("expected divergence at frame 5, got {other:?}"),
     }
 }
+
+#[test]
+fn a_stencil_frame_reports_a_particle_beyond_the_bound() {
+    let mut s = solver(
+        settings(Method::MassSpring, DT, 40, 1),
+        Forces::default(),
+        &hanging_grid(8),
+        in_plane(0.0, 1.0, 100.0),
+    );
+    run(&mut s, 5);
+    assert!(
+        s.runs_springs_by_stencil(),
+        "the stencil frame checks positions as it writes them back"
+    );
+    s.particles_mut().velocities[37].z = 1e9;
+    match s.step() {
+        Err(SolverError::Diverged {
+            method: Method::MassSpring,
+            frame: 5,
+            particle,
+            position,
+            bound,
+            ..
+        }) => {
+            // Springs carry particle 37's motion to its neighbours; the first is reported.
+            assert!(particle <= 37, "particle {particle}");
+            assert!(position.is_finite() && position.abs().max_element() > bound);
+        }
+        other => panic!("expected divergence at frame 5, got {other:?}"),
+    }
+}
