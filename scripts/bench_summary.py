@@ -314,8 +314,8 @@ def dressed(r):
         print(f"| {label} | {fmt(ms(r, f'dressed walker frame/{f}'))} |")
     print()
     print("| the walker in its T-shirt by method: the whole frame (solve, body contact, "
-          "self-collision) from the same state, 10 substeps (explicit mass-spring: the fewest "
-          "it is stable at, as `weft check` says) | ms/frame | × XPBD |")
+          "self-collision) from the same state, 10 substeps (explicit mass-spring: the substeps "
+          "`weft check` advises, inside its guaranteed bound) | ms/frame | × XPBD |")
     print("|---|---|---|")
     xpbd = ms(r, "walker by method/xpbd")
     for m in METHODS:
