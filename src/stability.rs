@@ -124,7 +124,7 @@ pub fn verdict(solver: &Solver, cloth: usize) -> Option<Verdict> {
                 },
                 // Not the estimate's count: the walker's T-shirt, advised 462 by it (0.9 of
                 // the mode's limit), exploded at 462 and 480 and held at 500.
-                (s.dt / sure).floor() as u64 + 1
+                bound.min_substeps(s.dt)
             )
         }
     );
@@ -174,6 +174,15 @@ mod tests {
             .expect("solvers")
     }
 
+    /// The substep count a verdict line advises (`sim.substeps >= N`).
+    fn suggested(text: &str) -> u64 {
+        let tail = text.split("sim.substeps >= ").nth(1).expect("a suggestion");
+        tail.split(' ')
+            .next()
+            .and_then(|n| n.parse().ok())
+            .expect("a count")
+    }
+
     #[test]
     fn explicit_springs_past_their_limit_are_warned_about() {
         let lines = warnings(&groups("mass-spring"));
@@ -191,15 +200,7 @@ mod tests {
             g[0].solver.settings().dt,
             g[0].solver.stability(0).expect("bound"),
         );
-        let tail = lines[0]
-            .split("sim.substeps >= ")
-            .nth(1)
-            .expect("a suggestion");
-        let n: f64 = tail
-            .split(' ')
-            .next()
-            .and_then(|n| n.parse().ok())
-            .expect("a count");
+        let n = suggested(&lines[0]) as f64;
         assert!(dt / n < bound.max_substep(), "{}", lines[0]);
         assert!(dt / (n - 1.0) >= bound.max_substep(), "{}", lines[0]);
         assert!(
@@ -242,13 +243,6 @@ mod tests {
             .expect("scene loads")
             .build()
             .expect("solvers")
-        };
-        let suggested = |text: &str| -> u64 {
-            let tail = text.split("sim.substeps >= ").nth(1).expect("a suggestion");
-            tail.split(' ')
-                .next()
-                .and_then(|n| n.parse().ok())
-                .expect("a count")
         };
         let one = verdict(&scene("1")[0].solver, 0).expect("a line");
         assert!(one.ok, "{}", one.text);

@@ -81,14 +81,19 @@ fn dressed(overrides: &[&str]) -> SolverGroup {
     shipped("character.toml", overrides)
 }
 
-/// The shipped scene `name` with `overrides`, stepped 12 frames (0.2 s).
-fn shipped(name: &str, overrides: &[&str]) -> SolverGroup {
+/// The shipped scene `name` with `overrides`, built and not stepped.
+fn built(name: &str, overrides: &[&str]) -> SolverGroup {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../assets/scenes")
         .join(name);
     let ov: Vec<Override> = overrides.iter().map(|s| s.parse().unwrap()).collect();
     let scene = weft_scene::load(&path, &ov).unwrap();
-    let mut g = scene.build().unwrap().remove(0);
+    scene.build().unwrap().remove(0)
+}
+
+/// The shipped scene `name` with `overrides`, stepped 12 frames (0.2 s).
+fn shipped(name: &str, overrides: &[&str]) -> SolverGroup {
+    let mut g = built(name, overrides);
     for _ in 0..12 {
         g.step().unwrap();
     }
@@ -178,15 +183,9 @@ fn bench(c: &mut Criterion) {
 /// The substeps a frame `weft check` advises for the walker's explicit springs under
 /// `overrides`: the fewest inside the guaranteed (Gershgorin) bound.
 fn stable_substeps(overrides: &[&str]) -> u64 {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes/character.toml");
-    let ov: Vec<Override> = overrides.iter().map(|s| s.parse().unwrap()).collect();
-    let g = weft_scene::load(&path, &ov)
-        .unwrap()
-        .build()
-        .unwrap()
-        .remove(0);
-    let sure = g.solver.stability(0).unwrap().max_substep();
-    (g.solver.settings().dt / sure).floor() as u64 + 1
+    let g = built("character.toml", overrides);
+    let dt = g.solver.settings().dt;
+    g.solver.stability(0).unwrap().min_substeps(dt)
 }
 
 /// The whole walker frame (solve + body + self-collision) under each method, side by side
