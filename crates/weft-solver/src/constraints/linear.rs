@@ -33,9 +33,12 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::linear_rows::{RowSums, State};
+use super::ray_stencil::RayStencil;
 use super::{Block, ConstraintSet, Distance, Isometric, Seam, Shape, Tether};
 use crate::params::FamilyParams;
 use crate::sparse::Sym3;
+use weft_simd::SimdPath;
 
 /// A shape whose gradient is one direction weighted per particle, ∇ₖC = aₖ n, and whose
 /// Hessian is ∂²C/∂pₖ∂pₘ = aₖ aₘ (I − n nᵀ)/ℓ, with u = Σ aₖ pₖ, ℓ = |u| and n = u/ℓ.
@@ -118,28 +121,6 @@ impl Ray {
 /// A spring without a Hessian: its share of A − M is g gᵀ, g = √σ ∇C, one term per particle.
 pub(crate) type Outer<const N: usize> = [DVec3; N];
 
-/// A particle's row of A − M and of the right-hand side, summed over its springs: what the
-/// linearisation adds to each particle (the caller starts each row with M's share).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct RowSums {
-    /// b = h f − h² K v (Baraff & Witkin eq. 6).
-    pub b: DVec3,
-    /// A x₀ for the warm start x₀.
-    pub ax: DVec3,
-    /// A's diagonal block.
-    pub d: Sym3,
-}
-
-impl RowSums {
-    /// Adds a term read with weight `a`: b and A x₀ scaled by a, the diagonal block by a².
-    #[inline(always)]
-    fn add(&mut self, a: f64, b: DVec3, ax: DVec3, d: Sym3) {
-        self.b += b * a;
-        self.ax += ax * a;
-        self.d = self.d.add(d.scale(a * a));
-    }
-}
-
 /// Every spring of a constraint set, linearised at one state, each block's in its
 /// [`PassOrder`] (a disabled or degenerate spring is all zeros), with those orders (set by
 /// [`Springs::order`]).
@@ -151,6 +132,12 @@ pub(crate) struct Springs {
     tethers: Vec<Ray>,
     seams: Vec<Ray>,
     orders: Option<[PassOrder; 5]>,
+    /// The distance springs as a stencil, where they form one (a grid): they are then
+    /// linearised and multiplied there, not in `distance`.
+    stencil: Option<Box<RayStencil>>,
+    /// The one-pass system off: its rows and products composed of the general passes.
+    #[cfg(test)]
+    composed: bool,
 }
 
 impl Springs {
@@ -163,6 +150,33 @@ impl Springs {
             PassOrder::new(&cs.tethers, n),
             PassOrder::new(&cs.seams, n),
         ]);
+        self.stencil = RayStencil::build(&cs.distance, n).map(Box::new);
+    }
+
+    /// The stencil, where its springs are all there are (no other block has any).
+    pub(crate) fn sole_stencil(&mut self) -> Option<&mut RayStencil> {
+        #[cfg(test)]
+        if self.composed {
+            return None;
+        }
+        let orders = self.orders.as_ref()?;
+        match orders[1..].iter().all(|o| o.springs.is_empty()) {
+            true => self.stencil.as_deref_mut(),
+            false => None,
+        }
+    }
+
+    /// Composes the system of the general passes where the stencil holds every spring (to test
+    /// the one-pass system against them).
+    #[cfg(test)]
+    pub(crate) fn without_system_passes(&mut self) {
+        self.composed = true;
+    }
+
+    /// Drops the stencil: the distance springs take the general passes (to test those).
+    #[cfg(test)]
+    pub(crate) fn without_stencil(&mut self) {
+        self.stencil = None;
     }
 }
 
@@ -213,19 +227,6 @@ impl PassOrder {
             starts,
         }
     }
-}
-
-/// What the linearisation needs besides the springs: the state, the substep and the warm start.
-#[derive(Clone, Copy)]
-pub(crate) struct State<'a> {
-    /// Positions.
-    pub x: &'a [DVec3],
-    /// Velocities.
-    pub v: &'a [DVec3],
-    /// The substep h.
-    pub h: f64,
-    /// The warm start x₀ of Δv, if any.
-    pub x0: Option<&'a [DVec3]>,
 }
 
 /// Runs `f(start, springs, per, rows, base)` over `order`'s runs of springs (from position
@@ -476,18 +477,22 @@ impl ConstraintSet {
     /// Linearises every spring at `st` into `out`, and adds each spring's share of the
     /// right-hand side, of (A − M) x₀ and of A − M's diagonal to its particles' `rows` (one per
     /// particle). `out`'s pass orders must be this set's over as many particles
-    /// ([`Springs::order`]); without them nothing is added.
+    /// ([`Springs::order`]); without them nothing is added. The stencil runs on `path`.
     pub(crate) fn linearize(
         &self,
         params: &[FamilyParams],
         st: State<'_>,
         out: &mut Springs,
         rows: &mut [RowSums],
+        path: SimdPath,
     ) {
         let Some([o_d, o_b, o_i, o_t, o_s]) = &out.orders else {
             return;
         };
-        linearize_rays((&self.distance, o_d), params, st, &mut out.distance, rows);
+        match out.stencil.as_deref_mut() {
+            Some(stencil) => stencil.linearize(params, st, rows, path),
+            None => linearize_rays((&self.distance, o_d), params, st, &mut out.distance, rows),
+        }
         linearize_outers((&self.dihedral, o_b), params, st, &mut out.dihedral, rows);
         linearize_rays((&self.isometric, o_i), params, st, &mut out.isometric, rows);
         linearize_rays((&self.tethers, o_t), params, st, &mut out.tethers, rows);
@@ -496,12 +501,21 @@ impl ConstraintSet {
     }
 
     /// Adds (A − M) p = (h D + h² K) p to `q`, for `springs` linearised on this set over as many
-    /// particles as `p` holds.
-    pub(crate) fn spring_product(&self, springs: &Springs, p: &[DVec3], q: &mut [DVec3]) {
+    /// particles as `p` holds; the stencil runs on `path`.
+    pub(crate) fn spring_product(
+        &self,
+        springs: &mut Springs,
+        p: &[DVec3],
+        q: &mut [DVec3],
+        path: SimdPath,
+    ) {
         let Some([o_d, o_b, o_i, o_t, o_s]) = &springs.orders else {
             return;
         };
-        product_rays((&self.distance, o_d), &springs.distance, p, q);
+        match springs.stencil.as_deref_mut() {
+            Some(stencil) => stencil.product(p, q, path),
+            None => product_rays((&self.distance, o_d), &springs.distance, p, q),
+        }
         product_outers((&self.dihedral, o_b), &springs.dihedral, p, q);
         product_rays((&self.isometric, o_i), &springs.isometric, p, q);
         product_rays((&self.tethers, o_t), &springs.tethers, p, q);

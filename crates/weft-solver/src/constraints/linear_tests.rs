@@ -177,16 +177,32 @@ fn rank_one_shapes_have_the_gradient_and_hessian_their_coefficients_give() {
     }
 }
 
-/// The springs linearised at (`x`, `v`) with warm start `x0`: the springs and each particle's
-/// row sums.
+/// How the distance springs are linearised: by the general passes, or by stencil on a path.
+#[derive(Clone, Copy, Debug)]
+enum Passes {
+    General,
+    Stencil(SimdPath),
+}
+
+/// The springs linearised at (`x`, `v`) with warm start `x0` by `passes`: the springs and
+/// each particle's row sums.
 fn linearized(
     cs: &ConstraintSet,
     params: &[FamilyParams],
     (x, v, x0): (&[DVec3], &[DVec3], &[DVec3]),
     h: f64,
+    passes: Passes,
 ) -> (Springs, Vec<RowSums>) {
     let mut springs = Springs::default();
     springs.order(cs, x.len());
+    assert!(springs.stencil.is_some(), "a grid's springs form a stencil");
+    let path = match passes {
+        Passes::General => {
+            springs.without_stencil();
+            SimdPath::widest()
+        }
+        Passes::Stencil(path) => path,
+    };
     let mut sums = vec![RowSums::default(); x.len()];
     let st = State {
         x,
@@ -194,14 +210,18 @@ fn linearized(
         h,
         x0: Some(x0),
     };
-    cs.linearize(params, st, &mut springs, &mut sums);
+    cs.linearize(params, st, &mut springs, &mut sums, path);
     (springs, sums)
 }
 
-/// (A − M) p through the product pass.
-fn product(cs: &ConstraintSet, springs: &Springs, p: &[DVec3]) -> Vec<DVec3> {
+/// (A − M) p through the product pass, on the path of `passes`.
+fn product(cs: &ConstraintSet, springs: &mut Springs, p: &[DVec3], passes: Passes) -> Vec<DVec3> {
+    let path = match passes {
+        Passes::General => SimdPath::widest(),
+        Passes::Stencil(path) => path,
+    };
     let mut q = vec![DVec3::ZERO; p.len()];
-    cs.spring_product(springs, p, &mut q);
+    cs.spring_product(springs, p, &mut q, path);
     q
 }
 
@@ -213,23 +233,27 @@ fn random_vectors(n: usize, seed: u64) -> Vec<DVec3> {
 
 #[test]
 fn rows_summed_by_the_passes_match_the_serial_springs() {
-    for bending in [Family::BendDihedral, Family::BendIsometric] {
+    let passes = [Passes::General, Passes::Stencil(SimdPath::widest())];
+    for (bending, passes) in [Family::BendDihedral, Family::BendIsometric]
+        .into_iter()
+        .flat_map(|b| passes.map(|p| (b, p)))
+    {
         let (cs, params, x, v) = crumpled(bending);
         let n = x.len();
         let h = 1e-3;
         let x0 = random_vectors(n, 0x0bad_cafe_f00d_0001);
-        let (springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h);
+        let (mut springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h, passes);
         // A − M applied to x₀, and to a fresh vector through the product pass.
         let (want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
         let (kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
-        let q = product(&cs, &springs, &x0);
+        let q = product(&cs, &mut springs, &x0, passes);
         let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
         let mut curved = 0;
         for i in 0..n {
             let ax = sums[i].ax;
             assert!(
                 close(ax, want_ax[i], scale),
-                "{bending:?} row {i}: {ax} {}",
+                "{bending:?} {passes:?} row {i}: {ax} {}",
                 want_ax[i]
             );
             assert!(close(q[i], want_ax[i], scale));
@@ -269,14 +293,14 @@ fn parts_in_parallel_sum_as_the_serial_springs_on_any_thread_count() {
     );
     let (n, h) = (x.len(), 1e-3);
     let x0 = random_vectors(n, 0x0bad_cafe_f00d_0003);
-    let run = |threads: usize| {
+    let run = |threads: usize, passes: Passes| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .expect("pool");
         pool.install(|| {
-            let (springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h);
-            let q = product(&cs, &springs, &x0);
+            let (mut springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h, passes);
+            let q = product(&cs, &mut springs, &x0, passes);
             let rows: Vec<[DVec3; 3]> = sums
                 .iter()
                 .map(|r| [r.b, r.ax, r.d.mul(DVec3::ONE)])
@@ -284,19 +308,32 @@ fn parts_in_parallel_sum_as_the_serial_springs_on_any_thread_count() {
             (rows, q)
         })
     };
-    let (rows, q) = run(1);
-    assert_eq!(
-        (rows.clone(), q.clone()),
-        run(2),
-        "1 and 2 threads, same bits"
-    );
     let (want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
     let (kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);
     let scale = want_ax.iter().map(|a| a.length()).fold(0.0, f64::max);
-    for i in 0..n {
-        assert!(close(q[i], want_ax[i], scale), "product row {i}");
-        assert!(close(rows[i][1], want_ax[i], scale), "A x0 row {i}");
-        assert!(close(rows[i][0], f[i] * h - kv[i], scale), "b row {i}");
+    let stencil = run(1, Passes::Stencil(SimdPath::Scalar));
+    for passes in [Passes::General, Passes::Stencil(SimdPath::widest())] {
+        let (rows, q) = run(1, passes);
+        assert_eq!(
+            (rows.clone(), q.clone()),
+            run(2, passes),
+            "{passes:?}: 1 and 2 threads"
+        );
+        for i in 0..n {
+            assert!(
+                close(q[i], want_ax[i], scale),
+                "{passes:?}: product row {i}"
+            );
+            assert!(
+                close(rows[i][1], want_ax[i], scale),
+                "{passes:?}: A x0 row {i}"
+            );
+            let b = f[i] * h - kv[i];
+            assert!(close(rows[i][0], b, scale), "{passes:?}: b row {i}");
+        }
+        if let Passes::Stencil(path) = passes {
+            assert_eq!((rows, q), stencil, "{path:?} and scalar lanes, same bits");
+        }
     }
 }
 
@@ -306,8 +343,9 @@ fn a_flat_isometric_hinge_keeps_its_stiffness_in_the_system() {
     let n = x.len();
     let h = 1e-3;
     let x0 = random_vectors(n, 0x0bad_cafe_f00d_0002);
-    let (springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h);
-    let q = product(&cs, &springs, &x0);
+    let passes = Passes::Stencil(SimdPath::widest());
+    let (mut springs, sums) = linearized(&cs, &params, (&x, &v, &x0), h, passes);
+    let q = product(&cs, &mut springs, &x0, passes);
     // The reference has no term for a hinge without a direction: add h² k a aᵀ ⊗ I by hand.
     let (mut want_ax, f) = reference_all(&cs, &params, &x, &v, (h * h, h), &x0);
     let (mut kv, _) = reference_all(&cs, &params, &x, &v, (h * h, 0.0), &v);

@@ -9,6 +9,7 @@
 //! - `seam`: a seam whose rest length ramps to zero over a closing time, then holds.
 //! - `block`: a coloured struct-of-arrays block of one shape and its projection.
 //! - `linear`: springs linearised at the current state, for implicit mass-spring.
+//! - `linear_rows`: the state a linearisation reads and the row sums it adds per particle.
 //! - `lanes`: the distance projection over `L` lanes at once.
 //! - `dihedral_lanes`: the dihedral projection over `L` lanes in explicit vectors.
 //! - `isometric_lanes`: the isometric projection over `L` lanes in explicit vectors.
@@ -20,6 +21,9 @@
 //!   gradients where one sweep leaves it soft, and its residual.
 //! - `spring_stencil`: explicit distance springs on a grid as fixed index offsets, their
 //!   forces in f32 lanes.
+//! - `ray_stencil`: implicit distance springs on a grid by slot: their linearisation and
+//!   products in f64 lanes; `ray_system`, the implicit system in one pass a step where they
+//!   are all the springs.
 //! - `parts`: contiguous particle ranges that let one colour be projected in parallel.
 
 mod block;
@@ -30,12 +34,14 @@ mod isometric;
 mod isometric_lanes;
 pub(crate) mod lanes;
 mod linear;
+mod linear_rows;
 #[cfg(test)]
 pub(crate) use linear::tests as linear_tests;
 mod parts;
 mod quad_cg;
 mod quad_lanes;
 mod quad_sweep;
+mod ray_stencil;
 mod seam;
 mod spring_force;
 mod spring_stencil;
@@ -45,7 +51,9 @@ pub(crate) use block::{Block, BlockBuilder, Rule};
 pub use dihedral::Dihedral;
 pub use distance::Distance;
 pub use isometric::Isometric;
-pub(crate) use linear::{RowSums, Springs, State as LinearState};
+pub(crate) use linear::Springs;
+pub(crate) use linear_rows::{RowSums, State as LinearState};
+pub(crate) use ray_stencil::SystemRows;
 pub use seam::Seam;
 pub(crate) use spring_stencil::{Mirror, Ring, SpringStencil, WIDEST};
 pub use tether::Tether;

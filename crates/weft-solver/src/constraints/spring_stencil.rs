@@ -116,18 +116,7 @@ impl SpringStencil {
     /// one: more than [`MOST_SLOTS`] (offset, group) slots, or two springs of one group between
     /// the same two particles.
     pub fn build(block: &Block<2, Distance>, n: usize) -> Option<Self> {
-        let mut slots: BTreeSet<(isize, u32)> = BTreeSet::new();
-        for (&[p, q], &group) in block.particles.iter().zip(&block.group) {
-            let o = q as isize - p as isize;
-            if o == 0 {
-                return None;
-            }
-            slots.extend([(o, group), (-o, group)]);
-            if slots.len() > MOST_SLOTS {
-                return None;
-            }
-        }
-        let slots: Vec<(isize, u32)> = slots.into_iter().collect();
+        let slots = slots_of(block)?;
         let stride = n.next_multiple_of(WIDEST);
         let mut rest = vec![-1.0f32; slots.len() * stride];
         for ((&[p, q], &group), shape) in
@@ -320,6 +309,23 @@ impl SpringStencil {
             }
         }
     }
+}
+
+/// The (offset, group) slots of `block`'s springs, ascending, each spring's in both directions;
+/// `None` beyond [`MOST_SLOTS`] or for a spring from a particle to itself.
+pub(super) fn slots_of(block: &Block<2, Distance>) -> Option<Vec<(isize, u32)>> {
+    let mut slots: BTreeSet<(isize, u32)> = BTreeSet::new();
+    for (&[p, q], &group) in block.particles.iter().zip(&block.group) {
+        let o = q as isize - p as isize;
+        if o == 0 {
+            return None;
+        }
+        slots.extend([(o, group), (-o, group)]);
+        if slots.len() > MOST_SLOTS {
+            return None;
+        }
+    }
+    Some(slots.into_iter().collect())
 }
 
 /// `W` values of `src` from `at` (the margins and the stride keep every load inside).

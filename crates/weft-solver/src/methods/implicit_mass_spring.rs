@@ -25,10 +25,11 @@ use rayon::prelude::*;
 
 use super::{ForcePass, SpringWork, Strategy};
 use crate::chunk::CHUNK;
-use crate::constraints::{ConstraintSet, LinearState, RowSums, Rule, Springs};
+use crate::constraints::{ConstraintSet, LinearState, RowSums, Rule, Springs, SystemRows};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
-use crate::sparse::{Operator, Sym3, solve};
+use crate::sparse::{Operator, Sym3, direction, solve};
+use weft_simd::SimdPath;
 
 /// Springs integrated with backward Euler: unconditionally stable, numerically damped.
 pub(crate) struct ImplicitMassSpring;
@@ -36,20 +37,25 @@ pub(crate) struct ImplicitMassSpring;
 /// A = M + h D + h² K, filtered: zero on the rows of particles with inverse mass 0.
 struct System<'a> {
     constraints: &'a ConstraintSet,
-    springs: &'a Springs,
+    springs: &'a mut Springs,
     w: &'a [f64],
+    simd: SimdPath,
 }
 
 impl Operator for System<'_> {
     fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64 {
         let w = self.w;
+        if let Some(stencil) = self.springs.sole_stencil() {
+            return stencil.system_product(w, p, q, self.simd);
+        }
         q.par_chunks_mut(CHUNK).enumerate().for_each(|(c, q)| {
             for (j, q) in q.iter_mut().enumerate() {
                 let i = c * CHUNK + j;
                 *q = if w[i] > 0.0 { p[i] / w[i] } else { DVec3::ZERO };
             }
         });
-        self.constraints.spring_product(self.springs, p, q);
+        self.constraints
+            .spring_product(self.springs, p, q, self.simd);
         let partials: Vec<f64> = q
             .par_chunks_mut(CHUNK)
             .enumerate()
@@ -67,6 +73,13 @@ impl Operator for System<'_> {
             })
             .collect();
         partials.iter().sum()
+    }
+
+    fn next_direction(&mut self, z: &[DVec3], beta: Option<f64>, p: &mut [DVec3]) {
+        match self.springs.sole_stencil() {
+            Some(stencil) => stencil.next_direction(z, beta, p),
+            None => direction(z, beta, p),
+        }
     }
 }
 
@@ -107,59 +120,31 @@ impl Strategy for ImplicitMassSpring {
             scratch,
             ..
         } = work;
-        // Each row starts with M's share: b = h M a_ext, M x₀ and M; the springs add theirs.
-        sums.resize(n, RowSums::default());
-        sums.par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, sums)| {
-                for (j, row) in sums.iter_mut().enumerate() {
-                    let i = c * CHUNK + j;
-                    let m = if w[i] > 0.0 { 1.0 / w[i] } else { 0.0 };
-                    *row = RowSums {
-                        b: accel[i] * (m * h),
-                        ax: dv[i] * m,
-                        d: Sym3::scaled_identity(m),
-                    };
-                }
-            });
-        let st = LinearState {
-            x: &particles.positions,
-            v: &particles.velocities,
-            h,
-            x0: warm.then_some(&dv[..]),
-        };
-        constraints.linearize(params, st, springs, sums);
         pinv.resize(n, Sym3::default());
         r.resize(n, DVec3::ZERO);
-        // Per particle: r = b − A x₀ and the block-Jacobi inverse; filtered particles get zeros
-        // (Baraff & Witkin's S).
-        let sums_ref = &*sums;
-        let partials: Vec<f64> = r
-            .par_chunks_mut(CHUNK)
-            .zip(pinv.par_chunks_mut(CHUNK))
-            .zip(dv.par_chunks_mut(CHUNK))
-            .enumerate()
-            .map(|(c, ((r, pinv), dv))| {
-                let mut bb = 0.0;
-                for j in 0..r.len() {
-                    let i = c * CHUNK + j;
-                    if w[i] <= 0.0 {
-                        (r[j], pinv[j], dv[j]) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
-                        continue;
-                    }
-                    let row = &sums_ref[i];
-                    r[j] = row.b - row.ax;
-                    pinv[j] = row.d.inverse();
-                    bb += row.b.dot(row.b);
-                }
-                bb
-            })
-            .collect();
-        let b_norm2: f64 = partials.iter().sum();
+        let state = (particles, h, warm);
+        let b_norm2 = match springs.sole_stencil() {
+            Some(stencil) => {
+                stencil.linearize_terms(params, linear_state(state, dv), pass.simd);
+                let rows = SystemRows {
+                    w,
+                    accel,
+                    x0: dv,
+                    r,
+                    pinv,
+                };
+                stencil.system_rows(rows, h, warm, pass.simd)
+            }
+            None => {
+                let system = (constraints, params, &mut *springs, pass.simd);
+                general_rows(system, state, sums, (dv, r, pinv), accel)
+            }
+        };
         let mut system = System {
             constraints,
             springs,
             w,
+            simd: pass.simd,
         };
         let outcome = solve(&mut system, pinv, b_norm2, dv, r, pass.cg, scratch, &|| {
             pass.stopping()
@@ -177,6 +162,75 @@ impl Strategy for ImplicitMassSpring {
     fn rule(&self, _h: f64) -> Option<Rule> {
         None
     }
+}
+
+/// The linearisation's state: the particles' positions and velocities, the substep and, when
+/// `warm`, the warm start `x0`.
+fn linear_state<'a>(
+    (particles, h, warm): (&'a Particles, f64, bool),
+    x0: &'a [DVec3],
+) -> LinearState<'a> {
+    LinearState {
+        x: &particles.positions,
+        v: &particles.velocities,
+        h,
+        x0: warm.then_some(x0),
+    }
+}
+
+/// The implicit system's rows by the general passes: each particle's row sums (M's share, then
+/// every spring's), then r = b − A x₀ and the block-Jacobi inverse, zeros at filtered
+/// particles (Baraff & Witkin's S). Returns ‖b‖², the chunks' sums added in order.
+fn general_rows(
+    (constraints, params, springs, simd): (&ConstraintSet, &[FamilyParams], &mut Springs, SimdPath),
+    state: (&Particles, f64, bool),
+    sums: &mut Vec<RowSums>,
+    (dv, r, pinv): (&mut [DVec3], &mut [DVec3], &mut [Sym3]),
+    accel: &[DVec3],
+) -> f64 {
+    let (particles, h, _) = state;
+    let (n, w) = (particles.len(), &particles.inv_masses[..]);
+    // Each row starts with M's share: b = h M a_ext, M x₀ and M; the springs add theirs.
+    sums.resize(n, RowSums::default());
+    sums.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, sums)| {
+            for (j, row) in sums.iter_mut().enumerate() {
+                let i = c * CHUNK + j;
+                let m = if w[i] > 0.0 { 1.0 / w[i] } else { 0.0 };
+                *row = RowSums {
+                    b: accel[i] * (m * h),
+                    ax: dv[i] * m,
+                    d: Sym3::scaled_identity(m),
+                };
+            }
+        });
+    constraints.linearize(params, linear_state(state, dv), springs, sums, simd);
+    // Per particle: r = b − A x₀ and the block-Jacobi inverse; filtered particles get zeros
+    // (Baraff & Witkin's S).
+    let sums_ref = &*sums;
+    let partials: Vec<f64> = r
+        .par_chunks_mut(CHUNK)
+        .zip(pinv.par_chunks_mut(CHUNK))
+        .zip(dv.par_chunks_mut(CHUNK))
+        .enumerate()
+        .map(|(c, ((r, pinv), dv))| {
+            let mut bb = 0.0;
+            for j in 0..r.len() {
+                let i = c * CHUNK + j;
+                if w[i] <= 0.0 {
+                    (r[j], pinv[j], dv[j]) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
+                    continue;
+                }
+                let row = &sums_ref[i];
+                r[j] = row.b - row.ax;
+                pinv[j] = row.d.inverse();
+                bb += row.b.dot(row.b);
+            }
+            bb
+        })
+        .collect();
+    partials.iter().sum()
 }
 
 #[cfg(test)]
@@ -210,33 +264,67 @@ mod tests {
         (rr / bb).sqrt()
     }
 
-    #[test]
-    fn each_solve_reaches_its_tolerance_and_the_warm_start_pays() {
-        let (cs, params, x, v) = crumpled(Family::BendIsometric);
-        let n = x.len();
-        let mut w = vec![100.0; n];
+    /// The grid's distance springs alone: a stencil that holds every spring.
+    fn distance_only(cs: &ConstraintSet) -> ConstraintSet {
+        ConstraintSet {
+            distance: cs.distance.clone(),
+            ..ConstraintSet::default()
+        }
+    }
+
+    /// The crumpled grid's particles, two of them pinned.
+    fn pinned(x: Vec<DVec3>, v: Vec<DVec3>) -> Particles {
+        let mut w = vec![100.0; x.len()];
         w[0] = 0.0;
         w[9] = 0.0;
-        let p = Particles {
+        Particles {
             prev_positions: x.clone(),
             positions: x,
             velocities: v,
             inv_masses: w,
-        };
+        }
+    }
+
+    /// A substep of 1/600 s solved down to `tolerance`.
+    fn pass(tolerance: f64) -> ForcePass<'static> {
+        ForcePass {
+            h: 1.0 / 600.0,
+            cg: CgLimits {
+                max_iterations: 500,
+                tolerance,
+            },
+            stop: None,
+            simd: SimdPath::widest(),
+        }
+    }
+
+    #[test]
+    fn each_solve_reaches_its_tolerance_and_the_warm_start_pays() {
+        let (all, params, x, v) = crumpled(Family::BendIsometric);
+        // Every family (the distance springs by stencil, the rest by the general passes), and
+        // the distance springs alone (the system in one pass).
+        for (cs, sole) in [(all.clone(), false), (distance_only(&all), true)] {
+            let p = pinned(x.clone(), v.clone());
+            solves_reach_their_tolerance(&cs, &params, &p, sole);
+        }
+    }
+
+    /// Three solves of one system, to 10⁻⁴, 10⁻⁸ and again 10⁻⁸ from its own solution.
+    fn solves_reach_their_tolerance(
+        cs: &ConstraintSet,
+        params: &[FamilyParams],
+        p: &Particles,
+        sole: bool,
+    ) {
+        let n = p.len();
         let (h, g) = (1.0 / 600.0, DVec3::new(0.0, -9.81, 0.0));
         let mut work = SpringWork::default();
         let mut iterations = Vec::new();
         for tolerance in [1e-4, 1e-8, 1e-8] {
             let mut accel = vec![g; n];
-            let pass = ForcePass {
-                h,
-                cg: CgLimits {
-                    max_iterations: 500,
-                    tolerance,
-                },
-                stop: None,
-            };
-            ImplicitMassSpring.add_internal_forces(&cs, &p, &params, pass, &mut work, &mut accel);
+            let pass = pass(tolerance);
+            ImplicitMassSpring.add_internal_forces(cs, p, params, pass, &mut work, &mut accel);
+            assert_eq!(work.springs.sole_stencil().is_some(), sole);
             let dv: Vec<DVec3> = (0..n)
                 .map(|i| {
                     if p.inv_masses[i] > 0.0 {
@@ -246,7 +334,7 @@ mod tests {
                     }
                 })
                 .collect();
-            let r = true_residual(&cs, &params, &p, g, h, &dv);
+            let r = true_residual(cs, params, p, g, h, &dv);
             assert!(
                 r <= tolerance * 1.001,
                 "tolerance {tolerance}: residual {r}"
@@ -262,6 +350,44 @@ mod tests {
         assert!(
             iterations[2] < iterations[1],
             "the same system from its own solution: {iterations:?}"
+        );
+    }
+
+    #[test]
+    fn the_one_pass_system_gives_the_composed_passes_bits_on_any_thread_count() {
+        let (all, params, x, v) = crumpled(Family::BendIsometric);
+        let (cs, p) = (distance_only(&all), pinned(x, v));
+        let g = DVec3::new(0.0, -9.81, 0.0);
+        let run = |threads: usize, composed: bool| -> Vec<u64> {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            pool.install(|| {
+                let mut work = SpringWork::default();
+                if composed {
+                    work.springs.without_system_passes();
+                }
+                // A cold solve, then two warm ones under other loads.
+                let mut bits = Vec::new();
+                for k in 0..3 {
+                    let mut accel = vec![g * (1.0 + k as f64); p.len()];
+                    let pass = pass(1e-8);
+                    ImplicitMassSpring
+                        .add_internal_forces(&cs, &p, &params, pass, &mut work, &mut accel);
+                    assert!(work.last.iterations > 2, "{:?}", work.last);
+                    bits.extend(accel.iter().flat_map(|a| a.to_array().map(f64::to_bits)));
+                }
+                assert_eq!(work.springs.sole_stencil().is_none(), composed);
+                bits
+            })
+        };
+        let one_pass = run(1, false);
+        assert_eq!(one_pass, run(2, false), "1 and 2 threads");
+        assert_eq!(
+            one_pass,
+            run(1, true),
+            "the one-pass system and the composed passes"
         );
     }
 }

@@ -58,6 +58,7 @@ mod tests {
     use crate::constraints::linear_tests::crumpled;
     use crate::params::Family;
     use crate::sparse::CgLimits;
+    use weft_simd::SimdPath;
 
     /// The slot pass's accelerations under a pool of `threads` threads.
     fn slot_accelerations(
@@ -78,6 +79,7 @@ mod tests {
                 tolerance: 1e-3,
             },
             stop: None,
+            simd: SimdPath::widest(),
         };
         let mut work = SpringWork::default();
         pool.install(|| MassSpring.add_internal_forces(cs, p, params, pass, &mut work, &mut accel));

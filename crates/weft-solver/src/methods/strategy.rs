@@ -9,6 +9,7 @@ use crate::constraints::{ConstraintSet, Rule};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
 use crate::sparse::CgLimits;
+use weft_simd::SimdPath;
 
 /// The substep a force pass is for: its length, the linear solve's limits, and the flag that
 /// abandons the frame.
@@ -20,6 +21,8 @@ pub(crate) struct ForcePass<'a> {
     pub cg: CgLimits,
     /// Raised to abandon the frame: a long solve stops early (see `Solver::set_stop`).
     pub stop: Option<&'a AtomicBool>,
+    /// The kernel path of the lane passes.
+    pub simd: SimdPath,
 }
 
 impl ForcePass<'_> {

@@ -228,6 +228,7 @@ impl Solver {
                     h,
                     cg: s.cg_limits(),
                     stop: self.stop.as_deref(),
+                    simd: path,
                 };
                 strategy.add_internal_forces(
                     &self.constraints,

@@ -26,6 +26,20 @@ pub(crate) struct CgLimits {
 pub(crate) trait Operator {
     /// `q ← A p`; returns p·q summed in chunk order.
     fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64;
+
+    /// The next search direction, `p ← z + β p` (`p ← z` without β), which [`Operator::apply`]
+    /// is given next: an operator may take its own copy of p in the same pass.
+    fn next_direction(&mut self, z: &[DVec3], beta: Option<f64>, p: &mut [DVec3]) {
+        direction(z, beta, p);
+    }
+}
+
+/// `p ← z + β p`, or `p ← z` without β.
+pub(crate) fn direction(z: &[DVec3], beta: Option<f64>, p: &mut [DVec3]) {
+    match beta {
+        Some(beta) => xpby(z, beta, p),
+        None => p.copy_from_slice(z),
+    }
 }
 
 /// What a solve did.
@@ -82,12 +96,13 @@ pub(crate) fn solve(
 ) -> Outcome {
     let n = x.len();
     let PcgScratch { z, p, q } = scratch;
+    // Each is written whole before it is read (z by the preconditioner, p from z, q by the
+    // operator): only the length is set.
     for v in [&mut *z, &mut *p, &mut *q] {
-        v.clear();
         v.resize(n, DVec3::ZERO);
     }
     let (mut delta, mut rr) = precondition(pinv, r, z);
-    p.copy_from_slice(z);
+    op.next_direction(z, None, p);
     let target = limits.tolerance * limits.tolerance * b_norm2;
     let mut iterations = 0;
     while rr > target && iterations < limits.max_iterations && !stopping() {
@@ -110,7 +125,7 @@ pub(crate) fn solve(
         iterations += 1;
         let beta = next / delta;
         delta = next;
-        xpby(z, beta, p);
+        op.next_direction(z, Some(beta), p);
     }
     let residual = if b_norm2 > 0.0 {
         (rr / b_norm2).sqrt()
