@@ -32,6 +32,31 @@ pub(crate) struct RowSums {
 }
 
 impl RowSums {
+    /// M's share of a particle's row, M = 1/w (zero where w = 0): b = h M a_ext, M x₀ and M.
+    /// The springs' shares are added to it.
+    #[inline(always)]
+    pub(crate) fn of_mass(w: f64, accel: DVec3, x0: DVec3, h: f64) -> Self {
+        let m = if w > 0.0 { 1.0 / w } else { 0.0 };
+        Self {
+            b: accel * (m * h),
+            ax: x0 * m,
+            d: Sym3::scaled_identity(m),
+        }
+    }
+
+    /// From the whole row, the particle's residual r = b − A x₀ and block-Jacobi inverse;
+    /// zeros, and x₀ = 0, where w = 0 (Baraff & Witkin's filter). Returns b·b (0 filtered).
+    #[inline(always)]
+    pub(crate) fn finish(&self, w: f64, r: &mut DVec3, pinv: &mut Sym3, x0: &mut DVec3) -> f64 {
+        if w <= 0.0 {
+            (*r, *pinv, *x0) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
+            return 0.0;
+        }
+        *r = self.b - self.ax;
+        *pinv = self.d.inverse();
+        self.b.dot(self.b)
+    }
+
     /// Adds a term read with weight `a`: b and A x₀ scaled by a, the diagonal block by a².
     #[inline(always)]
     pub(super) fn add(&mut self, a: f64, b: DVec3, ax: DVec3, d: Sym3) {

@@ -11,7 +11,7 @@ use pulp::Simd;
 use rayon::prelude::*;
 use weft_simd::{LaneKernel, Ops, SimdPath, on_path, store3};
 
-use super::{Geometry, RayStencil, lane, load, ray_sum, row_sums};
+use super::{Geometry, RayStencil, RowSums, lane, load, ray_sum, row_sums};
 use crate::chunk::CHUNK;
 use crate::sparse::Sym3;
 
@@ -217,17 +217,10 @@ impl LaneKernel for Setup<'_> {
             let sums = row_sums::<S, L>(Ops(s), geo, terms, lanes_x0, geo.margin + start + j);
             for l in 0..L.min(r.len() - j) {
                 let k = j + l;
-                if w[k] <= 0.0 {
-                    (r[k], pinv[k], x0[k]) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
-                    continue;
-                }
                 // M's share first, then the springs' (the general passes' order).
-                let m = 1.0 / w[k];
-                let b = accel[k] * (m * h) + sums.b(l);
-                let ax = x0[k] * m + sums.ax(l);
-                r[k] = b - ax;
-                pinv[k] = Sym3::scaled_identity(m).add(sums.d(l)).inverse();
-                bb += b.dot(b);
+                let mut row = RowSums::of_mass(w[k], accel[k], x0[k], h);
+                row.add(1.0, sums.b(l), sums.ax(l), sums.d(l));
+                bb += row.finish(w[k], &mut r[k], &mut pinv[k], &mut x0[k]);
             }
         }
         bb

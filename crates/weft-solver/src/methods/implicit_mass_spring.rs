@@ -197,12 +197,7 @@ fn general_rows(
         .for_each(|(c, sums)| {
             for (j, row) in sums.iter_mut().enumerate() {
                 let i = c * CHUNK + j;
-                let m = if w[i] > 0.0 { 1.0 / w[i] } else { 0.0 };
-                *row = RowSums {
-                    b: accel[i] * (m * h),
-                    ax: dv[i] * m,
-                    d: Sym3::scaled_identity(m),
-                };
+                *row = RowSums::of_mass(w[i], accel[i], dv[i], h);
             }
         });
     constraints.linearize(params, linear_state(state, dv), springs, sums, simd);
@@ -218,14 +213,7 @@ fn general_rows(
             let mut bb = 0.0;
             for j in 0..r.len() {
                 let i = c * CHUNK + j;
-                if w[i] <= 0.0 {
-                    (r[j], pinv[j], dv[j]) = (DVec3::ZERO, Sym3::default(), DVec3::ZERO);
-                    continue;
-                }
-                let row = &sums_ref[i];
-                r[j] = row.b - row.ax;
-                pinv[j] = row.d.inverse();
-                bb += row.b.dot(row.b);
+                bb += sums_ref[i].finish(w[i], &mut r[j], &mut pinv[j], &mut dv[j]);
             }
             bb
         })
