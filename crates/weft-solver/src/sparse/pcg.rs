@@ -80,6 +80,38 @@ fn precondition(pinv: &[Sym3], r: &[DVec3], z: &mut [DVec3]) -> (f64, f64) {
         .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
 }
 
+/// One pass of an iteration: x += α p, r −= α q, then z = P⁻¹ r; returns (r·z, r·r), each
+/// summed in chunk order (the bits of the update followed by [`precondition`]).
+fn step(
+    alpha: f64,
+    [p, q]: [&[DVec3]; 2],
+    x: &mut [DVec3],
+    r: &mut [DVec3],
+    pinv: &[Sym3],
+    z: &mut [DVec3],
+) -> (f64, f64) {
+    let partials: Vec<(f64, f64)> = (x.par_chunks_mut(CHUNK))
+        .zip(r.par_chunks_mut(CHUNK))
+        .zip(z.par_chunks_mut(CHUNK))
+        .zip(p.par_chunks(CHUNK).zip(q.par_chunks(CHUNK)))
+        .zip(pinv.par_chunks(CHUNK))
+        .map(|((((x, r), z), (p, q)), m)| {
+            let (mut rz, mut rr) = (0.0, 0.0);
+            for j in 0..x.len() {
+                x[j] += p[j] * alpha;
+                r[j] -= q[j] * alpha;
+                z[j] = m[j].mul(r[j]);
+                rz += r[j].dot(z[j]);
+                rr += r[j].dot(r[j]);
+            }
+            (rz, rr)
+        })
+        .collect();
+    partials
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+}
+
 /// Solves A x = b by PCG with the block preconditioner `pinv` (zero on the filtered rows),
 /// from the given `x` and its residual `r` = b − A x (filtered); `b_norm2` = ‖b‖₂². Polls
 /// `stopping` once per iteration.
@@ -111,16 +143,7 @@ pub(crate) fn solve(
             break;
         }
         let alpha = delta / pq;
-        x.par_chunks_mut(CHUNK)
-            .zip(r.par_chunks_mut(CHUNK))
-            .zip(p.par_chunks(CHUNK).zip(q.par_chunks(CHUNK)))
-            .for_each(|((x, r), (p, q))| {
-                for j in 0..x.len() {
-                    x[j] += p[j] * alpha;
-                    r[j] -= q[j] * alpha;
-                }
-            });
-        let (next, next_rr) = precondition(pinv, r, z);
+        let (next, next_rr) = step(alpha, [&*p, &*q], x, r, pinv, z);
         rr = next_rr;
         iterations += 1;
         let beta = next / delta;
@@ -212,6 +235,43 @@ mod tests {
             .map(|a| (DVec3::new(1.0, -0.5, 0.25) - *a).length())
             .fold(0.0, f64::max);
         assert!(worst < 1e-7, "true residual {worst}");
+    }
+
+    #[test]
+    fn the_fused_step_gives_the_update_and_preconditioner_bits() {
+        // Over several chunks, with a filtered (zero) block among them.
+        let n = 3 * CHUNK + 17;
+        let v = |k: usize, s: f64| {
+            let t = k as f64 * s;
+            DVec3::new(t.sin(), (1.3 * t).cos(), (0.7 * t).sin() - 0.2)
+        };
+        let (p, q): (Vec<DVec3>, Vec<DVec3>) = (0..n).map(|k| (v(k, 0.31), v(k, 0.17))).unzip();
+        let pinv: Vec<Sym3> = (0..n)
+            .map(|k| match k % 97 {
+                0 => Sym3::default(),
+                _ => Sym3::scaled_identity(1.0 + (k % 5) as f64)
+                    .add(Sym3::outer(v(k, 0.05), 0.3))
+                    .inverse(),
+            })
+            .collect();
+        let alpha = 0.37;
+        let (mut x, mut r) = ((0..n).map(|k| v(k, 0.11)).collect::<Vec<_>>(), q.clone());
+        r.iter_mut().enumerate().for_each(|(k, r)| *r += v(k, 0.23));
+        let (mut x2, mut r2, mut z, mut z2) = (
+            x.clone(),
+            r.clone(),
+            vec![DVec3::ZERO; n],
+            vec![DVec3::ZERO; n],
+        );
+        let fused = step(alpha, [&p, &q], &mut x, &mut r, &pinv, &mut z);
+        for k in 0..n {
+            x2[k] += p[k] * alpha;
+            r2[k] -= q[k] * alpha;
+        }
+        let apart = precondition(&pinv, &r2, &mut z2);
+        assert_eq!(fused.0.to_bits(), apart.0.to_bits());
+        assert_eq!(fused.1.to_bits(), apart.1.to_bits());
+        assert_eq!((x, r, z), (x2, r2, z2));
     }
 
     #[test]
