@@ -109,6 +109,18 @@ pub(crate) struct Step {
     pub wind: DVec3,
 }
 
+impl Step {
+    /// Whether the air is still and undamped: no drag (then g + 0 · (v_wind − v) is g to the
+    /// bit for finite velocities, as no component of g is −0), and e^(−c h) = 1 (a product
+    /// by 1 changes no bit).
+    pub fn still(&self) -> bool {
+        let negative_zero = |g: f64| g == 0.0 && g.is_sign_negative();
+        self.drag == 0.0
+            && self.keep == 1.0
+            && !self.gravity.to_array().into_iter().any(negative_zero)
+    }
+}
+
 /// One task's particles: `start` (a multiple of [`WIDEST`]) and, from there, its share of the
 /// state and of the next mirror (x then v, per axis), all of one length, a multiple of
 /// [`WIDEST`].
@@ -204,15 +216,16 @@ fn step_in<const W: usize>(
 ) {
     // Without damping the springs need no velocities: the mirror's are neither read nor
     // written.
-    match coef.iter().any(|&[_, c]| c != 0.0) {
-        true => {
-            forces::<W, true>(st, coef, from, p);
-            integrate::<true>(s, from, p);
-        }
-        false => {
-            forces::<W, false>(st, coef, from, p);
-            integrate::<false>(s, from, p);
-        }
+    let damped = coef.iter().any(|&[_, c]| c != 0.0);
+    match damped {
+        true => forces::<W, true>(st, coef, from, p),
+        false => forces::<W, false>(st, coef, from, p),
+    }
+    match (damped, s.still()) {
+        (true, true) => integrate::<true, true>(s, from, p),
+        (true, false) => integrate::<true, false>(s, from, p),
+        (false, true) => integrate::<false, true>(s, from, p),
+        (false, false) => integrate::<false, false>(s, from, p),
     }
 }
 
@@ -240,9 +253,10 @@ fn forces<const W: usize, const DAMPED: bool>(
 
 /// The part's integration from the forces in its scratch, one loop per axis over the part
 /// (the compiler vectorizes it, selects included); the next mirror's velocities only where
-/// `DAMPED` springs read them.
+/// `DAMPED` springs read them; in `STILL` air ([`Step::still`]) without the drag and the
+/// global damping, which would change no bit there.
 #[inline(always)]
-fn integrate<const DAMPED: bool>(s: &Step, from: &Mirror, p: &mut Part<'_>) {
+fn integrate<const DAMPED: bool, const STILL: bool>(s: &Step, from: &Mirror, p: &mut Part<'_>) {
     let (h, inv_h, keep) = (s.h, s.inv_h, s.keep);
     let (g, drag, wind) = (s.gravity.to_array(), s.drag, s.wind.to_array());
     let origin = from.origin.to_array();
@@ -262,11 +276,12 @@ fn integrate<const DAMPED: bool>(s: &Step, from: &Mirror, p: &mut Part<'_>) {
         for ((x, v), ((nx, nv), (&w, &f))) in state.zip(next.zip(given)) {
             let (x0, v0) = (*x, *v);
             // a = g + c_d (v_wind − v) + f w (`Forces::acceleration_of`, then the springs).
-            let acc = (g + drag * (wind - v0)) + f64::from(f) * w;
+            let air = if STILL { g } else { g + drag * (wind - v0) };
+            let acc = air + f64::from(f) * w;
             let free = w > 0.0;
             let x1 = if free { x0 + (v0 + acc * h) * h } else { x0 };
             let v1 = (x1 - x0) * inv_h;
-            let v1 = if free { v1 * keep } else { v1 };
+            let v1 = if !STILL && free { v1 * keep } else { v1 };
             *x = x1;
             *v = v1;
             *nx = (x1 - origin) as f32;
@@ -274,5 +289,101 @@ fn integrate<const DAMPED: bool>(s: &Step, from: &Mirror, p: &mut Part<'_>) {
                 *nv = v1 as f32;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One part's integration of `n` particles (every fifth pinned) from a fixed pseudo-random
+    /// state, by `integrate::<false, STILL>`: the bits of x, v, prev and the next mirror.
+    fn integrated<const STILL: bool>(s: &Step, n: usize) -> Vec<u64> {
+        let wave = |k: usize, f: f64| (k as f64 * f).sin();
+        let axes = |f: f64| -> [Vec<f64>; 3] {
+            std::array::from_fn(|a| (0..n).map(|k| wave(k, f + a as f64)).collect())
+        };
+        let (mut x, mut v, mut prev) = (axes(0.37), axes(1.1), axes(0.0));
+        let w: Vec<f64> = (0..n)
+            .map(|k| {
+                if k % 5 == 0 {
+                    0.0
+                } else {
+                    1.0 + wave(k, 0.3).abs()
+                }
+            })
+            .collect();
+        let mut next: [Vec<f32>; 6] = std::array::from_fn(|_| vec![0.0; n]);
+        let mut scratch = Scratch {
+            ring: Ring::default(),
+            force: std::array::from_fn(|a| {
+                (0..n).map(|k| wave(k, 2.3 + a as f64) as f32).collect()
+            }),
+        };
+        let from = Mirror {
+            origin: DVec3::new(0.1, 0.9, -0.2),
+            ..Mirror::default()
+        };
+        let [x0, x1, x2] = &mut x;
+        let [v0, v1, v2] = &mut v;
+        let [p0, p1, p2] = &mut prev;
+        let [n0, n1, n2, n3, n4, n5] = &mut next;
+        let mut part = Part {
+            start: 0,
+            x: [x0, x1, x2],
+            v: [v0, v1, v2],
+            prev: [p0, p1, p2],
+            w: &w,
+            next: [n0, n1, n2, n3, n4, n5],
+            scratch: &mut scratch,
+            last: true,
+        };
+        integrate::<false, STILL>(s, &from, &mut part);
+        let f64s = x
+            .iter()
+            .chain(&v)
+            .chain(&prev)
+            .flatten()
+            .map(|e| e.to_bits());
+        let f32s = next.iter().flatten().map(|e| u64::from(e.to_bits()));
+        f64s.chain(f32s).collect()
+    }
+
+    #[test]
+    fn still_air_skips_only_what_changes_no_bit() {
+        let still = Step {
+            h: 1.0 / 600.0,
+            inv_h: 600.0,
+            keep: 1.0,
+            gravity: DVec3::new(0.0, -9.81, 0.0),
+            drag: 0.0,
+            wind: DVec3::new(0.0, 0.0, 3.0),
+        };
+        assert!(still.still());
+        let n = 3 * WIDEST;
+        assert!(integrated::<true>(&still, n) == integrated::<false>(&still, n));
+        // Damping or drag is not still air: skipping them would change bits.
+        for s in [
+            Step {
+                keep: 0.999,
+                ..still
+            },
+            Step { drag: 0.1, ..still },
+        ] {
+            assert!(!s.still(), "{s:?}");
+            assert!(
+                integrated::<true>(&s, n) != integrated::<false>(&s, n),
+                "{s:?}"
+            );
+        }
+        // Nor is a −0 in g (−0 + 0 is +0).
+        let signed = DVec3::new(-0.0, -9.81, 0.0);
+        assert!(
+            !Step {
+                gravity: signed,
+                ..still
+            }
+            .still()
+        );
     }
 }
