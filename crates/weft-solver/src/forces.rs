@@ -100,6 +100,7 @@ impl Forces {
     }
 
     /// Gravity and linear drag on a particle moving at `v`: g + c_d (v_wind − v) (m/s²).
+    /// See [`crate::air::still_air`] for when it is g to the bit.
     #[inline(always)]
     pub(crate) fn acceleration_of(&self, v: DVec3) -> DVec3 {
         self.gravity + self.wind.drag * (self.wind.velocity - v)

@@ -39,6 +39,7 @@
 //! - `test_rand` (tests only): a seeded random source for unit tests.
 #![warn(missing_docs)]
 
+mod air;
 mod awake;
 mod builder;
 mod cantilever;

@@ -10,6 +10,7 @@ use glam::DVec3;
 use multiversion::multiversion;
 
 use super::layout::Chunk;
+use crate::air::still_air;
 use crate::forces::Forces;
 use crate::hook::{Contacts, ParticleContacts, ParticleRun};
 use crate::settings::within_bound;
@@ -494,10 +495,9 @@ impl Predict {
         }
     }
 
-    /// No drag (c_d = +0) and gravity not −0 along this axis: then g + c_d (v_wind − v) = g
-    /// exactly for every finite v (c_d (v_wind − v) is ±0, and g + ±0 = g unless g is −0).
+    /// Whether the air along this axis is still ([`still_air`]): a = g for every finite v.
     fn still_air(self) -> bool {
-        self.drag.to_bits() == 0 && self.g.to_bits() != (-0.0f64).to_bits()
+        still_air(self.drag, self.g)
     }
 
     /// [`Self::position`] of a free particle where [`Self::still_air`]: a = g, the same bits

@@ -8,6 +8,7 @@ use glam::DVec3;
 use multiversion::multiversion;
 use rayon::prelude::*;
 
+use crate::air::still_air;
 use crate::chunk::CHUNK;
 use crate::constraints::{Mirror, Ring, SpringStencil, WIDEST};
 use weft_simd::SimdPath;
@@ -110,14 +111,14 @@ pub(crate) struct Step {
 }
 
 impl Step {
-    /// Whether the air is still and undamped: no drag (then g + 0 · (v_wind − v) is g to the
-    /// bit for finite velocities, as no component of g is −0), and e^(−c h) = 1 (a product
-    /// by 1 changes no bit).
+    /// Whether the air is still ([`still_air`] along every axis: a = g to the bit for finite
+    /// velocities) and undamped (e^(−c h) = 1: a product by 1 changes no bit).
     pub fn still(&self) -> bool {
-        let negative_zero = |g: f64| g == 0.0 && g.is_sign_negative();
-        self.drag == 0.0
-            && self.keep == 1.0
-            && !self.gravity.to_array().into_iter().any(negative_zero)
+        let drag = self.drag;
+        self.keep == 1.0
+            && (self.gravity.to_array())
+                .into_iter()
+                .all(|g| still_air(drag, g))
     }
 }
 
