@@ -59,25 +59,33 @@ pub(crate) struct PcgScratch {
     q: Vec<DVec3>,
 }
 
+/// One row of z = P⁻¹ r: z = m r, with r·z and r·r added to `sums`.
+#[inline(always)]
+fn precondition_row(m: &Sym3, r: DVec3, z: &mut DVec3, sums: &mut (f64, f64)) {
+    *z = m.mul(r);
+    sums.0 += r.dot(*z);
+    sums.1 += r.dot(r);
+}
+
+/// The chunks' (r·z, r·r) added in chunk order.
+fn in_chunk_order(partials: Vec<(f64, f64)>) -> (f64, f64) {
+    (partials.iter()).fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+}
+
 /// z = P⁻¹ r over the rows; returns (r·z, r·r), each summed in chunk order.
 fn precondition(pinv: &[Sym3], r: &[DVec3], z: &mut [DVec3]) -> (f64, f64) {
-    let partials: Vec<(f64, f64)> = z
-        .par_chunks_mut(CHUNK)
+    let partials = (z.par_chunks_mut(CHUNK))
         .zip(r.par_chunks(CHUNK))
         .zip(pinv.par_chunks(CHUNK))
         .map(|((z, r), m)| {
-            let (mut rz, mut rr) = (0.0, 0.0);
+            let mut sums = (0.0, 0.0);
             for ((z, r), m) in z.iter_mut().zip(r).zip(m) {
-                *z = m.mul(*r);
-                rz += r.dot(*z);
-                rr += r.dot(*r);
+                precondition_row(m, *r, z, &mut sums);
             }
-            (rz, rr)
+            sums
         })
         .collect();
-    partials
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+    in_chunk_order(partials)
 }
 
 /// One pass of an iteration: x += α p, r −= α q, then z = P⁻¹ r; returns (r·z, r·r), each
@@ -90,26 +98,22 @@ fn step(
     pinv: &[Sym3],
     z: &mut [DVec3],
 ) -> (f64, f64) {
-    let partials: Vec<(f64, f64)> = (x.par_chunks_mut(CHUNK))
+    let partials = (x.par_chunks_mut(CHUNK))
         .zip(r.par_chunks_mut(CHUNK))
         .zip(z.par_chunks_mut(CHUNK))
         .zip(p.par_chunks(CHUNK).zip(q.par_chunks(CHUNK)))
         .zip(pinv.par_chunks(CHUNK))
         .map(|((((x, r), z), (p, q)), m)| {
-            let (mut rz, mut rr) = (0.0, 0.0);
+            let mut sums = (0.0, 0.0);
             for j in 0..x.len() {
                 x[j] += p[j] * alpha;
                 r[j] -= q[j] * alpha;
-                z[j] = m[j].mul(r[j]);
-                rz += r[j].dot(z[j]);
-                rr += r[j].dot(r[j]);
+                precondition_row(&m[j], r[j], &mut z[j], &mut sums);
             }
-            (rz, rr)
+            sums
         })
         .collect();
-    partials
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+    in_chunk_order(partials)
 }
 
 /// Solves A x = b by PCG with the block preconditioner `pinv` (zero on the filtered rows),
