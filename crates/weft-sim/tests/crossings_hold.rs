@@ -3,11 +3,9 @@
 //! (`weft_collide::crossings::measure`, through `Simulation`'s statistics, each solver's
 //! cloths together, a closed seam's two sides as one vertex).
 //!
-//! Single sheets that fold over a collider with no cloth contact turned on cross themselves:
-//! [`AWAITING_MESH_CONTACT`] lists them, and [`they_still_cross_today`] checks that they do,
-//! so the list cannot outlive the contact that empties it. The thin layers (`layers.toml`,
-//! `towel_fold.toml`, `twist.toml`) hold by mesh contact and are checked with the rest; the
-//! twist's turning pins ([`PIN_DRIVEN`]) may force cloth through cloth, but only after the
+//! The single sheets that fold over a collider (`sphere_drop.toml`, `table_drape.toml`,
+//! `mesh_drape.toml`) and the thin layers (`layers.toml`, `towel_fold.toml`, `twist.toml`)
+//! hold by mesh contact and are checked with the rest; the twist's turning pins ([`PIN_DRIVEN`]) may force cloth through cloth, but only after the
 //! contact's fail-safe has reported a pair it could not stop. The walker in two garments
 //! (`layered_outfit.toml`, among [`HEAVY`]) is checked under XPBD alone, every frame.
 
@@ -19,10 +17,6 @@ use weft_solver::Method;
 
 /// Frames each scene runs under each method (2 s at 60 frames a second).
 const FRAMES: u64 = 120;
-
-/// Scenes whose cloth passes through itself today, as measured: a single sheet with no
-/// self-collision that folds over a ball, a table or the bumpy blob folds through itself.
-const AWAITING_MESH_CONTACT: &[&str] = &["mesh_drape.toml", "sphere_drop.toml", "table_drape.toml"];
 
 /// Scenes checked for longer than [`FRAMES`]: `towel_fold.toml` folds its layers together
 /// only after 2 s.
@@ -163,7 +157,7 @@ fn shipped_but(except: &[&[&str]]) -> Vec<PathBuf> {
 
 #[test]
 fn no_shipped_scene_crosses_under_any_method() {
-    let paths = shipped_but(&[AWAITING_MESH_CONTACT, BUILT_TO_EXPLODE, HEAVY]);
+    let paths = shipped_but(&[BUILT_TO_EXPLODE, HEAVY]);
     assert!(paths.len() >= 8, "{paths:?}");
     let mut failed = Vec::new();
     for path in &paths {
@@ -189,20 +183,6 @@ fn no_shipped_scene_crosses_under_any_method() {
         }
     }
     assert!(failed.is_empty(), "{failed:#?}");
-}
-
-#[test]
-fn they_still_cross_today() {
-    for &name in AWAITING_MESH_CONTACT {
-        let runs = crossings_under_every_method(&scenes_dir().join(name), &[], FRAMES);
-        for run in &runs {
-            println!("{name} under {}: {run:?}", run.method);
-        }
-        assert!(
-            runs.iter().any(|r| r.worst.is_some()),
-            "{name} no longer crosses under any method: move it out of AWAITING_MESH_CONTACT"
-        );
-    }
 }
 
 #[test]
