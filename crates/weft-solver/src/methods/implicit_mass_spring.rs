@@ -149,11 +149,15 @@ impl Strategy for ImplicitMassSpring {
         let outcome = solve(&mut system, pinv, b_norm2, dv, r, pass.cg, scratch, &|| {
             pass.stopping()
         });
-        for ((a, dv), &w) in accel.iter_mut().zip(dv.iter()).zip(w) {
-            if w > 0.0 {
-                *a = *dv / h;
-            }
-        }
+        (accel.par_chunks_mut(CHUNK))
+            .zip(dv.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
+            .for_each(|(a, (dv, w))| {
+                for ((a, dv), &w) in a.iter_mut().zip(dv).zip(w) {
+                    if w > 0.0 {
+                        *a = *dv / h;
+                    }
+                }
+            });
         work.iterations += outcome.iterations;
         work.worst = work.worst.max(outcome.residual);
         work.last = outcome;

@@ -140,8 +140,9 @@ pub(crate) fn solve(
     let (mut delta, mut rr) = precondition(pinv, r, z);
     op.next_direction(z, None, p);
     let target = limits.tolerance * limits.tolerance * b_norm2;
+    let go_on = |rr: f64, iterations: u32| rr > target && iterations < limits.max_iterations;
     let mut iterations = 0;
-    while rr > target && iterations < limits.max_iterations && !stopping() {
+    while go_on(rr, iterations) && !stopping() {
         let pq = op.apply(p, q);
         if pq.is_nan() || pq <= 0.0 {
             break;
@@ -150,6 +151,10 @@ pub(crate) fn solve(
         let (next, next_rr) = step(alpha, [&*p, &*q], x, r, pinv, z);
         rr = next_rr;
         iterations += 1;
+        if !go_on(rr, iterations) {
+            // Done: the next direction would go unused.
+            break;
+        }
         let beta = next / delta;
         delta = next;
         op.next_direction(z, Some(beta), p);
