@@ -5,8 +5,9 @@
 //!
 //! The single sheets that fold over a collider (`sphere_drop.toml`, `table_drape.toml`,
 //! `mesh_drape.toml`) and the thin layers (`layers.toml`, `towel_fold.toml`, `twist.toml`)
-//! hold by mesh contact and are checked with the rest; the twist's turning pins ([`PIN_DRIVEN`]) may force cloth through cloth, but only after the
-//! contact's fail-safe has reported a pair it could not stop. The walker in two garments
+//! hold by mesh contact and are checked with the rest; the twist's turning pins
+//! ([`PIN_DRIVEN`]) may force cloth through cloth, but only after the contact's fail-safe has
+//! reported a pair it could not stop. The walker in two garments
 //! (`layered_outfit.toml`, among [`HEAVY`]) is checked under XPBD alone, every frame.
 
 use std::path::{Path, PathBuf};
