@@ -303,7 +303,7 @@ def dressed(r):
           "2,374 particles, a 5,126-triangle skinned body) | ms/frame |")
     print("|---|---|")
     for f, label in [("glb cape: solve + skinned body + self-collision",
-                      "solve + skinned-body contact + self-collision"),
+                      "solve + skinned-body contact + mesh contact (the scene's)"),
                      ("glb cape: solve + skinned body", "solve + skinned-body contact"),
                      ("glb cape: solve only", "solve only (no contact)"),
                      *[(f"glb cape 8k, frame {n}: {what}",
@@ -645,8 +645,9 @@ SPEED_ROWS = [
       "90² cloth")),
     ("dressed character", "`character.toml`: the walker in its T-shirt", "all",
      (DRESSED, "solve + body contact + self-collision", "ms/frame", "the walker in its T-shirt")),
-    ("skinned glTF character", "`glb_character.toml`: a cape on a jumping body", "all",
-     (DRESSED, "solve + skinned-body contact + self-collision", "ms/frame", "the BCN glTF")),
+    ("skinned glTF character", "`glb_character.toml`: a cape on a jumping body, mesh contact", "all",
+     (DRESSED, "solve + skinned-body contact + mesh contact (the scene's)", "ms/frame",
+      "the BCN glTF")),
     ("`weft run --out` (particles, the default)", "`reference.toml` at 128²", "all",
      (LOGGING, "`--log particles` (the default): positions, no compression",
       "128² reference ms/frame", None)),

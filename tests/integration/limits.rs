@@ -283,7 +283,7 @@ fn peak_memory_stays_within_the_estimate_on_every_shipped_scene_and_thick_cloths
         .collect();
     scenes.sort();
     assert!(scenes.len() >= 10, "{scenes:?}");
-    // Self-collision lists that hold most pairs of particles: the estimate counts them.
+    // Particle contact's lists that hold most pairs of particles: the estimate counts them.
     let sheet = |name: &str, n: usize, y: f64, t: f64| {
         format!(
             "[cloth.{name}]\nresolution = [{n}, {n}]\norientation = \"horizontal\"\n\
@@ -291,12 +291,13 @@ fn peak_memory_stays_within_the_estimate_on_every_shipped_scene_and_thick_cloths
         )
     };
     // 1 m thick, as thick as a 1 m sheet may be: every pair within reach.
-    let two = sheet("a", 48, 1.001, 1.0) + &sheet("b", 48, 1.0, 1.0) + "[self_collision]\n";
+    let particles = "[self_collision]\ncontact = \"particles\"\n";
+    let two = sheet("a", 48, 1.001, 1.0) + &sheet("b", 48, 1.0, 1.0) + particles;
     scenes.push(write(&dir, "two.toml", &two));
     scenes.push(write(
         &dir,
         "thick.toml",
-        &(sheet("a", 96, 1.0, 0.5) + "[self_collision]\n"),
+        &(sheet("a", 96, 1.0, 0.5) + particles),
     ));
     for scene in &scenes {
         // `explode.toml` shows mass-spring blowing up; with enough substeps it runs on.

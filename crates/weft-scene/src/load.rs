@@ -350,17 +350,22 @@ mod tests {
     }
 
     #[test]
-    fn contact_is_particles_unless_the_scene_asks_for_the_mesh() {
+    fn contact_is_the_mesh_unless_the_scene_asks_for_particles() {
         let spec = |scene: Scene| scene.self_collision.expect("self-collision on");
-        assert_eq!(
-            spec(self_collision("").expect("valid")).contact,
-            ContactKind::Particles
-        );
-        let mesh = self_collision("contact = \"mesh\"\n").expect("valid");
+        let mesh = self_collision("").expect("valid");
         assert_eq!(spec(mesh.clone()).contact, ContactKind::Mesh);
         let groups = mesh.build().expect("builds");
         let world = groups[0].world.as_ref().expect("a collision world");
         assert!(world.cloth_contact_stats().is_some(), "mesh contact is on");
+        let particles = self_collision("contact = \"particles\"\n").expect("valid");
+        assert_eq!(spec(particles.clone()).contact, ContactKind::Particles);
+        let groups = particles.build().expect("builds");
+        let world = groups[0].world.as_ref().expect("a collision world");
+        assert!(world.cloth_contact_stats().is_none(), "mesh contact is off");
+        assert!(
+            world.self_collision_lists().is_some(),
+            "particle contact is on"
+        );
         let err = self_collision("contact = \"edges\"\n")
             .expect_err("no such contact")
             .to_string();

@@ -1,12 +1,13 @@
-//! The memory estimate's bound on self-collision's candidate pairs against the pairs the
-//! list actually holds, frame by frame, on the shipped self-collision scenes and on thick
+//! The memory estimate's bound on particle contact's candidate pairs against the pairs the
+//! list actually holds, frame by frame, on the shipped scene of that contact and on thick
 //! cloths whose lists hold most pairs of particles.
 
 use crate::common;
 
 use weft_scene::{Scene, from_text};
 
-/// Two `n`×`n` sheets of 1 m, `gap` apart, `thickness` thick, colliding with each other.
+/// Two `n`×`n` sheets of 1 m, `gap` apart, `thickness` thick, kept apart from each other
+/// particle by particle.
 fn two_sheets(n: usize, gap: f64, thickness: f64) -> String {
     let sheet = |name: &str, y: f64| {
         format!(
@@ -15,7 +16,7 @@ fn two_sheets(n: usize, gap: f64, thickness: f64) -> String {
         )
     };
     format!(
-        "[sim]\nsubsteps = 4\n\n{}{}[self_collision]\nenabled = true\n",
+        "[sim]\nsubsteps = 4\n\n{}{}[self_collision]\nenabled = true\ncontact = \"particles\"\n",
         sheet("upper", 1.0 + gap),
         sheet("lower", 1.0)
     )
@@ -26,7 +27,7 @@ fn one_sheet(n: usize, thickness: f64) -> String {
     format!(
         "[sim]\nsubsteps = 4\n\n[cloth.sheet]\nresolution = [{n}, {n}]\nsize = [1.0, 1.0]\n\
          orientation = \"vertical\"\npins = [\"top\"]\nthickness = {thickness}\n\n\
-         [self_collision]\nenabled = true\n"
+         [self_collision]\nenabled = true\ncontact = \"particles\"\n"
     )
 }
 
