@@ -128,10 +128,10 @@ fn a_scene_file_that_is_a_device_is_refused() {
 #[test]
 fn sigint_while_self_collision_lists_a_thick_cloth_stops_within_a_second() {
     // A 512² sheet of 1 m, 1 m thick (as thick as a cloth may be: its own width), kept apart
-    // particle by particle (the thick cloth's contact): every
-    // particle lies within reach (at least twice the thickness) of every other, so the first
-    // list build tests 3·10¹⁰ pairs (all exempt, so it takes no memory): minutes of work
-    // inside the first substep, where the solver's own per-substep poll cannot see a stop.
+    // particle by particle (the thick cloth's contact): every particle lies within reach (at
+    // least twice the thickness) of every other, so the first list build tests 3·10¹⁰ pairs
+    // (all exempt, so it takes no memory): minutes of work inside the first substep, where
+    // the solver's own per-substep poll cannot see a stop.
     let dir = temp_dir("thick-self-collision");
     let scene = write(
         &dir,

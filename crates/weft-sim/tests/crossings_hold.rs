@@ -13,6 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
+use weft_collide::ClothContactStats;
 use weft_scene::Override;
 use weft_sim::Simulation;
 use weft_solver::Method;
@@ -118,17 +119,18 @@ pub fn crossings_under(path: &Path, method: Method, extra: &[String], frames: u6
         }
     }
     run.forced = forced_so_far(&sim);
-    run.mesh = (sim.groups.iter())
-        .any(|g| (g.world.as_ref()).is_some_and(|w| w.cloth_contact_stats().is_some()));
+    run.mesh = mesh_contact(&sim).next().is_some();
     run
+}
+
+/// The statistics of every solver's mesh contact (none where it is off).
+fn mesh_contact(sim: &Simulation) -> impl Iterator<Item = ClothContactStats> + '_ {
+    (sim.groups.iter()).filter_map(|g| g.world.as_ref()?.cloth_contact_stats())
 }
 
 /// Pairs forced through each other by pins so far, over every solver's mesh contact.
 fn forced_so_far(sim: &Simulation) -> u64 {
-    (sim.groups.iter())
-        .filter_map(|g| g.world.as_ref()?.cloth_contact_stats())
-        .map(|s| s.forced_so_far)
-        .sum()
+    mesh_contact(sim).map(|s| s.forced_so_far).sum()
 }
 
 /// The scene at `path` with every cloth switched to `method` (one solver for all).
