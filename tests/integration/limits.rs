@@ -83,6 +83,29 @@ fn a_scene_too_big_for_the_memory_is_refused_before_it_is_built() {
 }
 
 #[test]
+fn a_contact_list_too_big_for_the_memory_names_the_thickness_and_what_it_pairs() {
+    // A 96² sheet 0.2 m thick: gigabytes of listed pairs under either contact (mesh about
+    // 24 GiB, particles about 3.8).
+    let scene = |contact: &str| {
+        format!(
+            "[cloth.c]\nresolution = [96, 96]\nthickness = 0.2\n\n\
+             [self_collision]\ncontact = \"{contact}\"\n"
+        )
+    };
+    for (contact, pairs) in [
+        ("mesh", "pairs of elements (vertex–triangle and edge–edge)"),
+        ("particles", "pairs of particles"),
+    ] {
+        let (code, o, e) = check(&scene(contact), &["--max-memory", "1G"]);
+        assert_eq!(code, Some(1), "{contact}: {o}{e}");
+        assert!(
+            e.contains(":3: cloth.c.thickness") && e.contains(pairs) && e.contains("--max-memory"),
+            "{contact}: {e}"
+        );
+    }
+}
+
+#[test]
 fn mesh_files_above_the_cap_and_devices_are_refused() {
     let dir = temp_dir("mesh-cap");
     let mut obj = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");

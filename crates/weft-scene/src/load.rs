@@ -140,12 +140,16 @@ pub fn from_text_with(
             && by_pairs
             && let Some((name, m, _)) = thickest
         {
+            let what = match kind {
+                ContactKind::Particles => "particles",
+                ContactKind::Mesh => "elements (vertex–triangle and edge–edge)",
+            };
             return Err(src
                 .error(
                     &format!("cloth.{name}.thickness"),
                     format!(
                         "self-collision at this thickness ({} m) may list {pairs} pairs of \
-                         particles, and the scene needs about {} once built, more than the {} \
+                         {what}, and the scene needs about {} once built, more than the {} \
                          allowed ({origin}); lower the thickness, or raise the limit with \
                          --max-memory",
                         m.thickness,
