@@ -19,6 +19,7 @@ mod recover;
 mod replay;
 mod run;
 mod runtime_dir;
+mod seam_report;
 mod stability;
 mod stop;
 mod video;

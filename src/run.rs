@@ -122,6 +122,7 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
     let mut torn = false;
     let mut last = sim.stats(0.0, 0);
     let mut tally = CrossingTally::default();
+    let mut seams = weft_sim::SeamWatch::default();
     let result = (|| -> anyhow::Result<()> {
         if let Some(r) = rec.as_mut() {
             r.frame(&sim, &last)?;
@@ -135,6 +136,7 @@ pub fn run(scene: Scene, plan: &RunPlan<'_>, stop: &Arc<AtomicBool>) -> anyhow::
                 Ok(stats) => {
                     last = stats;
                     tally.add(&stats);
+                    bar.suspend(|| crate::seam_report::warn_open(&mut seams, &sim));
                     if let Some(r) = rec.as_mut() {
                         r.frame(&sim, &stats)?;
                         if stats.frame % 16 == 0 {

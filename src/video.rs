@@ -594,6 +594,7 @@ pub fn render(
         ProgressBar::hidden()
     };
     let mut code = ExitCode::SUCCESS;
+    let mut seams = weft_sim::SeamWatch::default();
     for _ in 0..plan.frames {
         if stop.load(Ordering::SeqCst) {
             eprintln!("weft: interrupted after {} frames", sim.frame());
@@ -615,6 +616,7 @@ pub fn render(
             );
             return Ok(ExitCode::from(EXIT_DIVERGED));
         }
+        bar.suspend(|| crate::seam_report::warn_open(&mut seams, &sim));
         match rec.frame(&sim) {
             Err(e) if e.is::<Stopped>() => {
                 eprintln!("weft: interrupted after {} frames", sim.frame());

@@ -13,7 +13,7 @@ use crate::app::picking::Ray;
 use crate::app::recording::SessionLog;
 use crate::default_scene;
 use weft_record::Status;
-use weft_sim::Simulation;
+use weft_sim::{SeamWatch, Simulation};
 
 /// Where a scene came from (to reset it, and to list it in the panel).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -84,6 +84,8 @@ pub struct Session {
     pub diverged: Option<String>,
     /// Frames simulated in this session (across resets).
     pub frames: u64,
+    /// The garments' seams, looked at once they were due to have closed.
+    pub seams: SeamWatch,
 }
 
 impl Session {
@@ -98,6 +100,7 @@ impl Session {
             stats: Stats::default(),
             diverged: None,
             frames: 0,
+            seams: SeamWatch::default(),
         }
     }
 
@@ -141,6 +144,7 @@ impl Session {
                 self.stats.bending_residual = stats.bending_residual;
                 self.stats.steps_last += 1;
                 self.frames += 1;
+                crate::seam_report::warn_open(&mut self.seams, &self.sim);
                 if let Some(log) = self.log.as_mut() {
                     log.frame(&self.sim, stats, dt, self.grab.as_ref())?;
                 }

@@ -23,6 +23,7 @@ mod recorder;
 mod recover;
 mod render_video;
 mod replay;
+mod seam_warning;
 mod small_things;
 mod stability_warning;
 mod stops;

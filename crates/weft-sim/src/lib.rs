@@ -1,18 +1,21 @@
 //! A Weft scene run: its solvers stepped in lockstep one frame at a time ([`Simulation`]),
 //! what each frame did ([`FrameStats`]), a held particle dragged about ([`grab`]), the live
-//! controls the viewer and Python change between frames ([`control`]), and a character's body
-//! posed for the renderer, the log and the export ([`body`]).
+//! controls the viewer and Python change between frames ([`control`]), a character's body
+//! posed for the renderer, the log and the export ([`body`]), and garment seams that did not
+//! close ([`seams`]).
 
 pub mod body;
 pub mod control;
 pub mod crossings;
 mod error;
 pub mod grab;
+pub mod seams;
 mod simulation;
 
 pub use control::{Control, LIVE_KEYS, Value};
 pub use crossings::{CrossingStats, StartCrossing};
 pub use error::SimError;
+pub use seams::{OpenSeams, SeamWatch};
 pub use simulation::{FrameStats, Simulation};
 
 #[cfg(test)]
