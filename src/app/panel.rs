@@ -285,6 +285,19 @@ fn stats_section(ui: &mut Ui, session: &Session) {
                  independent of contact",
             );
         }
+        let open: Vec<String> = (0..session.sim.scene.cloths.len())
+            .filter_map(|i| session.sim.open_seams(i))
+            .map(|s| format!("{}: {} of {}", s.cloth, s.open, s.pairs))
+            .collect();
+        if !open.is_empty() {
+            row(
+                "open seams",
+                open.join(", "),
+                "seam pairs still over 1 mm apart 0.25 s after the cloth's seam_time: something \
+                 holds them (a fold caught in the seam, the body's friction, soft springs); a \
+                 longer seam_time gives the panels time to settle as they close",
+            );
+        }
         row(
             "sim time",
             format!("{time:.3} s"),
