@@ -290,13 +290,14 @@ fn stats_section(ui: &mut Ui, session: &Session) {
             .map(|s| format!("{}: {} of {}", s.cloth, s.open, s.pairs))
             .collect();
         if !open.is_empty() {
-            row(
-                "open seams",
-                open.join(", "),
-                "seam pairs still over 1 mm apart 0.25 s after the cloth's seam_time: something \
+            let tip = format!(
+                "seam pairs still over {} mm apart {} s after the cloth's seam_time: something \
                  holds them (a fold caught in the seam, the body's friction, soft springs); a \
                  longer seam_time gives the panels time to settle as they close",
+                weft_sim::seams::OPEN_GAP * 1e3,
+                weft_sim::seams::SETTLE
             );
+            row("open seams", open.join(", "), &tip);
         }
         row(
             "sim time",

@@ -64,14 +64,21 @@ fn gaps(sim: &Simulation, i: usize) -> Option<Vec<f64>> {
     )
 }
 
+/// Whether scene cloth `i` has seams and they are due to have closed ([`SETTLE`] after its
+/// `seam_time`).
+fn due(sim: &Simulation, i: usize) -> bool {
+    (sim.scene.cloths.get(i))
+        .is_some_and(|c| !c.seams.is_empty() && sim.time() + 1e-9 >= c.seam_time + SETTLE)
+}
+
 impl Simulation {
     /// Scene cloth `i`'s seams, if they are due to have closed ([`SETTLE`] after its
     /// `seam_time`) and some pair is still more than [`OPEN_GAP`] apart.
     pub fn open_seams(&self, i: usize) -> Option<OpenSeams> {
-        let c = self.scene.cloths.get(i)?;
-        if self.time() + 1e-9 < c.seam_time + SETTLE {
+        if !due(self, i) {
             return None;
         }
+        let c = &self.scene.cloths[i];
         let gaps = gaps(self, i)?;
         let open = gaps.iter().filter(|&&g| g > OPEN_GAP).count();
         (open > 0).then(|| OpenSeams {
@@ -103,12 +110,11 @@ impl SeamWatch {
         }
         self.last = sim.time();
         let mut found = Vec::new();
-        for (i, c) in sim.scene.cloths.iter().enumerate() {
-            if self.looked[i] || c.seams.is_empty() || sim.time() + 1e-9 < c.seam_time + SETTLE {
-                continue;
+        for i in 0..n {
+            if !self.looked[i] && due(sim, i) {
+                self.looked[i] = true;
+                found.extend(sim.open_seams(i));
             }
-            self.looked[i] = true;
-            found.extend(sim.open_seams(i));
         }
         found
     }
