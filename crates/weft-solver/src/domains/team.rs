@@ -297,9 +297,7 @@ enum Owner {
 
 impl Domains {
     /// Runs `body` with a team of workers over the domains: one per rayon thread, at most one
-    /// per domain, a power of two; or, unless `spin`, a team of one whose passes fork and join
-    /// in rayon as [`fork`] does (a frame whose hook runs work of its own between the passes,
-    /// which a spinning helper slowed down: see `docs/performance-notes.md`).
+    /// per domain, a power of two.
     /// `work(k, domain, particles)` runs on each domain before its sweep in a pass that
     /// integrates substep `k`, with the domain's particles in the store (`x`, `v`, `w`).
     /// Coefficients from [`Domains::prepare`].
@@ -309,18 +307,13 @@ impl Domains {
         v: &[DVec3],
         w: &[f64],
         work: &W,
-        spin: bool,
         body: impl FnOnce(&mut Team<'_, '_, W>) -> R,
     ) -> R
     where
         W: Fn(u32, &mut Domain, &AosChunk<'_>) + Sync,
     {
         let count = self.list.len();
-        let workers = if spin {
-            rayon::current_num_threads().min(count).max(1)
-        } else {
-            1
-        };
+        let workers = rayon::current_num_threads().min(count).max(1);
         let slots = 1 << workers.ilog2();
         let (mut out, mut upper_nodes) = (Vec::new(), Vec::new());
         carve(0, count, 0, slots, &mut out, &mut upper_nodes);

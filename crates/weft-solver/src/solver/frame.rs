@@ -108,44 +108,37 @@ impl Solver {
         };
         let stop = self.stop.as_deref();
         let p = &self.particles;
-        // Spinning helpers only without a hook: a hook's contact passes and its own work
-        // between the passes ran slower beside them (mesh and sphere frames, 3–10 %).
-        let (stats, done) = self.domains.team(
-            &p.positions,
-            &p.velocities,
-            &p.inv_masses,
-            &work,
-            !active,
-            |team| {
-                let mut stats = StepStats::default();
-                for k in 0..s.substeps {
-                    if stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
-                        return (stats, k);
-                    }
-                    if active {
-                        let ctx = SubstepContext {
-                            method: s.method,
-                            time: times[k as usize],
-                            h,
-                            substep: k,
-                            frame_end,
-                        };
-                        hook.begin_substep(&ctx, p);
-                    }
-                    team.integrate_and_project(k);
-                    for it in 0..s.iterations {
-                        if it > 0 {
-                            team.project();
+        let (stats, done) =
+            self.domains
+                .team(&p.positions, &p.velocities, &p.inv_masses, &work, |team| {
+                    let mut stats = StepStats::default();
+                    for k in 0..s.substeps {
+                        if stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+                            return (stats, k);
                         }
-                        if active && let Some(contacts) = hook.particle_contacts() {
-                            let totals = team.collide(contacts, it == 0);
-                            stats.contacts = hook.fused_pass(it == 0, totals);
+                        if active {
+                            let ctx = SubstepContext {
+                                method: s.method,
+                                time: times[k as usize],
+                                h,
+                                substep: k,
+                                frame_end,
+                            };
+                            hook.begin_substep(&ctx, p);
+                        }
+                        team.integrate_and_project(k);
+                        for it in 0..s.iterations {
+                            if it > 0 {
+                                team.project();
+                            }
+                            if active && let Some(contacts) = hook.particle_contacts() {
+                                let totals = team.collide(contacts, it == 0);
+                                stats.contacts = hook.fused_pass(it == 0, totals);
+                            }
                         }
                     }
-                }
-                (stats, s.substeps)
-            },
-        );
+                    (stats, s.substeps)
+                });
         self.frame_targets = targets;
         if done == 0 {
             // Nothing loaded into the domains yet: the store is as it was.
