@@ -88,11 +88,6 @@ impl Strategy for ImplicitMassSpring {
         true
     }
 
-    /// About twenty short passes a substep, each a futex wake if the workers slept between.
-    fn keeps_workers_awake(&self) -> bool {
-        true
-    }
-
     fn add_internal_forces(
         &self,
         constraints: &ConstraintSet,

@@ -55,12 +55,6 @@ pub(crate) trait Strategy: Sync {
         false
     }
 
-    /// Whether the frame is many short parallel passes, run with the pool's other workers kept
-    /// awake between them (`crate::awake`); the implicit method's solve is.
-    fn keeps_workers_awake(&self) -> bool {
-        false
-    }
-
     /// Starts a substep.
     fn begin_substep(&self, _constraints: &mut ConstraintSet) {}
 

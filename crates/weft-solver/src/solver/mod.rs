@@ -472,7 +472,8 @@ impl Solver {
     /// each domain integrates, pins and projects its own particles, on a team of threads kept
     /// for the whole frame that hands each pass over with a spin, and resolves its particles'
     /// contacts in one parallel region per iteration. That path does the same arithmetic in
-    /// the same order as the general loop, so both give the same bits.
+    /// the same order as the general loop, so both give the same bits. The general loop runs
+    /// with the pool's other workers spinning for work between its passes (`crate::awake`).
     ///
     /// The frame runs on one of rayon's threads (`rayon::scope`, inline when called from one):
     /// its parallel loops then start from inside the pool, and the calling thread is handed
@@ -489,8 +490,7 @@ impl Solver {
                 self.frame_fused(rule, hook)
             }
             None if springs => awake(|| self.frame_springs()),
-            None if strategy.keeps_workers_awake() => awake(|| self.frame_general(hook)),
-            _ => self.frame_general(hook),
+            _ => awake(|| self.frame_general(hook)),
         });
         let frame::Frame {
             stats,
