@@ -5,7 +5,7 @@
 //! a substep, a 0.1 ms per-particle pass took as long on two threads as on one; the explicit
 //! stencil frame's pass a substep, 0.1 ms, lost a tenth of its frame to them; every frame of
 //! the general loop (self-collision, cloth contact, bending outside the sweep) runs in it too,
-//! 10–20 % quicker on two threads (`docs/performance-notes.md`). [`awake`] runs
+//! up to 20 % quicker on two threads (`docs/performance-notes.md`). [`awake`] runs
 //! a closure while one helper per other worker spins, running whatever rayon work is pending
 //! (`rayon::yield_now`, as `domains/team.rs`'s helpers do), until the closure returns. Which
 //! thread runs a job never changes what it computes: the bits stay the closure's own.

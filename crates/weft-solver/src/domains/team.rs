@@ -123,7 +123,7 @@ where
             coef: self.coef,
             mode: self.mode,
             reverse,
-            // A team of one (see `Domains::team`) forks inside its slot as the tree always did.
+            // A team of one (one thread or one domain) forks inside its slot as the tree did.
             serial: self.slots.len() > 1,
         };
         let first = slot.first;
