@@ -207,6 +207,10 @@ impl Material {
             Some((nx, ny)) if nx > 1 && ny > 1 => {
                 mesh.triangles.iter().map(area).sum::<f64>() / ((nx - 1) * (ny - 1)) as f64
             }
+            // Cut from a grid (`ClothMesh::cut_disc`): two triangles a cell, as inside it.
+            None if !mesh.shear.is_empty() => {
+                2.0 * median(mesh.triangles.iter().map(area).collect()).unwrap_or(0.0)
+            }
             _ => 0.0,
         };
         let shear: Vec<f64> = mesh
