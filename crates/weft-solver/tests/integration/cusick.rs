@@ -62,16 +62,16 @@ fn the_drape_holds_across_resolutions_and_methods() {
         let xpbd = drape(&cotton, cells, with(Method::Xpbd, 10), 4.0);
         let implicit = drape(&cotton, cells, with(Method::ImplicitMassSpring, 10), 4.0);
         println!("cotton at {cells} cells: XPBD {xpbd:.4}, implicit mass-spring {implicit:.4}");
-        assert!((0.05..0.95).contains(&xpbd), "{cells}: {xpbd}");
+        assert!((0.3..0.9).contains(&xpbd), "{cells}: {xpbd}");
         assert!(
-            (xpbd - implicit).abs() <= 0.03,
+            (xpbd - implicit).abs() < 0.03,
             "{cells}: {xpbd:.4} / {implicit:.4}"
         );
         read.push((xpbd, implicit));
     }
     let [(x30, i30), (x40, i40)] = [read[0], read[1]];
-    assert!((x30 - x40).abs() <= 0.03, "XPBD {x30:.4} / {x40:.4}");
-    assert!((i30 - i40).abs() <= 0.03, "implicit {i30:.4} / {i40:.4}");
+    assert!((x30 - x40).abs() < 0.03, "XPBD {x30:.4} / {x40:.4}");
+    assert!((i30 - i40).abs() < 0.03, "implicit {i30:.4} / {i40:.4}");
 }
 
 #[test]
