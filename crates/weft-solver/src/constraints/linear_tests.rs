@@ -21,7 +21,7 @@ pub(crate) fn crumpled(
 }
 
 /// An `n`² grid as [`crumpled`]'s, stretched by 30 % and moved by up to `noise` (0: flat).
-fn stretched(
+pub(crate) fn stretched(
     bending: Family,
     noise: f64,
     n: usize,

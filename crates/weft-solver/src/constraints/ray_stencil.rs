@@ -3,13 +3,17 @@
 //! the linear system, and of each product with it, is a sum over the same slots, read with unit
 //! stride in f64 lanes, `L` particles at a time (eight on AVX-512), with no scatter.
 //!
-//! Each spring is linearised once, at its lower end (the slots of positive offset): its ray
-//! (g, κ) and its share b of the right-hand side, by the arithmetic of `linear.rs`'s
-//! `linearize_ray` (Baraff & Witkin 1998, eq. 6). A particle then sums over its slots in slot
-//! order, with u = pᵢ − pᵢ₊ₒ for slot offset o: the product term g (g·u) + κ u, the diagonal
-//! block g gᵀ + κ I and ±b (+ at the lower end, − at the upper). Seen from the upper end u is
-//! negated exactly, so a spring gives its two particles exactly opposite terms. Every sum is a
-//! particle's own, in slot order: the same bits on every thread count and lane width.
+//! Each spring is linearised at its lower end (the slots of positive offset): its ray (g, κ)
+//! and its share b of the right-hand side, by the arithmetic of `linear.rs`'s `linearize_ray`
+//! (Baraff & Witkin 1998, eq. 6). The particles go in chunks, and each chunk linearises the
+//! springs it reads into a window of its own: those of its lower ends and of the widest offset
+//! before them, which the chunk before also linearises, to the same bits. A chunk's terms are
+//! then summed while they are still in cache, with no pass between, and no chunk reads
+//! another's. A particle sums over its slots in slot order, with u = pᵢ − pᵢ₊ₒ for slot
+//! offset o: the product term g (g·u) + κ u, the diagonal block g gᵀ + κ I and ±b (+ at the
+//! lower end, − at the upper). Seen from the upper end u is negated exactly, so a spring gives
+//! its two particles exactly opposite terms. Every sum is a particle's own, in slot order: the
+//! same bits on every thread count and lane width.
 
 use glam::DVec3;
 use pulp::Simd;
@@ -56,12 +60,18 @@ struct Geometry {
     spring_of: Vec<usize>,
     /// The positive slots' (offset, parameter group), ascending.
     positive: Vec<(isize, u32)>,
+    /// The lower ends a chunk's window holds before its first particle: the widest offset,
+    /// rounded up to [`WIDE`].
+    halo: usize,
     /// Rest length of positive slot k's spring at its lower end i, `rest[k][margin + i]`;
     /// negative where there is none.
     rest: Vec<Vec<f64>>,
 }
 
-/// The state per axis, padded by the margin (zero there), and the springs' terms.
+/// A chunk's window: each terms array over the window's lower ends.
+type Window = Vec<Vec<f64>>;
+
+/// The state per axis, padded by the margin (zero there), and the springs' terms by chunk.
 #[derive(Clone, Debug, Default)]
 struct Lanes {
     /// Positions.
@@ -70,8 +80,14 @@ struct Lanes {
     v: [Vec<f64>; 3],
     /// The vector a product multiplies (or the warm start).
     p: [Vec<f64>; 3],
-    /// Positive slot k's terms in `terms[k * TERMS ..]`: g per axis, κ, b per axis.
-    terms: Vec<Vec<f64>>,
+    /// Chunk c's window: positive slot k's terms in `windows[c][k * TERMS ..]` (g per axis, κ,
+    /// b per axis) at the lower ends from `c · CHUNK − halo` (see [`Geometry::window_from`]).
+    windows: Vec<Window>,
+    /// Each positive slot's stiffness k, damping c and whether its family is enabled (1 or 0),
+    /// as last loaded.
+    coef: Vec<[f64; 3]>,
+    /// The substep h, as last loaded.
+    h: f64,
     /// Whether `p` holds the direction of the last [`RayStencil::next_direction`], not yet used.
     direction: bool,
 }
@@ -105,8 +121,12 @@ impl RayStencil {
             }
             *r = shape.rest;
         }
+        let halo = widest.next_multiple_of(WIDE);
+        let windows = (0..stride.div_ceil(CHUNK))
+            .map(|c| vec![vec![0.0; halo + CHUNK.min(stride - c * CHUNK)]; positive.len() * TERMS])
+            .collect();
         let lanes = Lanes {
-            terms: vec![vec![0.0; len]; positive.len() * TERMS],
+            windows,
             ..Lanes::default()
         };
         let geo = Geometry {
@@ -115,6 +135,7 @@ impl RayStencil {
             offsets: slots.iter().map(|s| s.0).collect(),
             spring_of,
             positive,
+            halo,
             rest,
         };
         Some(Self { geo, lanes })
@@ -129,18 +150,20 @@ impl RayStencil {
         rows: &mut [RowSums],
         path: SimdPath,
     ) {
-        self.linearize_terms(params, st, path);
-        let (geo, terms) = (&self.geo, &self.lanes.terms[..]);
-        let x0 = st.x0.map(|_| &self.lanes.p);
-        rows.par_chunks_mut(CHUNK)
+        self.load_state(params, st);
+        let geo = &self.geo;
+        let (windows, state, p) = self.lanes.split();
+        let x0 = st.x0.map(|_| p);
+        (rows.par_chunks_mut(CHUNK).zip(windows.par_iter_mut()))
             .enumerate()
-            .for_each(|(c, rows)| {
-                let start = c * CHUNK;
+            .for_each(|(c, (rows, win))| {
+                state.linearize(geo, c, win, path);
+                let (start, win) = (c * CHUNK, &win[..]);
                 on_path(
                     path,
                     Sums {
                         geo,
-                        terms,
+                        win,
                         x0,
                         start,
                         rows,
@@ -149,8 +172,10 @@ impl RayStencil {
             });
     }
 
-    /// Loads the state into lanes (x₀ into `p`) and linearises every spring at its lower end.
-    pub fn linearize_terms(&mut self, params: &[FamilyParams], st: State<'_>, path: SimdPath) {
+    /// Loads the state into lanes (x₀ into `p`) and the springs' coefficients, for the
+    /// linearisation that follows ([`RayStencil::linearize`] or
+    /// [`RayStencil::system_rows`]).
+    pub fn load_state(&mut self, params: &[FamilyParams], st: State<'_>) {
         let Self { geo, lanes } = self;
         let len = geo.stride + 2 * geo.margin;
         load(&mut lanes.x, geo.margin, len, st.x);
@@ -159,7 +184,8 @@ impl RayStencil {
             load(&mut lanes.p, geo.margin, len, x0);
         }
         lanes.direction = false;
-        let coef: Vec<[f64; 3]> = (geo.positive.iter())
+        lanes.h = st.h;
+        lanes.coef = (geo.positive.iter())
             .map(|&(_, g)| {
                 let p = &params[g as usize];
                 [
@@ -169,32 +195,6 @@ impl RayStencil {
                 ]
             })
             .collect();
-        // Chunk by chunk of lower ends: each chunk's share of every array.
-        let m = geo.margin;
-        let chunks = geo.stride.div_ceil(CHUNK);
-        let mut outs: Vec<Vec<&mut [f64]>> = (0..chunks).map(|_| Vec::new()).collect();
-        for t in lanes.terms.iter_mut() {
-            for (c, s) in t[m..m + geo.stride].chunks_mut(CHUNK).enumerate() {
-                outs[c].push(s);
-            }
-        }
-        let (x, v, geo) = (&lanes.x, &lanes.v, &*geo);
-        let h = st.h;
-        outs.into_par_iter().enumerate().for_each(|(c, out)| {
-            let (start, coef) = (c * CHUNK, &coef[..]);
-            on_path(
-                path,
-                Terms {
-                    geo,
-                    x,
-                    v,
-                    coef,
-                    h,
-                    start,
-                    out,
-                },
-            );
-        });
     }
 
     /// Adds the springs' share of (A − M) p to `q`, for the springs of the last
@@ -203,20 +203,69 @@ impl RayStencil {
         let Self { geo, lanes } = self;
         load(&mut lanes.p, geo.margin, geo.stride + 2 * geo.margin, p);
         lanes.direction = false;
-        let (geo, terms, p) = (&*geo, &lanes.terms[..], &lanes.p);
+        let (geo, windows, p) = (&*geo, &lanes.windows, &lanes.p);
         q.par_chunks_mut(CHUNK).enumerate().for_each(|(c, q)| {
-            let start = c * CHUNK;
+            let (start, win) = (c * CHUNK, &windows[c][..]);
             on_path(
                 path,
                 Product {
                     geo,
-                    terms,
+                    win,
                     p,
                     start,
                     q,
                 },
             );
         });
+    }
+}
+
+impl Geometry {
+    /// The padded index of the first lower end in chunk `c`'s window.
+    fn window_from(&self, c: usize) -> usize {
+        self.margin + c * CHUNK - self.halo
+    }
+}
+
+/// What the linearisation of a window reads: the state in lanes and the springs' coefficients.
+struct LoadedState<'a> {
+    x: &'a [Vec<f64>; 3],
+    v: &'a [Vec<f64>; 3],
+    coef: &'a [[f64; 3]],
+    h: f64,
+}
+
+impl LoadedState<'_> {
+    /// Linearises the springs of chunk `c`'s window into `win`.
+    fn linearize(&self, geo: &Geometry, c: usize, win: &mut [Vec<f64>], path: SimdPath) {
+        let Self { x, v, coef, h } = *self;
+        let from = geo.window_from(c);
+        on_path(
+            path,
+            Terms {
+                geo,
+                x,
+                v,
+                coef,
+                h,
+                from,
+                out: win,
+            },
+        );
+    }
+}
+
+impl Lanes {
+    /// The windows, to write, beside what their linearisation reads and `p` (the warm start
+    /// after [`RayStencil::load_state`]).
+    fn split(&mut self) -> (&mut [Window], LoadedState<'_>, &[Vec<f64>; 3]) {
+        let state = LoadedState {
+            x: &self.x,
+            v: &self.v,
+            coef: &self.coef,
+            h: self.h,
+        };
+        (&mut self.windows, state, &self.p)
     }
 }
 
@@ -248,8 +297,8 @@ fn v3<S: Simd, const L: usize>(src: &[Vec<f64>], at: usize) -> V3<S> {
     ]
 }
 
-/// The springs' terms for one chunk of lower ends from `start` (`out`: each terms array's
-/// share, in array order).
+/// The springs' terms at the lower ends of one window, from padded index `from` on, into
+/// `out` (the window's arrays).
 struct Terms<'a> {
     geo: &'a Geometry,
     x: &'a [Vec<f64>; 3],
@@ -257,8 +306,8 @@ struct Terms<'a> {
     /// Each positive slot's stiffness k, damping c and whether its family is enabled (1 or 0).
     coef: &'a [[f64; 3]],
     h: f64,
-    start: usize,
-    out: Vec<&'a mut [f64]>,
+    from: usize,
+    out: &'a mut [Vec<f64>],
 }
 
 impl LaneKernel for Terms<'_> {
@@ -272,8 +321,8 @@ impl LaneKernel for Terms<'_> {
             v,
             coef,
             h,
-            start,
-            mut out,
+            from,
+            out,
         } = self;
         let f = Ops(s);
         let zero = f.c(0.0);
@@ -291,7 +340,7 @@ impl LaneKernel for Terms<'_> {
             let (hhk, sigma) = (f.c(hhk), f.c(hhk + h * damping));
             let (stiff_v, damping, h) = (f.c(stiff), f.c(damping), f.c(h));
             for j in (0..count).step_by(L) {
-                let i = geo.margin + start + j;
+                let i = from + j;
                 let at = i + o as usize;
                 let d = f.dif(&v3::<S, L>(x, i), &v3::<S, L>(x, at));
                 let uv = f.dif(&v3::<S, L>(v, i), &v3::<S, L>(v, at));
@@ -326,20 +375,21 @@ impl LaneKernel for Terms<'_> {
     }
 }
 
-/// Σ over the slots of g (g·u) + κ u, u = pᵢ − pᵢ₊ₒ, for the `L` particles at padded index `i`.
+/// Σ over the slots of g (g·u) + κ u, u = pᵢ − pᵢ₊ₒ, for the `L` particles at padded index `i`
+/// and index `w` of their chunk's window `win`.
 #[inline(always)]
 fn ray_sum<S: Simd, const L: usize>(
     f: Ops<S>,
     geo: &Geometry,
-    terms: &[Vec<f64>],
+    win: &[Vec<f64>],
     p: &[Vec<f64>; 3],
-    i: usize,
+    (i, w): (usize, usize),
 ) -> V3<S> {
     let pi = v3::<S, L>(p, i);
     let mut sum = [f.c(0.0); 3];
     for (&o, &k) in geo.offsets.iter().zip(&geo.spring_of) {
-        let t = &terms[k * TERMS..];
-        let low = i.wrapping_add_signed(o.min(0));
+        let t = &win[k * TERMS..];
+        let low = w.wrapping_add_signed(o.min(0));
         let (g, kappa) = (v3::<S, L>(t, low), load_at::<S, L>(&t[3], low));
         let u = f.dif(&pi, &v3::<S, L>(p, i.wrapping_add_signed(o)));
         let gu = f.dot(&g, &u);
@@ -351,10 +401,10 @@ fn ray_sum<S: Simd, const L: usize>(
 }
 
 /// The rows' sums for one chunk of particles from `start`: b, (A − M) x₀ and the diagonal
-/// block, added to `rows`.
+/// block, added to `rows` (`win`: the chunk's window).
 struct Sums<'a> {
     geo: &'a Geometry,
-    terms: &'a [Vec<f64>],
+    win: &'a [Vec<f64>],
     x0: Option<&'a [Vec<f64>; 3]>,
     start: usize,
     rows: &'a mut [RowSums],
@@ -367,13 +417,14 @@ impl LaneKernel for Sums<'_> {
     fn run<S: Simd, const L: usize>(self, s: S) {
         let Sums {
             geo,
-            terms,
+            win,
             x0,
             start,
             rows,
         } = self;
         for j in (0..rows.len()).step_by(L) {
-            let sums = row_sums::<S, L>(Ops(s), geo, terms, x0, geo.margin + start + j);
+            let at = (geo.margin + start + j, geo.halo + j);
+            let sums = row_sums::<S, L>(Ops(s), geo, win, x0, at);
             let end = L.min(rows.len() - j);
             for (l, row) in rows[j..j + end].iter_mut().enumerate() {
                 row.b += sums.b(l);
@@ -417,25 +468,26 @@ impl<const L: usize> LaneSums<L> {
     }
 }
 
-/// The springs' sums of the `L` rows at padded index `i`: ±b, (A − M) x₀ (zero without x₀)
-/// and the diagonal block g gᵀ + κ I, over the slots in slot order.
+/// The springs' sums of the `L` rows at padded index `at.0` and window index `at.1`: ±b,
+/// (A − M) x₀ (zero without x₀) and the diagonal block g gᵀ + κ I, over the slots in slot
+/// order.
 #[inline(always)]
 fn row_sums<S: Simd, const L: usize>(
     f: Ops<S>,
     geo: &Geometry,
-    terms: &[Vec<f64>],
+    win: &[Vec<f64>],
     x0: Option<&[Vec<f64>; 3]>,
-    i: usize,
+    at: (usize, usize),
 ) -> LaneSums<L> {
     let ax = match x0 {
-        Some(x0) => ray_sum::<S, L>(f, geo, terms, x0, i),
+        Some(x0) => ray_sum::<S, L>(f, geo, win, x0, at),
         None => [f.c(0.0); 3],
     };
     let mut b = [f.c(0.0); 3];
     let mut d = [f.c(0.0); 6];
     for (&o, &k) in geo.offsets.iter().zip(&geo.spring_of) {
-        let t = &terms[k * TERMS..];
-        let low = i.wrapping_add_signed(o.min(0));
+        let t = &win[k * TERMS..];
+        let low = at.1.wrapping_add_signed(o.min(0));
         let (g, kappa) = (v3::<S, L>(t, low), load_at::<S, L>(&t[3], low));
         let bs = v3::<S, L>(&t[4..], low);
         // Sym3::outer(g, 1) + κ I.
@@ -464,10 +516,11 @@ fn row_sums<S: Simd, const L: usize>(
     }
 }
 
-/// The springs' share of (A − M) p for one chunk of particles from `start`, added to `q`.
+/// The springs' share of (A − M) p for one chunk of particles from `start`, added to `q`
+/// (`win`: the chunk's window).
 struct Product<'a> {
     geo: &'a Geometry,
-    terms: &'a [Vec<f64>],
+    win: &'a [Vec<f64>],
     p: &'a [Vec<f64>; 3],
     start: usize,
     q: &'a mut [DVec3],
@@ -480,14 +533,15 @@ impl LaneKernel for Product<'_> {
     fn run<S: Simd, const L: usize>(self, s: S) {
         let Product {
             geo,
-            terms,
+            win,
             p,
             start,
             q,
         } = self;
         let f = Ops(s);
         for j in (0..q.len()).step_by(L) {
-            let sum = ray_sum::<S, L>(f, geo, terms, p, geo.margin + start + j);
+            let at = (geo.margin + start + j, geo.halo + j);
+            let sum = ray_sum::<S, L>(f, geo, win, p, at);
             let t = store3::<S, L>(&sum);
             let end = L.min(q.len() - j);
             for (l, q) in q[j..j + end].iter_mut().enumerate() {

@@ -31,11 +31,12 @@ pub(crate) struct SystemRows<'a> {
 }
 
 impl RayStencil {
-    /// The rows of the implicit system at substep `h` for the state of the last
-    /// [`RayStencil::linearize_terms`], written to `rows`: r = b − A x₀ and the inverse of A's
-    /// diagonal block (b = h M a_ext + the springs' share, A x₀ = M x₀ + the springs'); zeros,
-    /// and x₀ = 0, where w = 0. Returns ‖b‖², the chunks' sums added in order.
-    pub fn system_rows(&self, rows: SystemRows<'_>, h: f64, warm: bool, path: SimdPath) -> f64 {
+    /// Linearises the springs at the state of the last [`RayStencil::load_state`] and writes
+    /// the rows of the implicit system at its substep h to `rows`: r = b − A x₀ and the
+    /// inverse of A's diagonal block (b = h M a_ext + the springs' share, A x₀ = M x₀ + the
+    /// springs'); zeros, and x₀ = 0, where w = 0. Each chunk linearises its window and sums
+    /// its rows in one task. Returns ‖b‖², the chunks' sums added in order.
+    pub fn system_rows(&mut self, rows: SystemRows<'_>, warm: bool, path: SimdPath) -> f64 {
         let SystemRows {
             w,
             accel,
@@ -43,18 +44,21 @@ impl RayStencil {
             r,
             pinv,
         } = rows;
-        let (geo, terms) = (&self.geo, &self.lanes.terms[..]);
-        let lanes_x0 = warm.then_some(&self.lanes.p);
+        let (geo, h) = (&self.geo, self.lanes.h);
+        let (windows, state, p) = self.lanes.split();
+        let lanes_x0 = warm.then_some(p);
         let partials: Vec<f64> = (r.par_chunks_mut(CHUNK))
             .zip(pinv.par_chunks_mut(CHUNK))
             .zip(x0.par_chunks_mut(CHUNK))
+            .zip(windows.par_iter_mut())
             .enumerate()
-            .map(|(c, ((r, pinv), x0))| {
+            .map(|(c, (((r, pinv), x0), win))| {
+                state.linearize(geo, c, win, path);
                 let start = c * CHUNK;
                 let (w, accel) = (&w[start..start + r.len()], &accel[start..start + r.len()]);
                 let chunk = Setup {
                     geo,
-                    terms,
+                    win,
                     lanes_x0,
                     start,
                     h,
@@ -108,18 +112,18 @@ impl RayStencil {
         if !std::mem::take(&mut lanes.direction) {
             load(&mut lanes.p, geo.margin, geo.stride + 2 * geo.margin, p);
         }
-        let (geo, terms, lanes_p) = (&*geo, &lanes.terms[..], &lanes.p);
+        let (geo, windows, lanes_p) = (&*geo, &lanes.windows, &lanes.p);
         let partials: Vec<f64> = (q.par_chunks_mut(CHUNK))
             .zip(p.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
             .enumerate()
             .map(|(c, (q, (p, w)))| {
-                let start = c * CHUNK;
+                let (start, win) = (c * CHUNK, &windows[c][..]);
                 let rows = Rows { p, w, q };
                 on_path(
                     path,
                     System {
                         geo,
-                        terms,
+                        win,
                         p: lanes_p,
                         start,
                         rows,
@@ -138,10 +142,11 @@ struct Rows<'a> {
     q: &'a mut [DVec3],
 }
 
-/// q ← A p for one chunk of particles from `start` (see [`RayStencil::system_product`]).
+/// q ← A p for one chunk of particles from `start` (see [`RayStencil::system_product`]);
+/// `win`: the chunk's window.
 struct System<'a> {
     geo: &'a Geometry,
-    terms: &'a [Vec<f64>],
+    win: &'a [Vec<f64>],
     p: &'a [Vec<f64>; 3],
     start: usize,
     rows: Rows<'a>,
@@ -154,7 +159,7 @@ impl LaneKernel for System<'_> {
     fn run<S: Simd, const L: usize>(self, s: S) -> f64 {
         let System {
             geo,
-            terms,
+            win,
             p: lanes_p,
             start,
             rows: Rows { p, w, q },
@@ -162,7 +167,8 @@ impl LaneKernel for System<'_> {
         let f = Ops(s);
         let mut pq = 0.0;
         for j in (0..q.len()).step_by(L) {
-            let sum = ray_sum::<S, L>(f, geo, terms, lanes_p, geo.margin + start + j);
+            let at = (geo.margin + start + j, geo.halo + j);
+            let sum = ray_sum::<S, L>(f, geo, win, lanes_p, at);
             let t = store3::<S, L>(&sum);
             let end = L.min(q.len() - j);
             for l in 0..end {
@@ -181,10 +187,11 @@ impl LaneKernel for System<'_> {
     }
 }
 
-/// One chunk's rows of the implicit system (see [`RayStencil::system_rows`]).
+/// One chunk's rows of the implicit system (see [`RayStencil::system_rows`]); `win`: the
+/// chunk's window.
 struct Setup<'a> {
     geo: &'a Geometry,
-    terms: &'a [Vec<f64>],
+    win: &'a [Vec<f64>],
     lanes_x0: Option<&'a [Vec<f64>; 3]>,
     start: usize,
     h: f64,
@@ -202,7 +209,7 @@ impl LaneKernel for Setup<'_> {
     fn run<S: Simd, const L: usize>(self, s: S) -> f64 {
         let Setup {
             geo,
-            terms,
+            win,
             lanes_x0,
             start,
             h,
@@ -214,7 +221,8 @@ impl LaneKernel for Setup<'_> {
         } = self;
         let mut bb = 0.0;
         for j in (0..r.len()).step_by(L) {
-            let sums = row_sums::<S, L>(Ops(s), geo, terms, lanes_x0, geo.margin + start + j);
+            let at = (geo.margin + start + j, geo.halo + j);
+            let sums = row_sums::<S, L>(Ops(s), geo, win, lanes_x0, at);
             for l in 0..L.min(r.len() - j) {
                 let k = j + l;
                 // M's share first, then the springs' (the general passes' order).
