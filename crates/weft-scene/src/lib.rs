@@ -23,8 +23,8 @@ pub use build::SolverGroup;
 pub use collide::{DelayedSelfCollision, SelfContact, collider_desc};
 pub use error::{LONGEST_WORD, Origin, SceneError, SceneErrors, elide};
 pub use limits::{
-    BASE_BYTES, BYTES_PER_PAIR, BYTES_PER_PARTICLE, Limits, Member, PER_PARTICLE_SELF_COLLISION,
-    available_memory, contact_pairs, estimate_bytes, human, mesh_contact_pairs, peak_memory,
+    BASE_BYTES, BYTES_PER_PAIR, Limits, Member, PER_PARTICLE_SELF_COLLISION, available_memory,
+    bytes_per_particle, contact_pairs, estimate_bytes, human, mesh_contact_pairs, peak_memory,
     self_collision_pairs,
 };
 pub use load::{from_text, from_text_with, load, load_with};

@@ -3,6 +3,7 @@
 
 use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, Scene, SelfCollisionSpec};
 use crate::schema::{ContactKind, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, SceneFile};
+use weft_solver::Method;
 
 /// What a load may read and allocate.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -54,12 +55,20 @@ pub fn available_memory() -> Option<u64> {
     proc_kib("/proc/meminfo", "MemAvailable")
 }
 
-/// Bytes one particle of a built scene needs: its mesh (positions, masses, triangles, stretch
-/// and shear edges), the solver's store, constraints, domains and scratch, and one frame of
-/// log messages with their encode and compression buffers. The peak resident set of
-/// `weft run --out` over 512² and 1024² grids is 1010 bytes per particle (2026-11-24, AMD
-/// EPYC, AVX-512 path); rounded up for scenes with more constraints.
-pub const BYTES_PER_PARTICLE: u64 = 1200;
+/// Bytes one particle of a built scene needs under `method`: its mesh (positions, masses,
+/// triangles, constraints), the solver's store, domains and scratch (the spring methods' forces,
+/// the implicit method's linearised springs, rows and conjugate-gradient vectors), and one
+/// frame of log messages with their encode and compression buffers. The peak resident set of
+/// `weft run --out` over a 512² grid with every constraint family on, less [`BASE_BYTES`]:
+/// XPBD and PBD 1,452, mass-spring 2,072, implicit mass-spring 2,968 bytes a particle
+/// (2026-12-07, Xeon, AVX-512 path); rounded up.
+pub fn bytes_per_particle(method: Method) -> u64 {
+    match method {
+        Method::Xpbd | Method::Pbd => 1600,
+        Method::MassSpring => 2300,
+        Method::ImplicitMassSpring => 3200,
+    }
+}
 
 /// Extra bytes per self-collision member (its cell in the grid, anchors, tags, the contact
 /// sweep's corrections): measured 240 on a 512² grid, rounded up. The candidate pairs are
@@ -153,12 +162,15 @@ pub fn contact_pairs(members: &[Member], kind: ContactKind, margin: f64, adaptiv
     }
 }
 
-/// The memory a scene of `particles` needs once built and running: the process, the
-/// particles, and with self-collision its `members` and their candidate `pairs` (see
-/// [`self_collision_pairs`]).
-pub fn estimate_bytes(particles: u64, members: u64, pairs: u64) -> u64 {
+/// The memory a scene needs once built and running: the process, its cloths' particles (a
+/// count per cloth, with its method), and with self-collision its `members` and their
+/// candidate `pairs` (see [`self_collision_pairs`]).
+pub fn estimate_bytes(cloths: &[(Method, u64)], members: u64, pairs: u64) -> u64 {
+    let particles = (cloths.iter())
+        .map(|&(m, n)| n.saturating_mul(bytes_per_particle(m)))
+        .fold(0u64, u64::saturating_add);
     BASE_BYTES
-        .saturating_add(particles.saturating_mul(BYTES_PER_PARTICLE))
+        .saturating_add(particles)
         .saturating_add(members.saturating_mul(PER_PARTICLE_SELF_COLLISION))
         .saturating_add(pairs.saturating_mul(BYTES_PER_PAIR))
 }
@@ -220,9 +232,11 @@ pub(crate) fn built_pairs(cloths: &[ClothSpec], sc: Option<&SelfCollisionSpec>) 
 /// The memory a built scene of `cloths`, with self-collision `sc`, needs (mesh cloths and
 /// garments included; see [`estimate_bytes`]).
 pub(crate) fn built_bytes(cloths: &[ClothSpec], sc: Option<&SelfCollisionSpec>) -> u64 {
-    let particles: u64 = cloths.iter().map(|c| c.mesh.len() as u64).sum();
+    let particles: Vec<(Method, u64)> = (cloths.iter())
+        .map(|c| (c.method, c.mesh.len() as u64))
+        .collect();
     let (members, pairs) = built_pairs(cloths, sc);
-    estimate_bytes(particles, members, pairs)
+    estimate_bytes(&particles, members, pairs)
 }
 
 impl Scene {

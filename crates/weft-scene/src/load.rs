@@ -132,7 +132,15 @@ pub fn from_text_with(
             });
         let pairs = contact_pairs(&members, kind, margin, adaptive);
         let count = members.iter().map(|m| m.particles).sum();
-        let need = estimate_bytes(total, count, pairs);
+        let method = |name: &str| {
+            (file.cloth.get(name).and_then(|c| c.method))
+                .unwrap_or(file.sim.method)
+                .into()
+        };
+        let cloths: Vec<_> = (grids.iter())
+            .map(|(n, m, _)| (method(n), m.particles))
+            .collect();
+        let need = estimate_bytes(&cloths, count, pairs);
         let thickest =
             (grids.iter().filter(|g| g.2)).max_by(|a, b| a.1.thickness.total_cmp(&b.1.thickness));
         let by_pairs = pairs.saturating_mul(BYTES_PER_PAIR) > need / 2;
