@@ -187,7 +187,12 @@ pub(crate) fn grid_members(file: &SceneFile) -> Vec<(String, Member, bool)> {
         .filter(|(_, s)| s.mesh.is_none() && s.garment.is_none())
         .map(|(name, s)| {
             let [nx, ny] = s.resolution.unwrap_or(DEFAULT_RESOLUTION);
-            let particles = (nx.clamp(0, 4096) as u64) * (ny.clamp(0, 4096) as u64);
+            // Counts out of range count nothing: the resolution is refused by name instead.
+            let fits = |n: i64| (2..=4096).contains(&n);
+            let particles = match fits(nx) && fits(ny) {
+                true => nx as u64 * ny as u64,
+                false => 0,
+            };
             let [w, h] = s.size.unwrap_or(DEFAULT_SIZE);
             let member = Member {
                 particles,
