@@ -225,6 +225,12 @@ impl Geometry {
     fn window_from(&self, c: usize) -> usize {
         self.margin + c * CHUNK - self.halo
     }
+
+    /// The padded index and the window index of particle `j` of the chunk from `start`.
+    #[inline(always)]
+    fn at(&self, start: usize, j: usize) -> (usize, usize) {
+        (self.margin + start + j, self.halo + j)
+    }
 }
 
 /// What the linearisation of a window reads: the state in lanes and the springs' coefficients.
@@ -423,7 +429,7 @@ impl LaneKernel for Sums<'_> {
             rows,
         } = self;
         for j in (0..rows.len()).step_by(L) {
-            let at = (geo.margin + start + j, geo.halo + j);
+            let at = geo.at(start, j);
             let sums = row_sums::<S, L>(Ops(s), geo, win, x0, at);
             let end = L.min(rows.len() - j);
             for (l, row) in rows[j..j + end].iter_mut().enumerate() {
@@ -540,7 +546,7 @@ impl LaneKernel for Product<'_> {
         } = self;
         let f = Ops(s);
         for j in (0..q.len()).step_by(L) {
-            let at = (geo.margin + start + j, geo.halo + j);
+            let at = geo.at(start, j);
             let sum = ray_sum::<S, L>(f, geo, win, p, at);
             let t = store3::<S, L>(&sum);
             let end = L.min(q.len() - j);

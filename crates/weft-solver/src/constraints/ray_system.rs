@@ -167,7 +167,7 @@ impl LaneKernel for System<'_> {
         let f = Ops(s);
         let mut pq = 0.0;
         for j in (0..q.len()).step_by(L) {
-            let at = (geo.margin + start + j, geo.halo + j);
+            let at = geo.at(start, j);
             let sum = ray_sum::<S, L>(f, geo, win, lanes_p, at);
             let t = store3::<S, L>(&sum);
             let end = L.min(q.len() - j);
@@ -221,7 +221,7 @@ impl LaneKernel for Setup<'_> {
         } = self;
         let mut bb = 0.0;
         for j in (0..r.len()).step_by(L) {
-            let at = (geo.margin + start + j, geo.halo + j);
+            let at = geo.at(start, j);
             let sums = row_sums::<S, L>(Ops(s), geo, win, lanes_x0, at);
             for l in 0..L.min(r.len() - j) {
                 let k = j + l;
