@@ -2,7 +2,9 @@
 //! the scene may need once built, estimated from its particle count before any cloth exists.
 
 use crate::scene::{ClothSpec, DEFAULT_MAX_FILE_BYTES, Scene, SelfCollisionSpec};
-use crate::schema::{ContactKind, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, SceneFile};
+use crate::schema::{
+    ContactKind, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, RESOLUTION_RANGE, SceneFile,
+};
 use weft_solver::Method;
 
 /// What a load may read and allocate.
@@ -188,7 +190,7 @@ pub(crate) fn grid_members(file: &SceneFile) -> Vec<(String, Member, bool)> {
         .map(|(name, s)| {
             let [nx, ny] = s.resolution.unwrap_or(DEFAULT_RESOLUTION);
             // Counts out of range count nothing: the resolution is refused by name instead.
-            let fits = |n: i64| (2..=4096).contains(&n);
+            let fits = |n: i64| RESOLUTION_RANGE.contains(&n);
             let particles = match fits(nx) && fits(ny) {
                 true => nx as u64 * ny as u64,
                 false => 0,

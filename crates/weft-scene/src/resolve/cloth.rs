@@ -13,6 +13,7 @@ use crate::ranges;
 use crate::scene::ClothSpec;
 use crate::schema::{
     ClothSection, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, OrientationName,
+    RESOLUTION_RANGE,
 };
 
 pub(super) fn cloth(
@@ -153,10 +154,11 @@ pub(super) fn cloth(
     } else {
         c.unused(&k("scale"), &s.scale, "by a grid cloth");
         let [nx, ny] = s.resolution.unwrap_or(DEFAULT_RESOLUTION);
-        if !(2..=4096).contains(&nx) || !(2..=4096).contains(&ny) {
+        if !RESOLUTION_RANGE.contains(&nx) || !RESOLUTION_RANGE.contains(&ny) {
+            let (lo, hi) = (RESOLUTION_RANGE.start(), RESOLUTION_RANGE.end());
             c.bad(
                 &k("resolution"),
-                format!("each count must be in 2..=4096, got [{nx}, {ny}]"),
+                format!("each count must be in {lo}..={hi}, got [{nx}, {ny}]"),
             );
         }
         let [w, h] = s.size.unwrap_or(DEFAULT_SIZE);

@@ -11,6 +11,8 @@ use crate::family::Setting;
 
 /// A grid cloth's `resolution` when the file gives none.
 pub const DEFAULT_RESOLUTION: [i64; 2] = [20, 20];
+/// The particle counts along a grid's side that a `resolution` may give.
+pub const RESOLUTION_RANGE: std::ops::RangeInclusive<i64> = 2..=4096;
 /// A grid cloth's `size` (m) when the file gives none.
 pub const DEFAULT_SIZE: [f64; 2] = [1.0, 1.0];
 /// A cloth's collision `thickness` (m) when the file gives none.

@@ -16,6 +16,7 @@ mod exact;
 pub use character::{AnimationKey, AttachSection, CharacterSection, WrapName};
 pub use cloth::{
     ClothSection, DEFAULT_RESOLUTION, DEFAULT_SIZE, DEFAULT_THICKNESS, OrientationName, PinSpec,
+    RESOLUTION_RANGE,
 };
 pub use collider::{ColliderSection, PartSection, ShapeKind};
 
