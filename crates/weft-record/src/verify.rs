@@ -165,7 +165,11 @@ mod tests {
         let scene = weft_scene::from_text("s.toml", text, &[], &weft_scene::DirFiles(".".into()))
             .expect("the scene loads");
         let mut sim = Simulation::new(scene).expect("the scene builds");
-        let path = std::env::temp_dir().join(format!("weft-verify-{}.mcap", std::process::id()));
+        // One file per call: the tests that call this run side by side in one process.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let name = format!("weft-verify-{}-{call}.mcap", std::process::id());
+        let path = std::env::temp_dir().join(name);
         let file = std::fs::File::create(&path).expect("a temporary file");
         let options = RecordOptions {
             mesh_every: 0,
