@@ -1,8 +1,7 @@
 //! One mesh collider as every particle sees it in one projection ([`MeshFrame`]), what one
 //! particle's contacts with it did ([`Outcome`]), and the skins and rounds the contact tiers
-//! share. The tiers add their own methods to [`MeshFrame`]: the candidate lists
-//! ([`super::candidates`]), certificates ([`super::certificate`]) and edge contacts
-//! ([`super::edge_contact`]).
+//! share. The candidate lists ([`super::candidates`]) and the contact grid
+//! ([`super::grid_contacts`]) add their own methods to [`MeshFrame`].
 
 use glam::DVec3;
 use weft_solver::Contacts;
@@ -60,10 +59,10 @@ impl<'a> MeshFrame<'a> {
 }
 
 /// One particle of a run as each contact tier takes it: particle `j` of `lists` (its
-/// candidate list, riding list and certificate), where it stood at the substep's start
+/// candidate list and riding list), where it stood at the substep's start
 /// (`prev`), where it is now (`x`, moved in place by the pushes) and its thickness `r`.
 pub(crate) struct RunParticle<'a> {
-    /// The run's lists and certificates.
+    /// The run's candidate lists.
     pub lists: &'a mut ChunkLists,
     /// The particle's index in `lists`.
     pub j: usize,

@@ -10,15 +10,10 @@
 //! - `ccd`: continuous collision of a moving point with a still or moving triangle.
 //! - `deforming`: what drives a deforming mesh (vertex animations, keyframes).
 //! - `face_update`: a moving mesh's face normals every substep and planes every frame.
-//! - `convexity`: each face's one-ring, and the ring triangles that may come in front of it.
 //! - `frame`: one mesh as every particle sees it in one projection (`MeshFrame`).
-//! - `chunk_lists`: what a mesh keeps per particle of a chunk: lists and certificates.
+//! - `chunk_lists`: what a mesh keeps per particle of a chunk: its candidate list.
 //! - `candidates`: per-particle candidate lists kept with a skin, and contacts through them.
 //! - `riding`: a list's certificate that rides with a deforming surface.
-//! - `certificate`: a particle's certificate: a face, how far the other triangles lie.
-//! - `certified`: the block test certificates allow, in explicit vectors.
-//! - `edge_contact`: contacts over a convex edge of a certificate's face.
-//! - `list_run`: a run of particles against their candidate lists, a block at a time.
 //! - `contact_grid`: a still mesh's uniform grid of cell lists, sides and clearances.
 //! - `face_cert`: what the grid's first test reads of one triangle, and what it decides.
 //! - `grid_lanes`: that first test over `L` lanes in explicit vectors.
@@ -33,21 +28,16 @@ pub(crate) mod bvh;
 pub(crate) mod bvh_node;
 pub(crate) mod candidates;
 pub(crate) mod ccd;
-pub(crate) mod certificate;
-pub(crate) mod certified;
 pub(crate) mod chunk_lists;
 pub(crate) mod closest;
 pub(crate) mod contact_grid;
-pub(crate) mod convexity;
 pub(crate) mod deforming;
-pub(crate) mod edge_contact;
 pub(crate) mod face_cert;
 pub(crate) mod face_update;
 pub(crate) mod frame;
 pub(crate) mod grid_contacts;
 pub(crate) mod grid_lanes;
 pub(crate) mod grid_run;
-pub(crate) mod list_run;
 pub(crate) mod normals;
 #[cfg(test)]
 mod open_side_tests;
@@ -64,7 +54,6 @@ use glam::DVec3;
 
 use bvh::Bvh;
 use closest::{Closest, closest_on_triangle};
-use convexity::{Fronts, Rings};
 use normals::{Topology, pseudo_normal};
 
 /// One triangle at the end of the substep: its corners and unit normal (what the contact
@@ -167,13 +156,6 @@ pub(crate) struct MeshGeometry {
     extent: f64,
     /// Adjacency and closedness.
     topology: Topology,
-    /// Each face's one-ring.
-    rings: Rings,
-    /// Per face, the ring triangles that may come in front of its plane over the current
-    /// frame (over the mesh's life while it is still).
-    fronts: Fronts,
-    /// How far the farthest-moving vertex moves over the current frame (m).
-    frame_reach: f64,
     /// Boxes of the triangles over the substep (start and end).
     bvh: Bvh,
     /// A bound on how far any vertex moved, summed over the substeps so far (m).
@@ -220,7 +202,6 @@ impl MeshGeometry {
         let (bvh, order) = Bvh::build(&boxes);
         let triangles: Vec<[u32; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
         let topology = Topology::new(vertices.len(), &triangles);
-        let rings = Rings::new(&triangles, &topology);
         let extent = vertices
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
@@ -234,9 +215,6 @@ impl MeshGeometry {
             start: vertices.to_vec(),
             end: vertices.to_vec(),
             topology,
-            rings,
-            fronts: Fronts::default(),
-            frame_reach: 0.0,
             bvh,
             travel: 0.0,
             travel_before: 0.0,
@@ -254,8 +232,6 @@ impl MeshGeometry {
         face_update::update_normals(&mut geometry.normals, &geometry.triangles, &geometry.end);
         face_update::update_planes(&mut geometry.planes, &geometry.triangles, &geometry.end);
         geometry.set_margin(extent);
-        let ends = (&geometry.end[..], &geometry.end[..]);
-        (geometry.fronts).update(&geometry.triangles, &geometry.rings, ends, (extent, 0));
         geometry
     }
 
@@ -338,10 +314,7 @@ impl MeshGeometry {
         });
         let extent = (from.iter().chain(end)).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
         self.slack = Self::remaining(&self.end, end);
-        self.frame_reach = self.slack;
         self.frame_id += 1;
-        let ends = (&self.frame.0[..], &self.frame.1[..]);
-        (self.fronts).update(&self.triangles, &self.rings, ends, (extent, self.frame_id));
         self.frame_span = (0.0, 0.0);
         self.set_margin(extent);
     }
@@ -544,24 +517,6 @@ impl MeshGeometry {
             return self.within(x, radius, Some(f64::INFINITY), out);
         }
         best.map(|(d2, t, q)| self.signed(x, t, q, d2))
-    }
-
-    /// The distance from `x` to the nearest triangle sharing no corner with triangle `t` (off
-    /// its ring), or `radius` if none is nearer.
-    pub fn off_ring(&self, x: DVec3, t: usize, radius: f64) -> f64 {
-        let ring = self.triangles[t];
-        let at = (x.as_vec3(), self.margin_at(x));
-        let mut limit = radius * radius;
-        self.bvh.branch_and_bound(x, limit, |u| {
-            if convexity::share_a_corner(ring, self.triangles[u]) {
-                return limit;
-            }
-            if let Some((d2, _)) = self.closest_within(u, x, at, limit) {
-                limit = limit.min(d2);
-            }
-            limit
-        });
-        limit.sqrt()
     }
 
     /// A riding list's search (`riding`): appends to `out` every triangle within `radius` of

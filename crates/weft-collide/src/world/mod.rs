@@ -36,7 +36,6 @@ use crate::trimesh::deforming::MeshAnimation;
 use crate::trimesh::frame::{MeshFrame, RunParticle};
 use crate::trimesh::grid_contacts::GridParticles;
 use crate::trimesh::grid_run::resolve_grid_run;
-use crate::trimesh::list_run::resolve_list_run;
 
 mod cloth;
 mod runs;
@@ -220,11 +219,6 @@ impl CollisionWorld {
     /// Candidate lists built so far for triangle-mesh contacts (all mesh colliders).
     pub fn mesh_list_builds(&self) -> u64 {
         self.sum_over_lists(|l| l.builds)
-    }
-
-    /// Certificates made so far for triangle-mesh contacts (all mesh colliders with lists).
-    pub fn mesh_certificate_builds(&self) -> u64 {
-        self.sum_over_lists(|l| l.certs.builds)
     }
 
     /// `count` summed over every chunk of candidate lists, of the general loop and the fused
@@ -451,7 +445,7 @@ impl CollisionWorld {
                                 Some(grid) => {
                                     frame.resolve_in_grid(*grid, i, prev[i], x, thickness[i])
                                 }
-                                None => frame.resolve_listed(RunParticle::new(
+                                None => frame.resolve(RunParticle::new(
                                     &mut lists[slot],
                                     j,
                                     prev[i],

@@ -30,10 +30,9 @@ impl ParticleContacts for CollisionWorld {
     /// particle meets the colliders in the same order, and what one particle meets depends on
     /// that particle alone, so the bits are the same): the substep's sweep first, then each
     /// still half-space or ball a block of particles at a time ([`resolve_still`]), each mesh
-    /// still over the substep on its grid a block at a time too ([`resolve_grid_run`]), a mesh
-    /// off a grid whose pose is the identity through the run's candidate lists (locked for the
-    /// pass) a block at a time as well ([`resolve_list_run`]), any other collider particle by
-    /// particle.
+    /// still over the substep on its grid a block at a time too ([`resolve_grid_run`]), any
+    /// other collider particle by particle (a mesh off a grid through the run's candidate
+    /// lists, locked for the pass).
     fn resolve_run(&self, run: ParticleRun<'_>, fresh: bool) -> Contacts {
         let frames = self.grid_frames(fresh);
         let start = run.start;
@@ -82,9 +81,6 @@ impl CollisionWorld {
             Some(s) => Some(Blocked::Surface(s)),
             None => match &frames[j] {
                 Some((frame, Some(grid))) if frame.settles() => Some(Blocked::Mesh(frame, *grid)),
-                Some((frame, None)) if frame.lists_settle() => {
-                    Some(Blocked::Lists(frame, listed(&frames[..j])))
-                }
                 _ => None,
             },
         };
@@ -121,9 +117,6 @@ impl CollisionWorld {
                 Some((_, Blocked::Mesh(frame, grid))) => {
                     total = total.merge(resolve_grid_run(frame, grid, r, &mut run));
                 }
-                Some((_, Blocked::Lists(frame, slot))) => {
-                    total = total.merge(resolve_list_run(frame, &mut lists[slot], r, &mut run));
-                }
                 None => {}
             }
             k = stop + 1;
@@ -138,9 +131,6 @@ enum Blocked<'f, 'a> {
     Surface(Surface),
     /// A mesh still over the substep, on its grid.
     Mesh(&'f MeshFrame<'a>, GridRef<'a>),
-    /// A mesh with candidate lists whose pose is the identity throughout, and the slot of
-    /// its lists among the run's.
-    Lists(&'f MeshFrame<'a>, usize),
 }
 
 impl CollisionWorld {
@@ -235,7 +225,7 @@ impl CollisionWorld {
                     Some(grid) => frame.resolve_in_grid(*grid, i, prev, x, r),
                     None => {
                         slot += 1;
-                        frame.resolve_listed(RunParticle::new(
+                        frame.resolve(RunParticle::new(
                             &mut lists[slot - 1],
                             i - start,
                             prev,
