@@ -1,6 +1,13 @@
 //! `weft._weft`, the native module of the `weft` Python package: [`Simulation`] (a scene
 //! stepped with the GIL released, its arrays as numpy arrays, live settings, grabs and MCAP
 //! recordings), the exceptions, and the lists of methods and materials.
+//!
+//! Its modules:
+//!
+//! - `convert`: between Python and Weft: overrides, live values, vectors, numpy arrays, exceptions.
+//! - `recording`: `Simulation.record`: the MCAP log `weft run --out` writes, as the CLI does.
+//! - `simulation`: `weft.Simulation`: a scene's solvers from Python.
+//! - `watch`: stepping with the GIL released while the calling thread hears Ctrl-C.
 
 // pyo3's macros expand to code that the workspace's `missing_docs` cannot see documented
 // (their docs are the Python docstrings, which these `///` comments become).

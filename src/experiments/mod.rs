@@ -1,5 +1,17 @@
 //! `weft experiments`: the recorder. Runs a queue of scene variants in parallel (optionally one
 //! shard of it), logs each run to MCAP, and writes a summary table and plots.
+//!
+//! Its modules:
+//!
+//! - `cantilever`: the cantilever bending test in an experiments file, a strip per run.
+//! - `front`: cost–accuracy fronts: the runs no cheaper run of their series beats.
+//! - `metrics`: metrics of one run, measured while it steps.
+//! - `montage`: every rendered run of a series tiled into one labelled video.
+//! - `plot`: PNG line plots of one metric against a swept key, one line per series.
+//! - `progress`: progress while `weft experiments` runs: one bar for the queue, on a terminal.
+//! - `reference`: a converged reference run that the accuracy metrics compare every run with.
+//! - `report`: the queue's summary: CSV, Markdown and plots, from every run result present.
+//! - `spec`: the experiments file, expanded into a numbered queue of runs.
 
 mod cantilever;
 mod front;

@@ -2,8 +2,18 @@
 //! sequence (`obj.rs`) or an animated GLB (`glb.rs`). The log is checked whole first, the frames
 //! are chosen (`select.rs`), the memory and disk the export needs are estimated before anything
 //! is read or written (`estimate.rs`), the tracks are read (`log.rs`), and every file is written
-//! through `output.rs` (a partial renamed when whole, never over the log). A signal stops the
+//! through `crate::output` (a partial renamed when whole, never over the log). A signal stops the
 //! export between two messages or frames: files finished stay, the one in progress goes.
+//!
+//! Its modules:
+//!
+//! - `body`: the character's body in an export, each part a collider track.
+//! - `collider_track`: a collider's track over the exported frames, and its logged pose.
+//! - `estimate`: the memory and disk an export will need, checked before any frame is read.
+//! - `glb`: the exported frames as one animated GLB, cloths as shape keys for Blender.
+//! - `log`: what an export reads from a log: frames, cloth triangles and positions, colliders.
+//! - `obj`: one frame as Wavefront OBJ text, each cloth and each collider an object.
+//! - `select`: which logged frames an export writes: `--frames A..B` and `--every N`.
 
 pub mod body;
 pub mod collider_track;

@@ -4,6 +4,19 @@
 //!
 //! The renderer only reads the solver's particle positions (as [`FrameData`]); it never
 //! mutates simulation state.
+//!
+//! The crate's modules:
+//!
+//! - `camera`: the orbit camera around a target, and rays from pixels and back.
+//! - `error`: renderer errors.
+//! - `geometry`: CPU-side geometry: cloth normals, collider meshes, wireframe edges and bounds.
+//! - `gpu`: adapter, device and queue.
+//! - `offscreen`: an offscreen colour target read back as an image.
+//! - `pipelines`: render pipelines, bind group layouts and vertex layouts.
+//! - `renderer`: the renderer: meshes staged on the CPU, uploaded, and drawn by its passes.
+//! - `scene`: what the renderer draws: a scene's fixed meshes and the per-frame state.
+//! - `tile`: a rectangle of a larger image drawn on its own, so big renders go a tile at a time.
+//! - `uniforms`: the main pass's uniform block, the material palette and the sun.
 
 mod camera;
 mod error;

@@ -3,6 +3,16 @@
 //! controls the viewer and Python change between frames ([`control`]), a character's body
 //! posed for the renderer, the log and the export ([`body`]), and garment seams that did not
 //! close ([`seams`]).
+//!
+//! The crate's modules:
+//!
+//! - `body`: a character's body as posed shapes, for the renderer, the log and the export.
+//! - `control`: live controls, named by the scene file's own keys, applied between frames.
+//! - `crossings`: cloth crossings and near approaches measured on a scene's solvers.
+//! - `error`: what a grab or a live control refuses, naming the key, the cloth or the value.
+//! - `grab`: holding one particle of a cloth and dragging it.
+//! - `seams`: a garment's seam pairs still apart once the seams were due to have closed.
+//! - `simulation`: a scene's solvers stepped in lockstep, one frame at a time.
 
 pub mod body;
 pub mod control;

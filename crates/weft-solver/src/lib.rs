@@ -20,6 +20,7 @@
 //!   reads its bending length back.
 //! - `cantilever`: the cantilever bending test's strip, clamp and chord angle.
 //! - `elastica`: the heavy elastica, the exact shape of the cantilever bending test.
+//! - `cusick`: the Cusick drape test: a fabric disc clamped and draped, and its drape coefficient.
 //! - `spring_defaults`: spring constants scaled to the cloth, stable for the explicit springs.
 //! - `stability`: the explicit springs' highest mode and the largest stable substep.
 //! - `coloring`: greedy graph colouring of the constraints.
@@ -27,10 +28,13 @@
 //! - `domains`: domain decomposition of the distance constraints for parallel SIMD sweeps.
 //! - `method`: the four methods and the strategy each plugs into the step loop.
 //! - `methods`: one small strategy per method, and the `Strategy` trait.
+//! - `sparse`: sparse linear algebra for the spring methods: force rows, vectors, blocks, PCG.
 //! - `forces`: gravity, wind, aerodynamics and damping.
+//! - `air`: when the air leaves a particle's acceleration at gravity, so a kernel may skip drag.
 //! - `motion`: prescribed rigid motions for kinematic pins (and colliders elsewhere).
 //! - `driver`: driven pins, placed by something outside the solver at every substep.
 //! - `chunk`: the task size of the per-particle parallel loops.
+//! - `awake`: keeps the pool's other workers awake through a run of short parallel passes.
 //! - `solver`: the [`Solver`] and its step loop, fused and general.
 //! - `builder`: [`SolverBuilder`], which assembles cloths, constraints and pins into a solver.
 //! - `settings`: time stepping settings.

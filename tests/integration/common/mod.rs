@@ -1,4 +1,7 @@
 //! Helpers for the `weft` binary's tests: run it, write scenes, read its MCAP logs.
+//!
+//! - `screen`: screenshots of the virtual X server: read, compared by region, saved as PNG.
+//! - `x11`: the real viewer in a virtual X server (Xvfb), driven by `xdotool`.
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;

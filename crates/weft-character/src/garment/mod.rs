@@ -1,5 +1,12 @@
 //! Garments sewn from flat panels: outlines triangulated to a chosen edge length, placed
 //! around the body, and seams given as matched vertex pairs, as a weft-solver [`ClothMesh`].
+//!
+//! Its modules:
+//!
+//! - `outline`: panel outlines sampled to the target edge length, a seam's two sides alike.
+//! - `sew`: building a garment: panels triangulated, placed around the body, merged and seamed.
+//! - `spec`: the garment file: flat panels, their placement around the body, and their seams.
+//! - `triangulate`: a sampled outline triangulated and refined to the target edge length.
 
 mod outline;
 mod sew;

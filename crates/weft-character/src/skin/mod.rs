@@ -7,6 +7,14 @@
 //! inverse bind matrix. The skinned mesh node's own transform is ignored, as the
 //! specification requires. This module reads a parsed document and its buffers; reading
 //! files (and external buffers) is [`crate::files`]'s job.
+//!
+//! Its modules:
+//!
+//! - `animation`: glTF node animation channels, interpolated linearly (slerp for rotations) or
+//!   stepwise.
+//! - `attach`: cloth vertices attached to a joint of a skinned character, following its node.
+//! - `collider`: a skinned mesh as a deforming triangle-mesh collider for weft-collide.
+//! - `load`: from a parsed glTF document and its buffers to a `SkinnedMesh`.
 
 mod animation;
 mod attach;

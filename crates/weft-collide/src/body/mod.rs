@@ -7,6 +7,14 @@
 //! phase built for a few substeps at a time (`grid.rs`), swept contact in each part's moving
 //! frame and contact planes with Coulomb friction against the part's own motion
 //! (`contact.rs`).
+//!
+//! Its modules:
+//!
+//! - `collider`: a body in the collision world: its parts at a substep's ends, broad phase, sweeps.
+//! - `contact`: one particle against a body's parts: the swept test and the contact planes.
+//! - `grid`: the body's broad phase, a uniform grid of the parts each cell's particles could touch.
+//! - `motion`: a body part over one substep: its geometry at the end and its frame's rigid motion.
+//! - `round_cone`: a tapered capsule, with its signed distance, closest point and normal in f64.
 
 mod collider;
 mod contact;

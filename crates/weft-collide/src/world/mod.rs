@@ -8,6 +8,11 @@
 //! stiffness: it moves the particle to the surface, and the shared loop's velocity update
 //! v = (x − x_prev) / h then removes the normal approach velocity, exactly as it does for XPBD
 //! and PBD.
+//!
+//! Its modules:
+//!
+//! - `cloth`: turning mesh-level cloth contact on and off in a world, and what it did.
+//! - `runs`: the contacts of a run of particles, as the solver's fused pass hands them over.
 
 use std::ops::Range;
 use std::sync::Arc;

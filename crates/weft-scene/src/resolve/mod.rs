@@ -1,6 +1,16 @@
 //! Validation: turns a deserialised [`SceneFile`] into a checked [`Scene`](crate::Scene) with
 //! solver types, reporting every bad value with its key and line. The [`Checker`] holds the
 //! shared checks; a cloth, a collider each have their own file.
+//!
+//! Its modules:
+//!
+//! - `character`: the `[character]` table, checked and built into a `CharacterSpec`.
+//! - `checker`: the `Checker`, which collects every error, and the shared checks.
+//! - `cloth`: a `[cloth.<name>]` table, checked and built into a `ClothSpec`.
+//! - `collider`: a `[[collider]]` table, checked into a `ColliderSpec`.
+//! - `garment`: a garment cloth: its panels built into a mesh, its seams and its attachments.
+//! - `model`: a skinned glTF character (`[character] model`): read, animated and placed.
+//! - `pins`: a cloth's `pins` and `held` lists, checked into solver pins or vertex indices.
 
 mod character;
 mod checker;

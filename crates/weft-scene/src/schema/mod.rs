@@ -1,6 +1,13 @@
 //! The scene file as written: serde structures mirroring the TOML, before validation.
 //!
 //! Every table denies unknown keys, so a typo is an error rather than a silently ignored value.
+//!
+//! Its modules:
+//!
+//! - `character`: `[character]` and a garment's `attach` entries.
+//! - `cloth`: `[cloth.<name>]`: its own keys and the keys of each constraint family.
+//! - `collider`: `[[collider]]` and the parts of a compound.
+//! - `exact`: fixed-length arrays read exactly, so that a short array is an error.
 
 use std::collections::BTreeMap;
 use std::fmt;

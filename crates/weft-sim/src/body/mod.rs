@@ -2,6 +2,8 @@
 //! capsule or a sphere) placed in its own frame, centred between its end spheres with its
 //! local y axis from the first end to the second and turning with the bone that carries it.
 //! One pose for the renderer, the `/colliders` and `/colliders/state` channels and the export.
+//!
+//! - `mesh`: a body part's surface as triangles in its own frame, a surface of revolution.
 
 pub mod mesh;
 

@@ -19,6 +19,7 @@
 //!   kernel.
 //! - `quad_cg`: XPBD's bending step, alone or with the distance constraints, by conjugate
 //!   gradients where one sweep leaves it soft, and its residual.
+//! - `spring_force`: spring forces by slots, each particle summing its own slots in order.
 //! - `spring_stencil`: explicit distance springs on a grid as fixed index offsets, their
 //!   forces in f32 lanes.
 //! - `ray_stencil`: implicit distance springs on a grid by slot: their linearisation and

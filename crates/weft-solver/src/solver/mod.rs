@@ -1,5 +1,10 @@
 //! The solver: one step loop shared by every method (the loop itself, fused and general, is
 //! in `frame.rs`).
+//!
+//! Its modules:
+//!
+//! - `frame`: one frame of the step loop, fused or general, the same bits either way.
+//! - `frame_springs`: the explicit mass-spring frame by stencil, one parallel pass a substep.
 
 mod frame;
 mod frame_springs;

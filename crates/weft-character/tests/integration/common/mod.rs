@@ -1,5 +1,8 @@
 //! Fixtures shared by the character tests, and (`watch`) weft-collide's test hook that checks
 //! every substep.
+//!
+//! - `triangle`: weft-collide's reference closest point on a triangle, included by path.
+//! - `watch`: weft-collide's hook that checks the particles after every substep, included by path.
 #![allow(dead_code)]
 
 #[path = "../../../../weft-collide/tests/integration/common/triangle.rs"]

@@ -1,5 +1,8 @@
 //! Shared test helpers: a hook that wraps the collision world and checks every substep, and
 //! (`split`) a scene's self-collision timed in a world of its own.
+//!
+//! - `split`: a scene's collisions as two hooks, self-collision timed from outside.
+//! - `watch`: a hook that runs the collision world and checks the particles after every substep.
 #![allow(dead_code)]
 
 pub mod split;

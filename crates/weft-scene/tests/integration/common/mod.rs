@@ -1,6 +1,9 @@
 //! Shared test helpers: the shipped scenes, loaded with overrides and switched to one method,
 //! a hook that checks the particles after every substep, and a reference closest point on a
 //! triangle.
+//!
+//! - `triangle`: weft-collide's reference closest point on a triangle, included by path.
+//! - `watch`: weft-collide's hook that checks the particles after every substep, included by path.
 #![allow(dead_code)]
 
 #[path = "../../../../weft-collide/tests/integration/common/triangle.rs"]

@@ -1,4 +1,6 @@
 //! Fixtures shared by the physics tests.
+//!
+//! - `flag`: the windy flag the determinism tests run, on a given thread count, fused or general.
 #![allow(dead_code)]
 
 pub mod flag;
