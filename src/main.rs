@@ -1,5 +1,13 @@
 //! The `weft` binary: the interactive viewer; runs scenes headless, logs them to MCAP, checks
 //! scene files, replays logs and runs experiment queues.
+//!
+//! Its modules, by command: `run` (`weft run`), `app` (`weft view`), `video` (`weft render`),
+//! `experiments`, `replay`, `recover`, `export`, `fabric`, `explain` (`weft check --explain`)
+//! and `cli` (the command line). Shared by several: `view` and `framing` (what is drawn and
+//! from where), `output` (files that never overwrite an input), `limits` (memory and file
+//! size), `stop` (SIGINT and SIGTERM), `say` (standard output), `runtime_dir` (a private
+//! `XDG_RUNTIME_DIR` for the GPU), `stability`, `crossing_report` and `seam_report` (warnings
+//! in words) and `default_scene` (the built-in hanging cloth).
 
 // First, so that `say!` is in scope in every module below.
 #[macro_use]

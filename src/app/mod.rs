@@ -9,6 +9,7 @@
 //! | `picking.rs`, `grab.rs` | ray–cloth picking; grabbing and dragging through the solver |
 //! | `command.rs` | pause, step and reset, as the keys and the panel both ask for them |
 //! | `camera.rs` | the camera's framing (F, Home) and following a character |
+//! | `character.rs` | the character choices (clip, garment scene, fabrics), applied by reloading |
 //! | `labels.rs` | the cloths' labels in the 3-D view and their legend colours |
 //! | `input.rs` | key and mouse-button bindings |
 //! | `panel.rs` | the egui side panel |

@@ -6,6 +6,9 @@
 //! that path. Every width runs the same IEEE operations in the same order, so the path changes
 //! the speed, never the bits. The solver's constraint sweep and the collision crate's contact
 //! kernels both build on this crate, which depends on neither.
+//!
+//! Its modules: `path` (the instruction sets and how one is picked) and `lanes` (the lane
+//! operations and the kernel trait).
 
 mod lanes;
 mod path;

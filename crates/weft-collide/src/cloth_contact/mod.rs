@@ -17,7 +17,8 @@
 //! freezes impact zones at their start, so that no pair of elements touches during the
 //! substep: a cloth that started without crossings has none at the substep's end (see
 //! [`failsafe`] for what prescribed motion can still force). [`topology`] lists the elements,
-//! [`geometry`] holds the closest-point queries.
+//! [`geometry`] holds the closest-point queries. [`grid`] is the broad phase's uniform grid of element
+//! boxes.
 //!
 //! Every part is parallel over pairs and sums in the list's order: same bits on any thread
 //! count.
