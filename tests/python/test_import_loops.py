@@ -2,23 +2,12 @@
 """Checks scripts/check_import_loops.py on small made-up workspaces: a loop between two
 sibling modules (through `use` and through a path written inline) fails it, a tree whose
 children only name their parent passes, and test-only modules are left out."""
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
+from script_cases import check
+
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "check_import_loops.py"
-
-
-def run(files):
-    """Exit code and output of the check on a workspace holding `files` (path -> text)."""
-    with tempfile.TemporaryDirectory() as d:
-        for path, text in files.items():
-            f = Path(d) / path
-            f.parent.mkdir(parents=True, exist_ok=True)
-            f.write_text(text)
-        p = subprocess.run([sys.executable, str(SCRIPT), "--root", d], capture_output=True, text=True)
-        return p.returncode, p.stdout + p.stderr
 
 
 CASES = [
@@ -68,16 +57,7 @@ CASES = [
 
 
 def main():
-    passed = failed = 0
-    for name, files, want_code, want_text in CASES:
-        code, out = run(files)
-        if code == want_code and want_text in out:
-            passed += 1
-        else:
-            failed += 1
-            print(f"FAIL {name}: exit {code} (want {want_code}), output:\n{out}")
-    print(f"{passed} passed, {failed} failed")
-    return 1 if failed else 0
+    return check(SCRIPT, CASES)
 
 
 if __name__ == "__main__":
