@@ -23,8 +23,8 @@
 //! - `spring_stencil`: explicit distance springs on a grid as fixed index offsets, their
 //!   forces in f32 lanes.
 //! - `ray_stencil`: implicit distance springs on a grid by slot: their linearisation and
-//!   products in f64 lanes; `ray_system`, the implicit system in one pass a step where they
-//!   are all the springs.
+//!   products in f64 lanes; `ray_system`, the implicit system's rows and conjugate gradients
+//!   in f64 lanes where they are all the springs.
 //! - `parts`: contiguous particle ranges that let one colour be projected in parallel.
 
 mod block;
@@ -54,7 +54,7 @@ pub use distance::Distance;
 pub use isometric::Isometric;
 pub(crate) use linear::Springs;
 pub(crate) use linear_rows::{RowSums, State as LinearState};
-pub(crate) use ray_stencil::SystemRows;
+pub(crate) use ray_stencil::SystemIo;
 pub use seam::Seam;
 pub(crate) use spring_stencil::{Mirror, Ring, SpringStencil, WIDEST};
 pub use tether::Tether;

@@ -29,7 +29,8 @@ use crate::sparse::Sym3;
 
 #[path = "ray_system.rs"]
 mod system;
-pub(crate) use system::SystemRows;
+use system::ChunkVectors;
+pub(crate) use system::SystemIo;
 
 /// The widest lane group (AVX-512's f64 lanes): the stride and the margins are its multiples.
 const WIDE: usize = 8;
@@ -88,8 +89,8 @@ struct Lanes {
     coef: Vec<[f64; 3]>,
     /// The substep h, as last loaded.
     h: f64,
-    /// Whether `p` holds the direction of the last [`RayStencil::next_direction`], not yet used.
-    direction: bool,
+    /// Each chunk's vectors of the implicit solve (`ray_system.rs`).
+    chunks: Vec<ChunkVectors>,
 }
 
 impl RayStencil {
@@ -122,11 +123,16 @@ impl RayStencil {
             *r = shape.rest;
         }
         let halo = widest.next_multiple_of(WIDE);
-        let windows = (0..stride.div_ceil(CHUNK))
-            .map(|c| vec![vec![0.0; halo + CHUNK.min(stride - c * CHUNK)]; positive.len() * TERMS])
+        let chunk_len = |c: usize| CHUNK.min(stride - c * CHUNK);
+        let chunks = stride.div_ceil(CHUNK);
+        let windows = (0..chunks)
+            .map(|c| vec![vec![0.0; halo + chunk_len(c)]; positive.len() * TERMS])
             .collect();
         let lanes = Lanes {
             windows,
+            chunks: (0..chunks)
+                .map(|c| ChunkVectors::new(chunk_len(c)))
+                .collect(),
             ..Lanes::default()
         };
         let geo = Geometry {
@@ -174,7 +180,7 @@ impl RayStencil {
 
     /// Loads the state into lanes (x₀ into `p`) and the springs' coefficients, for the
     /// linearisation that follows ([`RayStencil::linearize`] or
-    /// [`RayStencil::system_rows`]).
+    /// [`RayStencil::solve_system`]).
     pub fn load_state(&mut self, params: &[FamilyParams], st: State<'_>) {
         let Self { geo, lanes } = self;
         let len = geo.stride + 2 * geo.margin;
@@ -183,7 +189,6 @@ impl RayStencil {
         if let Some(x0) = st.x0 {
             load(&mut lanes.p, geo.margin, len, x0);
         }
-        lanes.direction = false;
         lanes.h = st.h;
         lanes.coef = (geo.positive.iter())
             .map(|&(_, g)| {
@@ -202,7 +207,6 @@ impl RayStencil {
     pub fn product(&mut self, p: &[DVec3], q: &mut [DVec3], path: SimdPath) {
         let Self { geo, lanes } = self;
         load(&mut lanes.p, geo.margin, geo.stride + 2 * geo.margin, p);
-        lanes.direction = false;
         let (geo, windows, p) = (&*geo, &lanes.windows, &lanes.p);
         q.par_chunks_mut(CHUNK).enumerate().for_each(|(c, q)| {
             let (start, win) = (c * CHUNK, &windows[c][..]);
@@ -272,6 +276,24 @@ impl Lanes {
             h: self.h,
         };
         (&mut self.windows, state, &self.p)
+    }
+
+    /// [`Lanes::split`] with the chunks' vectors of the solve, to write.
+    fn split_chunks(
+        &mut self,
+    ) -> (
+        &mut [Window],
+        &mut [ChunkVectors],
+        LoadedState<'_>,
+        &[Vec<f64>; 3],
+    ) {
+        let state = LoadedState {
+            x: &self.x,
+            v: &self.v,
+            coef: &self.coef,
+            h: self.h,
+        };
+        (&mut self.windows, &mut self.chunks, state, &self.p)
     }
 }
 
@@ -430,7 +452,12 @@ impl LaneKernel for Sums<'_> {
         } = self;
         for j in (0..rows.len()).step_by(L) {
             let at = geo.at(start, j);
-            let sums = row_sums::<S, L>(Ops(s), geo, win, x0, at);
+            let (b, ax, d) = row_terms::<S, L>(Ops(s), geo, win, x0, at);
+            let sums = LaneSums::<L> {
+                b: store3::<S, L>(&b),
+                ax: store3::<S, L>(&ax),
+                d: d.map(|d| store::<S, L>(d)),
+            };
             let end = L.min(rows.len() - j);
             for (l, row) in rows[j..j + end].iter_mut().enumerate() {
                 row.b += sums.b(l);
@@ -475,16 +502,16 @@ impl<const L: usize> LaneSums<L> {
 }
 
 /// The springs' sums of the `L` rows at padded index `at.0` and window index `at.1`: ±b,
-/// (A − M) x₀ (zero without x₀) and the diagonal block g gᵀ + κ I, over the slots in slot
-/// order.
+/// (A − M) x₀ (zero without x₀) and the diagonal block g gᵀ + κ I (entries in `Sym3`'s
+/// order), over the slots in slot order.
 #[inline(always)]
-fn row_sums<S: Simd, const L: usize>(
+fn row_terms<S: Simd, const L: usize>(
     f: Ops<S>,
     geo: &Geometry,
     win: &[Vec<f64>],
     x0: Option<&[Vec<f64>; 3]>,
     at: (usize, usize),
-) -> LaneSums<L> {
+) -> (V3<S>, V3<S>, [S::f64s; 6]) {
     let ax = match x0 {
         Some(x0) => ray_sum::<S, L>(f, geo, win, x0, at),
         None => [f.c(0.0); 3],
@@ -515,11 +542,7 @@ fn row_sums<S: Simd, const L: usize>(
             };
         }
     }
-    LaneSums {
-        b: store3::<S, L>(&b),
-        ax: store3::<S, L>(&ax),
-        d: d.map(|d| store::<S, L>(d)),
-    }
+    (b, ax, d)
 }
 
 /// The springs' share of (A − M) p for one chunk of particles from `start`, added to `q`

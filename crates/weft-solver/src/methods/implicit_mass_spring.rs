@@ -25,16 +25,17 @@ use rayon::prelude::*;
 
 use super::{ForcePass, SpringWork, Strategy};
 use crate::chunk::CHUNK;
-use crate::constraints::{ConstraintSet, LinearState, RowSums, Rule, Springs, SystemRows};
+use crate::constraints::{ConstraintSet, LinearState, RowSums, Rule, Springs, SystemIo};
 use crate::params::FamilyParams;
 use crate::particles::Particles;
-use crate::sparse::{Operator, Sym3, direction, solve};
+use crate::sparse::{Operator, Outcome, Sym3, solve};
 use weft_simd::SimdPath;
 
 /// Springs integrated with backward Euler: unconditionally stable, numerically damped.
 pub(crate) struct ImplicitMassSpring;
 
-/// A = M + h D + h² K, filtered: zero on the rows of particles with inverse mass 0.
+/// A = M + h D + h² K, filtered: zero on the rows of particles with inverse mass 0. M p is
+/// formed as p (1/w), as the lanes of `constraints/ray_system.rs` form it from their masses.
 struct System<'a> {
     constraints: &'a ConstraintSet,
     springs: &'a mut Springs,
@@ -45,13 +46,14 @@ struct System<'a> {
 impl Operator for System<'_> {
     fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64 {
         let w = self.w;
-        if let Some(stencil) = self.springs.sole_stencil() {
-            return stencil.system_product(w, p, q, self.simd);
-        }
         q.par_chunks_mut(CHUNK).enumerate().for_each(|(c, q)| {
             for (j, q) in q.iter_mut().enumerate() {
                 let i = c * CHUNK + j;
-                *q = if w[i] > 0.0 { p[i] / w[i] } else { DVec3::ZERO };
+                *q = if w[i] > 0.0 {
+                    p[i] * (1.0 / w[i])
+                } else {
+                    DVec3::ZERO
+                };
             }
         });
         self.constraints
@@ -73,13 +75,6 @@ impl Operator for System<'_> {
             })
             .collect();
         partials.iter().sum()
-    }
-
-    fn next_direction(&mut self, z: &[DVec3], beta: Option<f64>, p: &mut [DVec3]) {
-        match self.springs.sole_stencil() {
-            Some(stencil) => stencil.next_direction(z, beta, p),
-            None => direction(z, beta, p),
-        }
     }
 }
 
@@ -106,6 +101,8 @@ impl Strategy for ImplicitMassSpring {
             work.dv.clear();
             work.dv.resize(n, DVec3::ZERO);
         }
+        let state = (particles, h, warm);
+        let stopping = || pass.stopping();
         let SpringWork {
             springs,
             sums,
@@ -115,52 +112,59 @@ impl Strategy for ImplicitMassSpring {
             scratch,
             ..
         } = work;
-        pinv.resize(n, Sym3::default());
-        r.resize(n, DVec3::ZERO);
-        let state = (particles, h, warm);
-        let b_norm2 = match springs.sole_stencil() {
+        let outcome = match springs.sole_stencil() {
+            // The stencil's springs alone: the whole solve in lanes.
             Some(stencil) => {
                 stencil.load_state(params, linear_state(state, dv));
-                let rows = SystemRows {
-                    w,
-                    accel,
-                    x0: dv,
-                    r,
-                    pinv,
-                };
-                stencil.system_rows(rows, warm, pass.simd)
+                let io = SystemIo { w, accel, dv };
+                stencil.solve_system(io, warm, pass.cg, &stopping, pass.simd)
             }
             None => {
+                pinv.resize(n, Sym3::default());
+                r.resize(n, DVec3::ZERO);
                 let system = (constraints, params, &mut *springs, pass.simd);
-                general_rows(system, state, sums, (dv, r, pinv), accel)
+                let b_norm2 = general_rows(system, state, sums, (dv, r, pinv), accel);
+                let mut system = System {
+                    constraints,
+                    springs,
+                    w,
+                    simd: pass.simd,
+                };
+                let outcome = solve(
+                    &mut system,
+                    pinv,
+                    b_norm2,
+                    dv,
+                    r,
+                    pass.cg,
+                    scratch,
+                    &stopping,
+                );
+                (accel.par_chunks_mut(CHUNK))
+                    .zip(dv.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
+                    .for_each(|(a, (dv, w))| {
+                        for ((a, dv), &w) in a.iter_mut().zip(dv).zip(w) {
+                            if w > 0.0 {
+                                *a = *dv / h;
+                            }
+                        }
+                    });
+                outcome
             }
         };
-        let mut system = System {
-            constraints,
-            springs,
-            w,
-            simd: pass.simd,
-        };
-        let outcome = solve(&mut system, pinv, b_norm2, dv, r, pass.cg, scratch, &|| {
-            pass.stopping()
-        });
-        (accel.par_chunks_mut(CHUNK))
-            .zip(dv.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
-            .for_each(|(a, (dv, w))| {
-                for ((a, dv), &w) in a.iter_mut().zip(dv).zip(w) {
-                    if w > 0.0 {
-                        *a = *dv / h;
-                    }
-                }
-            });
-        work.iterations += outcome.iterations;
-        work.worst = work.worst.max(outcome.residual);
-        work.last = outcome;
+        record(work, outcome);
     }
 
     fn rule(&self, _h: f64) -> Option<Rule> {
         None
     }
+}
+
+/// Adds a solve's `outcome` to the frame's iterations and worst residual.
+fn record(work: &mut SpringWork, outcome: Outcome) {
+    work.iterations += outcome.iterations;
+    work.worst = work.worst.max(outcome.residual);
+    work.last = outcome;
 }
 
 /// The linearisation's state: the particles' positions and velocities, the substep and, when

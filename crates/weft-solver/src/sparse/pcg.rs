@@ -26,12 +26,6 @@ pub(crate) struct CgLimits {
 pub(crate) trait Operator {
     /// `q ← A p`; returns p·q summed in chunk order.
     fn apply(&mut self, p: &[DVec3], q: &mut [DVec3]) -> f64;
-
-    /// The next search direction, `p ← z + β p` (`p ← z` without β), which [`Operator::apply`]
-    /// is given next: an operator may take its own copy of p in the same pass.
-    fn next_direction(&mut self, z: &[DVec3], beta: Option<f64>, p: &mut [DVec3]) {
-        direction(z, beta, p);
-    }
 }
 
 /// `p ← z + β p`, or `p ← z` without β.
@@ -40,6 +34,19 @@ pub(crate) fn direction(z: &[DVec3], beta: Option<f64>, p: &mut [DVec3]) {
         Some(beta) => xpby(z, beta, p),
         None => p.copy_from_slice(z),
     }
+}
+
+/// The passes of one preconditioned conjugate-gradient solve, over vectors a system holds
+/// itself (x, r, z, p, q, the preconditioner P⁻¹), each sum taken in chunk order.
+pub(crate) trait CgPasses {
+    /// z = P⁻¹ r and p = z; returns (r·z, r·r).
+    fn start(&mut self) -> (f64, f64);
+    /// q ← A p; returns p·q.
+    fn apply(&mut self) -> f64;
+    /// x += α p, r −= α q, then z = P⁻¹ r; returns (r·z, r·r).
+    fn step(&mut self, alpha: f64) -> (f64, f64);
+    /// p ← z + β p.
+    fn direction(&mut self, beta: f64);
 }
 
 /// What a solve did.
@@ -137,18 +144,70 @@ pub(crate) fn solve(
     for v in [&mut *z, &mut *p, &mut *q] {
         v.resize(n, DVec3::ZERO);
     }
-    let (mut delta, mut rr) = precondition(pinv, r, z);
-    op.next_direction(z, None, p);
+    let mut passes = Vectors {
+        op,
+        pinv,
+        x,
+        r,
+        z,
+        p,
+        q,
+    };
+    iterate(&mut passes, b_norm2, limits, stopping)
+}
+
+/// The general system's vectors, one 3-vector a particle, and its operator.
+struct Vectors<'a> {
+    op: &'a mut dyn Operator,
+    pinv: &'a [Sym3],
+    x: &'a mut [DVec3],
+    r: &'a mut [DVec3],
+    z: &'a mut [DVec3],
+    p: &'a mut [DVec3],
+    q: &'a mut [DVec3],
+}
+
+impl CgPasses for Vectors<'_> {
+    fn start(&mut self) -> (f64, f64) {
+        let sums = precondition(self.pinv, self.r, self.z);
+        direction(self.z, None, self.p);
+        sums
+    }
+
+    fn apply(&mut self) -> f64 {
+        self.op.apply(self.p, self.q)
+    }
+
+    fn step(&mut self, alpha: f64) -> (f64, f64) {
+        let pq = [&*self.p, &*self.q];
+        step(alpha, pq, self.x, self.r, self.pinv, self.z)
+    }
+
+    fn direction(&mut self, beta: f64) {
+        direction(self.z, Some(beta), self.p);
+    }
+}
+
+/// Conjugate gradients over `passes` (Baraff & Witkin's modified PCG): from their x and
+/// r = b − A x, down to ‖r‖ ≤ tolerance · ‖b‖ (`b_norm2` = ‖b‖₂²), at most the cap; polls
+/// `stopping` once per iteration.
+pub(crate) fn iterate(
+    passes: &mut dyn CgPasses,
+    b_norm2: f64,
+    limits: CgLimits,
+    stopping: &dyn Fn() -> bool,
+) -> Outcome {
+    let (mut delta, mut rr) = passes.start();
     let target = limits.tolerance * limits.tolerance * b_norm2;
     let go_on = |rr: f64, iterations: u32| rr > target && iterations < limits.max_iterations;
     let mut iterations = 0;
     while go_on(rr, iterations) && !stopping() {
-        let pq = op.apply(p, q);
+        let pq = passes.apply();
         if pq.is_nan() || pq <= 0.0 {
             break;
         }
         let alpha = delta / pq;
-        let (next, next_rr) = step(alpha, [&*p, &*q], x, r, pinv, z);
+        let (next, next_rr) = passes.step(alpha);
         rr = next_rr;
         iterations += 1;
         if !go_on(rr, iterations) {
@@ -157,7 +216,7 @@ pub(crate) fn solve(
         }
         let beta = next / delta;
         delta = next;
-        op.next_direction(z, Some(beta), p);
+        passes.direction(beta);
     }
     let residual = if b_norm2 > 0.0 {
         (rr / b_norm2).sqrt()
