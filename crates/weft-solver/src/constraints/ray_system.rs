@@ -142,7 +142,7 @@ struct Passes<'a> {
 }
 
 impl Passes<'_> {
-    /// Runs `kernel(c, chunk, its part of p)` on every chunk with p's part to write, and
+    /// Runs `kernel` on every chunk's vectors with the chunk's part of p to write, and
     /// returns the chunks' sums added in order.
     fn with_direction<K>(&mut self, kernel: K) -> (f64, f64)
     where
