@@ -158,7 +158,7 @@ impl RayStencil {
     ) {
         self.load_state(params, st);
         let geo = &self.geo;
-        let (windows, state, p) = self.lanes.split();
+        let (windows, _, state, p) = self.lanes.split();
         let x0 = st.x0.map(|_| p);
         (rows.par_chunks_mut(CHUNK).zip(windows.par_iter_mut()))
             .enumerate()
@@ -266,20 +266,9 @@ impl LoadedState<'_> {
 }
 
 impl Lanes {
-    /// The windows, to write, beside what their linearisation reads and `p` (the warm start
-    /// after [`RayStencil::load_state`]).
-    fn split(&mut self) -> (&mut [Window], LoadedState<'_>, &[Vec<f64>; 3]) {
-        let state = LoadedState {
-            x: &self.x,
-            v: &self.v,
-            coef: &self.coef,
-            h: self.h,
-        };
-        (&mut self.windows, state, &self.p)
-    }
-
-    /// [`Lanes::split`] with the chunks' vectors of the solve, to write.
-    fn split_chunks(
+    /// The windows and the chunks' vectors of the solve, to write, beside what the windows'
+    /// linearisation reads and `p` (the warm start after [`RayStencil::load_state`]).
+    fn split(
         &mut self,
     ) -> (
         &mut [Window],

@@ -17,7 +17,7 @@ use weft_simd::{LaneKernel, Ops, SimdPath, V3, load, load_at, on_path, store};
 
 use super::{Geometry, RayStencil, ray_sum, row_terms, v3};
 use crate::chunk::CHUNK;
-use crate::sparse::{CgLimits, CgPasses, Outcome, iterate};
+use crate::sparse::{CgLimits, CgPasses, Outcome, in_chunk_order, iterate};
 
 /// What the implicit solve reads and writes per particle.
 pub(crate) struct SystemIo<'a> {
@@ -110,7 +110,7 @@ impl RayStencil {
     /// one task. Returns ‖b‖², the chunks' sums added in order.
     fn system_rows(&mut self, w: &[f64], accel: &[DVec3], warm: bool, path: SimdPath) -> f64 {
         let (geo, h) = (&self.geo, self.lanes.h);
-        let (windows, chunks, state, p) = self.lanes.split_chunks();
+        let (windows, chunks, state, p) = self.lanes.split();
         let x0 = warm.then_some(p);
         let partials: Vec<f64> = (windows.par_iter_mut().zip(chunks.par_iter_mut()))
             .enumerate()
@@ -155,7 +155,7 @@ impl Passes<'_> {
             .into_par_iter()
             .map(|(cv, d0, d1, d2)| kernel(cv, [d0, d1, d2]))
             .collect();
-        (partials.iter()).fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+        in_chunk_order(partials)
     }
 }
 
@@ -195,7 +195,7 @@ impl CgPasses for Passes<'_> {
                 on_path(path, Step { cv, alpha, p, from })
             })
             .collect();
-        (partials.iter()).fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+        in_chunk_order(partials)
     }
 
     fn direction(&mut self, beta: f64) {

@@ -18,6 +18,8 @@ pub(crate) mod rows;
 pub(crate) mod sym3;
 pub(crate) mod vector;
 
-pub(crate) use pcg::{CgLimits, CgPasses, Operator, Outcome, PcgScratch, iterate, solve};
+pub(crate) use pcg::{
+    CgLimits, CgPasses, Operator, Outcome, PcgScratch, in_chunk_order, iterate, solve,
+};
 pub(crate) use rows::Rows;
 pub(crate) use sym3::Sym3;

@@ -75,7 +75,7 @@ fn precondition_row(m: &Sym3, r: DVec3, z: &mut DVec3, sums: &mut (f64, f64)) {
 }
 
 /// The chunks' (r·z, r·r) added in chunk order.
-fn in_chunk_order(partials: Vec<(f64, f64)>) -> (f64, f64) {
+pub(crate) fn in_chunk_order(partials: Vec<(f64, f64)>) -> (f64, f64) {
     (partials.iter()).fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
 }
 
